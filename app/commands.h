@@ -1,0 +1,21 @@
+#pragma once
+// Each subcommand registers its options on the CLI11 app and returns the function that runs it.
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace ts::app {
+
+struct GlobalOptions {
+  int device = -1;         // --device N (else TETRASAND_DEVICE, else auto)
+  bool verbose = false;
+  bool quiet = false;
+  bool gl_debug = false;   // --gl-debug: KHR_debug output, GL errors checked after every kernel
+};
+
+using Runner = std::function<int()>;
+
+Runner add_devices_command(CLI::App& app, const GlobalOptions& global);
+Runner add_info_command(CLI::App& app, const GlobalOptions& global);
+
+}  // namespace ts::app

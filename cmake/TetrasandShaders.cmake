@@ -1,0 +1,47 @@
+# Shaders are validated at build time by glslangValidator, so a GLSL error fails the build, not a run,
+# and are copied next to the executables (build tree) and installed beside them (share/tetrasand/shaders).
+#
+# tetrasand_add_shaders(<target> <file>...) with files relative to ${CMAKE_SOURCE_DIR}/shaders.
+function(tetrasand_add_shaders target)
+  set(stamps)
+  set(shader_root ${CMAKE_SOURCE_DIR}/shaders)
+  # Every kernel may include the shared headers, so each check depends on all of them.
+  file(GLOB_RECURSE shared_headers CONFIGURE_DEPENDS ${shader_root}/common/*.h ${shader_root}/common/*.glsl)
+  foreach(rel IN LISTS ARGN)
+    set(src ${shader_root}/${rel})
+    set(dst ${TETRASAND_SHADER_BUILD_DIR}/${rel})
+    set(stamp ${CMAKE_CURRENT_BINARY_DIR}/shader-stamps/${rel}.ok)
+    get_filename_component(stamp_dir ${stamp} DIRECTORY)
+    get_filename_component(dst_dir ${dst} DIRECTORY)
+    add_custom_command(
+      OUTPUT ${stamp} ${dst}
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${stamp_dir} ${dst_dir}
+      # -G (GL SPIR-V) is the mode in which Debian's glslang 12 resolves #include; auto-mapping keeps
+      # plain GL uniforms legal there. The output is discarded: drivers compile the GLSL at run time.
+      COMMAND ${GLSLANG_VALIDATOR} --quiet -G --auto-map-locations --auto-map-bindings -o /dev/null -I${shader_root} ${src}
+      COMMAND ${CMAKE_COMMAND} -E copy_if_different ${src} ${dst}
+      COMMAND ${CMAKE_COMMAND} -E touch ${stamp}
+      DEPENDS ${src} ${shared_headers}
+      COMMENT "glslangValidator ${rel}"
+      VERBATIM)
+    list(APPEND stamps ${stamp})
+    get_filename_component(rel_dir ${rel} DIRECTORY)
+    install(FILES ${src} DESTINATION share/tetrasand/shaders/${rel_dir})
+  endforeach()
+  add_custom_target(${target} ALL DEPENDS ${stamps})
+endfunction()
+
+# Header-only files shared by shaders (and, for layouts, by C++): copied, not validated alone.
+function(tetrasand_add_shader_headers target)
+  set(outs)
+  foreach(rel IN LISTS ARGN)
+    set(dst ${TETRASAND_SHADER_BUILD_DIR}/${rel})
+    add_custom_command(OUTPUT ${dst}
+      COMMAND ${CMAKE_COMMAND} -E copy_if_different ${CMAKE_SOURCE_DIR}/shaders/${rel} ${dst}
+      DEPENDS ${CMAKE_SOURCE_DIR}/shaders/${rel} VERBATIM)
+    list(APPEND outs ${dst})
+    get_filename_component(rel_dir ${rel} DIRECTORY)
+    install(FILES ${CMAKE_SOURCE_DIR}/shaders/${rel} DESTINATION share/tetrasand/shaders/${rel_dir})
+  endforeach()
+  add_custom_target(${target} ALL DEPENDS ${outs})
+endfunction()

@@ -1,0 +1,288 @@
+#include "gpu/gl.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <utility>
+
+#include "core/error.h"
+
+namespace ts::gpu {
+
+namespace {
+
+std::string gl_error_name(GLenum code) {
+  switch (code) {
+    case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
+    default: return fmt::format("GL error 0x{:x}", code);
+  }
+}
+
+GLuint compile_stage(const ShaderLibrary& library, GLenum stage, const std::string& relative,
+                     const std::vector<std::string>& defines) {
+  const ShaderSource source = library.load(relative, defines);
+  const GLuint shader = glCreateShader(stage);
+  const char* text = source.text.c_str();
+  glShaderSource(shader, 1, &text, nullptr);
+  glCompileShader(shader);
+  GLint ok = GL_FALSE;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    GLint length = 0;
+    glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
+    glGetShaderInfoLog(shader, length, nullptr, log.data());
+    glDeleteShader(shader);
+    throw GpuError("cannot compile shader " + relative + ":\n" +
+                   ShaderLibrary::annotate_log(log.c_str(), source, library.root()));
+  }
+  return shader;
+}
+
+GLuint link(const std::vector<GLuint>& shaders, const std::string& name) {
+  const GLuint program = glCreateProgram();
+  for (GLuint s : shaders) glAttachShader(program, s);
+  glLinkProgram(program);
+  for (GLuint s : shaders) {
+    glDetachShader(program, s);
+    glDeleteShader(s);
+  }
+  GLint ok = GL_FALSE;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    GLint length = 0;
+    glGetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
+    glGetProgramInfoLog(program, length, nullptr, log.data());
+    glDeleteProgram(program);
+    throw GpuError("cannot link program " + name + ":\n" + log.c_str());
+  }
+  return program;
+}
+
+}  // namespace
+
+void check_gl(const std::string& what) {
+  const GLenum code = glGetError();
+  if (code != GL_NO_ERROR) {
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    throw GpuError(gl_error_name(code) + " in " + what);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------- Buffer
+
+Buffer::Buffer(std::size_t bytes, const void* data, GLbitfield flags) : bytes_(bytes) {
+  glCreateBuffers(1, &id_);
+  // Zero-sized storage is illegal; keep one word so empty scenes still bind something valid.
+  glNamedBufferStorage(id_, static_cast<GLsizeiptr>(std::max<std::size_t>(bytes, 4)), bytes ? data : nullptr,
+                       flags | GL_DYNAMIC_STORAGE_BIT);
+  if (glGetError() == GL_OUT_OF_MEMORY) {
+    glDeleteBuffers(1, &id_);
+    id_ = 0;
+    throw GpuError(fmt::format("out of GPU memory allocating a buffer of {:.1f} MiB", bytes / 1048576.0));
+  }
+}
+
+Buffer::~Buffer() {
+  if (id_) glDeleteBuffers(1, &id_);
+}
+
+Buffer::Buffer(Buffer&& other) noexcept
+    : id_(std::exchange(other.id_, 0)), bytes_(std::exchange(other.bytes_, 0)) {}
+
+Buffer& Buffer::operator=(Buffer&& other) noexcept {
+  if (this != &other) {
+    if (id_) glDeleteBuffers(1, &id_);
+    id_ = std::exchange(other.id_, 0);
+    bytes_ = std::exchange(other.bytes_, 0);
+  }
+  return *this;
+}
+
+void Buffer::upload(const void* data, std::size_t bytes, std::size_t offset) {
+  if (offset + bytes > bytes_) throw GpuError(fmt::format("buffer upload of {} bytes at {} overruns {} bytes", bytes, offset, bytes_));
+  if (bytes) glNamedBufferSubData(id_, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+}
+
+void Buffer::download(void* data, std::size_t bytes, std::size_t offset) const {
+  if (offset + bytes > bytes_) throw GpuError(fmt::format("buffer read of {} bytes at {} overruns {} bytes", bytes, offset, bytes_));
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  if (bytes) glGetNamedBufferSubData(id_, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+}
+
+void Buffer::fill_zero() {
+  const GLuint zero = 0;
+  glClearNamedBufferData(id_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+}
+
+void Buffer::bind(GLuint binding, GLenum target) const { glBindBufferBase(target, binding, id_); }
+
+// --------------------------------------------------------------------------------------------- Program
+
+Program Program::compute(const ShaderLibrary& library, const std::string& relative,
+                         const std::vector<std::string>& defines) {
+  Program p;
+  p.name_ = relative;
+  p.id_ = link({compile_stage(library, GL_COMPUTE_SHADER, relative, defines)}, relative);
+  return p;
+}
+
+Program Program::graphics(const ShaderLibrary& library, const std::string& vertex, const std::string& geometry,
+                          const std::string& fragment, const std::vector<std::string>& defines) {
+  Program p;
+  p.name_ = vertex + "+" + (geometry.empty() ? "" : geometry + "+") + fragment;
+  std::vector<GLuint> shaders{compile_stage(library, GL_VERTEX_SHADER, vertex, defines)};
+  if (!geometry.empty()) shaders.push_back(compile_stage(library, GL_GEOMETRY_SHADER, geometry, defines));
+  shaders.push_back(compile_stage(library, GL_FRAGMENT_SHADER, fragment, defines));
+  p.id_ = link(shaders, p.name_);
+  return p;
+}
+
+Program::~Program() {
+  if (id_) glDeleteProgram(id_);
+}
+
+Program::Program(Program&& other) noexcept
+    : id_(std::exchange(other.id_, 0)), name_(std::move(other.name_)), uniforms_(std::move(other.uniforms_)) {}
+
+Program& Program::operator=(Program&& other) noexcept {
+  if (this != &other) {
+    if (id_) glDeleteProgram(id_);
+    id_ = std::exchange(other.id_, 0);
+    name_ = std::move(other.name_);
+    uniforms_ = std::move(other.uniforms_);
+  }
+  return *this;
+}
+
+void Program::use() const { glUseProgram(id_); }
+
+GLint Program::uniform(const char* name) const {
+  auto it = uniforms_.find(name);
+  if (it == uniforms_.end()) it = uniforms_.emplace(name, glGetUniformLocation(id_, name)).first;
+  return it->second;
+}
+
+void Program::set(const char* name, int value) const { glProgramUniform1i(id_, uniform(name), value); }
+void Program::set(const char* name, unsigned value) const { glProgramUniform1ui(id_, uniform(name), value); }
+void Program::set(const char* name, float value) const { glProgramUniform1f(id_, uniform(name), value); }
+void Program::set(const char* name, float x, float y, float z) const { glProgramUniform3f(id_, uniform(name), x, y, z); }
+void Program::set(const char* name, float x, float y, float z, float w) const {
+  glProgramUniform4f(id_, uniform(name), x, y, z, w);
+}
+void Program::set(const char* name, int x, int y, int z) const { glProgramUniform3i(id_, uniform(name), x, y, z); }
+void Program::set_matrix4(const char* name, const float* m) const {
+  glProgramUniformMatrix4fv(id_, uniform(name), 1, GL_FALSE, m);
+}
+
+std::array<int, 3> Program::local_size() const {
+  std::array<int, 3> size{1, 1, 1};
+  glGetProgramiv(id_, GL_COMPUTE_WORK_GROUP_SIZE, size.data());
+  return size;
+}
+
+// ----------------------------------------------------------------------------------------------- Queue
+
+Queue::~Queue() {
+  for (const auto& p : pending_) {
+    glDeleteQueries(1, &p.start);
+    glDeleteQueries(1, &p.stop);
+  }
+  if (!spare_queries_.empty()) glDeleteQueries(static_cast<GLsizei>(spare_queries_.size()), spare_queries_.data());
+}
+
+void Queue::dispatch(const Program& program, std::uint32_t gx, std::uint32_t gy, std::uint32_t gz, GLbitfield barrier) {
+  if (gx == 0 || gy == 0 || gz == 0) return;
+  begin(program.name());
+  program.use();
+  glDispatchCompute(gx, gy, gz);
+  if (barrier) glMemoryBarrier(barrier);
+  end(program.name());
+  if (check_errors_) check("kernel " + program.name());
+}
+
+void Queue::dispatch_items(const Program& program, std::size_t items, GLbitfield barrier) {
+  const std::size_t local = static_cast<std::size_t>(program.local_size()[0]);
+  const std::size_t groups = (items + local - 1) / local;
+  if (groups > 0xffffffffull) throw GpuError("dispatch of " + program.name() + " is too large");
+  dispatch(program, static_cast<std::uint32_t>(groups), 1, 1, barrier);
+}
+
+void Queue::check(const std::string& what) const { check_gl(what); }
+
+void Queue::begin(const std::string& name) {
+  if (!timings_) return;
+  Pending p;
+  p.name = name;
+  if (spare_queries_.size() < 2) {
+    GLuint ids[64];
+    glGenQueries(64, ids);
+    spare_queries_.insert(spare_queries_.end(), ids, ids + 64);
+  }
+  p.start = spare_queries_.back();
+  spare_queries_.pop_back();
+  p.stop = spare_queries_.back();
+  spare_queries_.pop_back();
+  glQueryCounter(p.start, GL_TIMESTAMP);
+  pending_.push_back(std::move(p));
+}
+
+void Queue::end(const std::string& name) {
+  if (!timings_) return;
+  auto it = std::find_if(pending_.rbegin(), pending_.rend(), [&](const Pending& p) { return p.name == name; });
+  if (it == pending_.rend()) return;
+  glQueryCounter(it->stop, GL_TIMESTAMP);
+  // Bound the number of queries in flight: long simulations dispatch millions of kernels.
+  if (pending_.size() >= 256) resolve(true);
+}
+
+void Queue::resolve(bool wait) {
+  std::vector<Pending> still;
+  for (auto& p : pending_) {
+    GLint available = 0;
+    glGetQueryObjectiv(p.stop, GL_QUERY_RESULT_AVAILABLE, &available);
+    if (!available && !wait) {
+      still.push_back(p);
+      continue;
+    }
+    GLuint64 t0 = 0, t1 = 0;
+    glGetQueryObjectui64v(p.start, GL_QUERY_RESULT, &t0);
+    glGetQueryObjectui64v(p.stop, GL_QUERY_RESULT, &t1);
+    auto total = std::find_if(totals_.begin(), totals_.end(), [&](const KernelTiming& k) { return k.name == p.name; });
+    if (total == totals_.end()) {
+      totals_.push_back({p.name, 0, 0.0});
+      total = totals_.end() - 1;
+    }
+    total->calls += 1;
+    total->milliseconds += static_cast<double>(t1 - t0) * 1e-6;
+    spare_queries_.push_back(p.start);
+    spare_queries_.push_back(p.stop);
+  }
+  pending_ = std::move(still);
+}
+
+std::vector<KernelTiming> Queue::timings() {
+  resolve(true);
+  return totals_;
+}
+
+std::string Queue::timing_report() {
+  const auto all = timings();
+  double sum = 0.0;
+  for (const auto& k : all) sum += k.milliseconds;
+  std::string out = fmt::format("{:<40} {:>8} {:>12} {:>10}\n", "GPU kernel", "calls", "total ms", "share");
+  for (const auto& k : all) {
+    out += fmt::format("{:<40} {:>8} {:>12.3f} {:>9.1f}%\n", k.name, k.calls, k.milliseconds,
+                       sum > 0 ? 100.0 * k.milliseconds / sum : 0.0);
+  }
+  out += fmt::format("{:<40} {:>8} {:>12.3f}\n", "total", "", sum);
+  return out;
+}
+
+}  // namespace ts::gpu

@@ -1,0 +1,146 @@
+#pragma once
+// A thin layer over OpenGL 4.5 (direct state access): buffers, programs, and a queue that dispatches
+// compute kernels by name with explicit memory barriers, reads buffers back, and times each kernel
+// with GPU timestamp queries when asked (--timings). Everything GPU-side in tetrasand goes through it.
+#include <GL/glew.h>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "gpu/shader_library.h"
+
+namespace ts::gpu {
+
+// A shader storage / general-purpose GL buffer. Move-only.
+class Buffer {
+ public:
+  Buffer() = default;
+  explicit Buffer(std::size_t bytes, const void* data = nullptr, GLbitfield flags = GL_DYNAMIC_STORAGE_BIT);
+  template <typename T>
+  static Buffer from(std::span<const T> items) {
+    return Buffer(items.size_bytes(), items.data());
+  }
+  ~Buffer();
+  Buffer(Buffer&& other) noexcept;
+  Buffer& operator=(Buffer&& other) noexcept;
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+
+  GLuint id() const { return id_; }
+  std::size_t bytes() const { return bytes_; }
+  void upload(const void* data, std::size_t bytes, std::size_t offset = 0);
+  template <typename T>
+  void upload(std::span<const T> items, std::size_t first = 0) {
+    upload(items.data(), items.size_bytes(), first * sizeof(T));
+  }
+  void download(void* data, std::size_t bytes, std::size_t offset = 0) const;
+  template <typename T>
+  std::vector<T> read(std::size_t count, std::size_t first = 0) const {
+    std::vector<T> out(count);
+    if (count) download(out.data(), count * sizeof(T), first * sizeof(T));
+    return out;
+  }
+  void fill_zero();
+  void bind(GLuint binding, GLenum target = GL_SHADER_STORAGE_BUFFER) const;
+
+ private:
+  GLuint id_ = 0;
+  std::size_t bytes_ = 0;
+};
+
+// A linked program: one compute kernel, or a vertex[/geometry]/fragment pipeline. Move-only.
+class Program {
+ public:
+  Program() = default;
+  // Compiles shaders/<relative> (a .comp file). Throws GpuError naming the file and line.
+  static Program compute(const ShaderLibrary& library, const std::string& relative,
+                         const std::vector<std::string>& defines = {});
+  static Program graphics(const ShaderLibrary& library, const std::string& vertex, const std::string& geometry,
+                          const std::string& fragment, const std::vector<std::string>& defines = {});
+  ~Program();
+  Program(Program&& other) noexcept;
+  Program& operator=(Program&& other) noexcept;
+  Program(const Program&) = delete;
+  Program& operator=(const Program&) = delete;
+
+  GLuint id() const { return id_; }
+  const std::string& name() const { return name_; }
+  void use() const;
+  GLint uniform(const char* name) const;  // -1 when the compiler removed it
+  void set(const char* name, int value) const;
+  void set(const char* name, unsigned value) const;
+  void set(const char* name, float value) const;
+  void set(const char* name, float x, float y, float z) const;
+  void set(const char* name, float x, float y, float z, float w) const;
+  void set(const char* name, int x, int y, int z) const;
+  void set_matrix4(const char* name, const float* column_major) const;
+  // Work-group size declared by a compute kernel (layout(local_size_x = ...)).
+  std::array<int, 3> local_size() const;
+
+ private:
+  GLuint id_ = 0;
+  std::string name_;
+  mutable std::map<std::string, GLint, std::less<>> uniforms_;
+};
+
+// Per-kernel GPU times, accumulated over a run.
+struct KernelTiming {
+  std::string name;
+  std::size_t calls = 0;
+  double milliseconds = 0.0;
+};
+
+// Issues work in order and owns the timer queries. One per context and stage is fine.
+class Queue {
+ public:
+  explicit Queue(bool timings = false, bool check_errors = false) : timings_(timings), check_errors_(check_errors) {}
+  ~Queue();
+  Queue(const Queue&) = delete;
+  Queue& operator=(const Queue&) = delete;
+
+  // Dispatches `groups` work groups of `program`, then issues glMemoryBarrier(barrier) so the next
+  // kernel sees this one's writes. barrier = 0 for none (the caller batches barriers itself).
+  void dispatch(const Program& program, std::uint32_t groups_x, std::uint32_t groups_y = 1,
+                std::uint32_t groups_z = 1, GLbitfield barrier = GL_SHADER_STORAGE_BARRIER_BIT);
+  // Enough groups of the program's local size to cover `items` threads along x.
+  void dispatch_items(const Program& program, std::size_t items, GLbitfield barrier = GL_SHADER_STORAGE_BARRIER_BIT);
+  // Times arbitrary GL work (draw calls, copies) under `name`.
+  template <typename F>
+  void timed(const std::string& name, F&& work) {
+    begin(name);
+    work();
+    end(name);
+  }
+  void finish() const { glFinish(); }
+  bool timings_enabled() const { return timings_; }
+  // Resolves outstanding queries and returns totals per kernel, in first-use order.
+  std::vector<KernelTiming> timings();
+  // A table for --timings.
+  std::string timing_report();
+
+ private:
+  void begin(const std::string& name);
+  void end(const std::string& name);
+  void check(const std::string& what) const;
+  void resolve(bool wait);
+
+  struct Pending {
+    std::string name;
+    GLuint start = 0, stop = 0;
+  };
+  bool timings_;
+  bool check_errors_;
+  std::vector<Pending> pending_;
+  std::vector<GLuint> spare_queries_;
+  std::vector<KernelTiming> totals_;
+};
+
+// Throws GpuError with `what` when glGetError reports an error.
+void check_gl(const std::string& what);
+
+}  // namespace ts::gpu

@@ -1,0 +1,23 @@
+#pragma once
+// C++ view of the GPU buffer layouts defined once in shaders/common/layouts.h, pinned here so a
+// layout change that breaks std430 agreement fails the build; tests/gpu/layouts_test.cpp checks
+// the same numbers against what the GLSL compiler reports.
+#include <cstddef>
+
+#include "shaders/common/layouts.h"
+
+namespace ts::gpu::layout {
+
+static_assert(sizeof(vec4) == 16 && alignof(vec4) == 16);
+static_assert(sizeof(SdfTriangle) == 160);
+static_assert(offsetof(SdfTriangle, face_normal) == 48);
+static_assert(offsetof(SdfTriangle, edge_normal) == 64);
+static_assert(offsetof(SdfTriangle, vertex_normal) == 112);
+static_assert(sizeof(SamplerGrid) == 32);
+static_assert(offsetof(SamplerGrid, dims) == 16);
+static_assert(sizeof(SimMaterial) == 32);
+static_assert(offsetof(SimMaterial, damping) == 16);
+static_assert(sizeof(SimPlane) == 32);
+static_assert(offsetof(SimPlane, extent) == 16);
+
+}  // namespace ts::gpu::layout

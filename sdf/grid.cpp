@@ -1,0 +1,1 @@
+#include "sdf/grid.h"

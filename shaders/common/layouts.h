@@ -1,0 +1,54 @@
+// GPU buffer layouts: the ONE definition shared by C++ (through gpu/layouts.h) and GLSL (#include).
+// Rules that keep std430 and C++ identical: every member is a 16-byte vector (vec4/uvec4/ivec4) or an
+// array of them; scalars travel in the .w of a vec4. Sizes are pinned by static_assert in
+// gpu/layouts.h and read back from a compiled shader in tests/gpu/layouts_test.cpp.
+#ifndef TETRASAND_COMMON_LAYOUTS_H
+#define TETRASAND_COMMON_LAYOUTS_H
+
+#ifdef __cplusplus
+#include <cstdint>
+namespace ts::gpu::layout {
+struct alignas(16) vec4 { float x, y, z, w; };
+struct alignas(16) uvec4 { std::uint32_t x, y, z, w; };
+struct alignas(16) ivec4 { std::int32_t x, y, z, w; };
+#define TS_LAYOUT(name) struct alignas(16) name
+#else
+#define TS_LAYOUT(name) struct name
+#endif
+
+// ---- sdf: one triangle for scan conversion, in grid-local voxel units (voxel centres at integers).
+// Pseudonormals are angle-weighted (Baerentzen & Aanaes 2005); edge e runs from vertex e to e+1.
+TS_LAYOUT(SdfTriangle) {
+  vec4 vertex[3];         // xyz: position [voxels]; w unused
+  vec4 face_normal;       // xyz: unit face normal; w: 1 for a usable triangle, 0 if degenerate
+  vec4 edge_normal[3];    // xyz: edge pseudonormal
+  vec4 vertex_normal[3];  // xyz: vertex pseudonormal
+};
+
+// ---- sampler: shared constants of one relaxation step.
+TS_LAYOUT(SamplerGrid) {
+  vec4 origin_cell;       // xyz: world position of cell (0,0,0)'s corner [m]; w: cell size [m]
+  uvec4 dims;             // xyz: cells along each axis of the hashed grid; w: hash table size
+};
+
+// ---- sim: one material as the contact kernel reads it (SI units).
+TS_LAYOUT(SimMaterial) {
+  vec4 elastic;           // x: E [Pa], y: Poisson ratio, z: restitution, w: friction coefficient mu
+  vec4 damping;           // x: gamma_s [N s/m], y: thesis gamma_n [N s/m^1.5], z: density [kg/m^3], w: unused
+};
+
+// ---- sim: an implicit boundary plane (smooth wall): n . x >= offset is the allowed side.
+TS_LAYOUT(SimPlane) {
+  vec4 normal_offset;     // xyz: unit normal into the allowed side; w: offset [m]
+  vec4 extent;            // xyz: centre of the finite patch [m] (unused if w < 0); w: patch radius [m], <0 infinite
+};
+
+#ifdef __cplusplus
+#undef TS_LAYOUT
+}  // namespace ts::gpu::layout
+#endif
+
+// Buffer binding points, shared by host and kernels.
+#define TS_BINDING_SDF_TRIANGLES 0
+
+#endif  // TETRASAND_COMMON_LAYOUTS_H

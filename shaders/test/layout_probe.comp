@@ -1,0 +1,16 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Declares every shared layout in a std430 block so tests can read the compiler's offsets back.
+#include "common/layouts.h"
+layout(local_size_x = 1) in;
+layout(std430, binding = 0) buffer SdfTriangles { SdfTriangle sdf_triangles[]; };
+layout(std430, binding = 1) buffer SamplerGrids { SamplerGrid sampler_grids[]; };
+layout(std430, binding = 2) buffer SimMaterials { SimMaterial sim_materials[]; };
+layout(std430, binding = 3) buffer SimPlanes { SimPlane sim_planes[]; };
+void main() {
+  // Touch each block so no compiler drops it.
+  sdf_triangles[0].face_normal.w += 1.0;
+  sampler_grids[0].dims.w += 1u;
+  sim_materials[0].damping.w += 1.0;
+  sim_planes[0].extent.w += 1.0;
+}

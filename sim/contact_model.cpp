@@ -1,0 +1,1 @@
+// contact model (being written)

@@ -1,0 +1,66 @@
+// The C++ structs in gpu/layouts.h and the GLSL compiler must agree on every offset and stride.
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <string>
+
+#include "gpu/context.h"
+#include "gpu/gl.h"
+#include "gpu/layouts.h"
+
+namespace ts::gpu {
+namespace {
+
+struct Probe {
+  GLint offset = -1;
+  GLint top_level_stride = -1;
+};
+
+Probe query(const Program& program, const std::string& name) {
+  const GLuint index = glGetProgramResourceIndex(program.id(), GL_BUFFER_VARIABLE, name.c_str());
+  EXPECT_NE(index, GL_INVALID_INDEX) << name;
+  Probe p;
+  if (index == GL_INVALID_INDEX) return p;
+  const GLenum props[] = {GL_OFFSET, GL_TOP_LEVEL_ARRAY_STRIDE};
+  GLint values[2] = {-1, -1};
+  glGetProgramResourceiv(program.id(), GL_BUFFER_VARIABLE, index, 2, props, 2, nullptr, values);
+  p.offset = values[0];
+  p.top_level_stride = values[1];
+  return p;
+}
+
+class GpuLayouts : public ::testing::Test {
+ protected:
+  Context context;
+  ShaderLibrary library;
+  Program probe = Program::compute(library, "test/layout_probe.comp");
+};
+
+TEST_F(GpuLayouts, SdfTriangleMatchesCpp) {
+  using layout::SdfTriangle;
+  EXPECT_EQ(query(probe, "sdf_triangles[0].vertex[0]").top_level_stride, static_cast<GLint>(sizeof(SdfTriangle)));
+  EXPECT_EQ(query(probe, "sdf_triangles[0].vertex[0]").offset, static_cast<GLint>(offsetof(SdfTriangle, vertex)));
+  EXPECT_EQ(query(probe, "sdf_triangles[0].face_normal").offset, static_cast<GLint>(offsetof(SdfTriangle, face_normal)));
+  EXPECT_EQ(query(probe, "sdf_triangles[0].edge_normal[0]").offset,
+            static_cast<GLint>(offsetof(SdfTriangle, edge_normal)));
+  EXPECT_EQ(query(probe, "sdf_triangles[0].vertex_normal[0]").offset,
+            static_cast<GLint>(offsetof(SdfTriangle, vertex_normal)));
+}
+
+TEST_F(GpuLayouts, SamplerGridMatchesCpp) {
+  using layout::SamplerGrid;
+  EXPECT_EQ(query(probe, "sampler_grids[0].origin_cell").top_level_stride, static_cast<GLint>(sizeof(SamplerGrid)));
+  EXPECT_EQ(query(probe, "sampler_grids[0].dims").offset, static_cast<GLint>(offsetof(SamplerGrid, dims)));
+}
+
+TEST_F(GpuLayouts, SimStructsMatchCpp) {
+  using layout::SimMaterial;
+  using layout::SimPlane;
+  EXPECT_EQ(query(probe, "sim_materials[0].elastic").top_level_stride, static_cast<GLint>(sizeof(SimMaterial)));
+  EXPECT_EQ(query(probe, "sim_materials[0].damping").offset, static_cast<GLint>(offsetof(SimMaterial, damping)));
+  EXPECT_EQ(query(probe, "sim_planes[0].normal_offset").top_level_stride, static_cast<GLint>(sizeof(SimPlane)));
+  EXPECT_EQ(query(probe, "sim_planes[0].extent").offset, static_cast<GLint>(offsetof(SimPlane, extent)));
+}
+
+}  // namespace
+}  // namespace ts::gpu
