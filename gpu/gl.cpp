@@ -172,6 +172,7 @@ GLint Program::uniform(const char* name) const {
 void Program::set(const char* name, int value) const { glProgramUniform1i(id_, uniform(name), value); }
 void Program::set(const char* name, unsigned value) const { glProgramUniform1ui(id_, uniform(name), value); }
 void Program::set(const char* name, float value) const { glProgramUniform1f(id_, uniform(name), value); }
+void Program::set(const char* name, float x, float y) const { glProgramUniform2f(id_, uniform(name), x, y); }
 void Program::set(const char* name, float x, float y, float z) const { glProgramUniform3f(id_, uniform(name), x, y, z); }
 void Program::set(const char* name, float x, float y, float z, float w) const {
   glProgramUniform4f(id_, uniform(name), x, y, z, w);

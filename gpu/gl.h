@@ -75,6 +75,7 @@ class Program {
   void set(const char* name, int value) const;
   void set(const char* name, unsigned value) const;
   void set(const char* name, float value) const;
+  void set(const char* name, float x, float y) const;
   void set(const char* name, float x, float y, float z) const;
   void set(const char* name, float x, float y, float z, float w) const;
   void set(const char* name, int x, int y, int z) const;

@@ -13,6 +13,8 @@ static_assert(sizeof(SdfTriangle) == 160);
 static_assert(offsetof(SdfTriangle, face_normal) == 48);
 static_assert(offsetof(SdfTriangle, edge_normal) == 64);
 static_assert(offsetof(SdfTriangle, vertex_normal) == 112);
+static_assert(sizeof(SdfPrism) == 80);
+static_assert(offsetof(SdfPrism, normal_margin) == 64);
 static_assert(sizeof(SamplerGrid) == 32);
 static_assert(offsetof(SamplerGrid, dims) == 16);
 static_assert(sizeof(SimMaterial) == 32);

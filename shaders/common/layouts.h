@@ -25,6 +25,15 @@ TS_LAYOUT(SdfTriangle) {
   vec4 vertex_normal[3];  // xyz: vertex pseudonormal
 };
 
+// ---- sdf: the bounding prism of one triangle, built on the CPU in double precision. Its base is the
+// triangle grown in its plane by the prism margin (3 corners), or for needle triangles, whose grown
+// corners would shoot far out, the grown in-plane bounding rectangle (4 corners). The geometry shader
+// extrudes the base by +-margin along the normal and slices the resulting tetrahedra.
+TS_LAYOUT(SdfPrism) {
+  vec4 corner[4];         // xyz: base corner [voxels]; corner[0].w: corner count (3 or 4)
+  vec4 normal_margin;     // xyz: unit face normal; w: extrusion along +-normal [voxels]
+};
+
 // ---- sampler: shared constants of one relaxation step.
 TS_LAYOUT(SamplerGrid) {
   vec4 origin_cell;       // xyz: world position of cell (0,0,0)'s corner [m]; w: cell size [m]
@@ -50,5 +59,6 @@ TS_LAYOUT(SimPlane) {
 
 // Buffer binding points, shared by host and kernels.
 #define TS_BINDING_SDF_TRIANGLES 0
+#define TS_BINDING_SDF_PRISMS 1
 
 #endif  // TETRASAND_COMMON_LAYOUTS_H

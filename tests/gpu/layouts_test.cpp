@@ -47,6 +47,12 @@ TEST_F(GpuLayouts, SdfTriangleMatchesCpp) {
             static_cast<GLint>(offsetof(SdfTriangle, vertex_normal)));
 }
 
+TEST_F(GpuLayouts, SdfPrismMatchesCpp) {
+  using layout::SdfPrism;
+  EXPECT_EQ(query(probe, "sdf_prisms[0].corner[0]").top_level_stride, static_cast<GLint>(sizeof(SdfPrism)));
+  EXPECT_EQ(query(probe, "sdf_prisms[0].normal_margin").offset, static_cast<GLint>(offsetof(SdfPrism, normal_margin)));
+}
+
 TEST_F(GpuLayouts, SamplerGridMatchesCpp) {
   using layout::SamplerGrid;
   EXPECT_EQ(query(probe, "sampler_grids[0].origin_cell").top_level_stride, static_cast<GLint>(sizeof(SamplerGrid)));
