@@ -1,0 +1,91 @@
+#include "gpu/hash_grid.h"
+
+#include <bit>
+
+namespace ts::gpu {
+
+PrefixScan::PrefixScan(const ShaderLibrary& library)
+    : blocks_(Program::compute(library, "common/scan_blocks.comp")),
+      add_(Program::compute(library, "common/scan_add.comp")) {}
+
+void PrefixScan::run(Queue& queue, Buffer& values, std::uint32_t count) {
+  // Level l+1 holds the block sums of level l; the last level is a single block's total.
+  std::vector<std::uint32_t> sizes{count};
+  while (sizes.back() > 512u) sizes.push_back((sizes.back() + 511u) / 512u);
+  if (levels_.size() < sizes.size()) levels_.resize(sizes.size());  // before any address is taken
+  for (std::size_t l = 1; l <= sizes.size(); ++l) {
+    const std::size_t bytes = (l < sizes.size() ? sizes[l] : 1u) * sizeof(std::uint32_t);
+    if (levels_[l - 1].bytes() < bytes) levels_[l - 1] = Buffer(bytes);
+  }
+  auto level_buffer = [&](std::size_t l) -> Buffer& { return l == 0 ? values : levels_[l - 1]; };
+  // Down: scan each level's blocks, writing block sums to the next level.
+  for (std::size_t l = 0; l < sizes.size(); ++l) {
+    level_buffer(l).bind(0);
+    level_buffer(l + 1).bind(1);
+    blocks_.set("count", sizes[l]);
+    queue.dispatch(blocks_, (sizes[l] + 511u) / 512u);
+  }
+  // Up: add each level's scanned block offsets back into the level below.
+  for (std::size_t l = sizes.size() - 1; l-- > 0;) {
+    level_buffer(l).bind(0);
+    level_buffer(l + 1).bind(1);
+    add_.set("count", sizes[l]);
+    queue.dispatch_items(add_, sizes[l]);
+  }
+}
+
+HashGrid::HashGrid(const ShaderLibrary& library)
+    : count_(Program::compute(library, "common/grid_count.comp")),
+      scatter_(Program::compute(library, "common/grid_scatter.comp")),
+      sort_cells_(Program::compute(library, "common/grid_sort_cells.comp")),
+      scan_(library) {}
+
+void HashGrid::reserve(std::uint32_t count) {
+  if (count <= capacity_ && table_size_ != 0) return;
+  capacity_ = std::max<std::uint32_t>(count, 64u);
+  table_size_ = std::bit_ceil(2u * capacity_);
+  const std::size_t ids = capacity_ * sizeof(std::uint32_t), cells = table_size_ * sizeof(std::uint32_t);
+  cell_of_ = Buffer(ids);
+  slot_ = Buffer(ids);
+  sorted_ = Buffer(ids);
+  cell_count_ = Buffer(cells);
+  cell_start_ = Buffer(cells);
+}
+
+void HashGrid::build(Queue& queue, const Buffer& positions, std::uint32_t count, float cell_size) {
+  reserve(count);
+  cell_size_ = cell_size;
+  cell_count_.fill_zero();
+  positions.bind(0);
+  cell_of_.bind(1);
+  cell_count_.bind(2);
+  slot_.bind(3);
+  count_.set("count", count);
+  count_.set("cell_size", cell_size);
+  count_.set("table_size", table_size_);
+  queue.dispatch_items(count_, count);
+  glCopyNamedBufferSubData(cell_count_.id(), cell_start_.id(), 0, 0,
+                           static_cast<GLsizeiptr>(table_size_ * sizeof(std::uint32_t)));
+  scan_.run(queue, cell_start_, table_size_);
+  cell_of_.bind(1);
+  cell_count_.bind(2);
+  slot_.bind(3);
+  cell_start_.bind(4);
+  sorted_.bind(5);
+  scatter_.set("count", count);
+  queue.dispatch_items(scatter_, count);
+  sort_cells_.set("table_size", table_size_);
+  queue.dispatch_items(sort_cells_, table_size_);
+}
+
+void HashGrid::bind() const {
+  cell_count_.bind(2);
+  cell_start_.bind(4);
+  sorted_.bind(5);
+}
+
+std::size_t HashGrid::bytes() const {
+  return cell_of_.bytes() + slot_.bytes() + sorted_.bytes() + cell_count_.bytes() + cell_start_.bytes();
+}
+
+}  // namespace ts::gpu

@@ -1,0 +1,46 @@
+#pragma once
+// A hashed uniform grid rebuilt on the GPU by counting sort: count per cell, exclusive prefix sum,
+// scatter, and an in-cell sort by particle id for deterministic neighbour order. Memory follows the
+// particle count (hash table = next power of two >= 2 x particles), never the domain size.
+//
+// Bindings the neighbour kernels read after build(): 2 = cell_count, 4 = cell_start, 5 = sorted ids
+// (see shaders/common/hash_grid.glsl for the hash).
+#include <cstdint>
+
+#include "gpu/gl.h"
+
+namespace ts::gpu {
+
+// Exclusive prefix sum of uint buffers, recursive over 512-value blocks.
+class PrefixScan {
+ public:
+  explicit PrefixScan(const ShaderLibrary& library);
+  // Scans values[0, count) in place.
+  void run(Queue& queue, Buffer& values, std::uint32_t count);
+
+ private:
+  Program blocks_, add_;
+  std::vector<Buffer> levels_;  // levels_[l]: block sums of level l (level 0 = the values), grown on demand
+};
+
+class HashGrid {
+ public:
+  explicit HashGrid(const ShaderLibrary& library);
+  // positions: vec4 per particle (xyz used) bound to binding 0 during the build.
+  void build(Queue& queue, const Buffer& positions, std::uint32_t count, float cell_size);
+  // Rebinds the grid buffers to bindings 2, 4 and 5 for a neighbour kernel.
+  void bind() const;
+  std::uint32_t table_size() const { return table_size_; }
+  float cell_size() const { return cell_size_; }
+  std::size_t bytes() const;
+
+ private:
+  void reserve(std::uint32_t count);
+  Program count_, scatter_, sort_cells_;
+  PrefixScan scan_;
+  Buffer cell_of_, slot_, cell_count_, cell_start_, sorted_;
+  std::uint32_t capacity_ = 0, table_size_ = 0;
+  float cell_size_ = 0.0f;
+};
+
+}  // namespace ts::gpu

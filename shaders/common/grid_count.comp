@@ -1,0 +1,20 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Counting sort, pass 1: each particle finds its hashed cell and takes a slot in it. Slot order within
+// a cell depends on atomics; grid_sort_cells.comp restores index order so results stay deterministic.
+#include "common/hash_grid.glsl"
+layout(local_size_x = 256) in;
+layout(std430, binding = 0) readonly buffer Positions { vec4 positions[]; };
+layout(std430, binding = 1) writeonly buffer CellOf { uint cell_of[]; };
+layout(std430, binding = 2) buffer CellCount { uint cell_count[]; };
+layout(std430, binding = 3) writeonly buffer Slot { uint slot[]; };
+uniform uint count;
+uniform float cell_size;
+uniform uint table_size;
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  uint h = hash_cell(cell_of_position(positions[i].xyz, cell_size), table_size);
+  cell_of[i] = h;
+  slot[i] = atomicAdd(cell_count[h], 1u);
+}

@@ -1,0 +1,22 @@
+#version 450
+// Counting sort, pass 4: insertion sort of each cell's ids, so neighbours are always visited in index
+// order and float sums over them are bitwise reproducible. Cells hold a handful of ids.
+layout(local_size_x = 256) in;
+layout(std430, binding = 2) readonly buffer CellCount { uint cell_count[]; };
+layout(std430, binding = 4) readonly buffer CellStart { uint cell_start[]; };
+layout(std430, binding = 5) buffer Sorted { uint sorted_ids[]; };
+uniform uint table_size;
+void main() {
+  uint c = gl_GlobalInvocationID.x;
+  if (c >= table_size) return;
+  uint begin = cell_start[c], n = cell_count[c];
+  for (uint a = 1u; a < n; ++a) {
+    uint key = sorted_ids[begin + a];
+    uint b = a;
+    while (b > 0u && sorted_ids[begin + b - 1u] > key) {
+      sorted_ids[begin + b] = sorted_ids[begin + b - 1u];
+      --b;
+    }
+    sorted_ids[begin + b] = key;
+  }
+}

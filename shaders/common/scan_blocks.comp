@@ -1,0 +1,40 @@
+#version 450
+// Exclusive prefix sum, pass 1: each work group scans 512 values in shared memory (Blelloch 1990) and
+// writes its total to block_sums, which the host scans recursively before scan_add.comp adds it back.
+layout(local_size_x = 256) in;
+layout(std430, binding = 0) buffer Values { uint values[]; };
+layout(std430, binding = 1) writeonly buffer BlockSums { uint block_sums[]; };
+uniform uint count;
+shared uint temp[512];
+void main() {
+  uint t = gl_LocalInvocationID.x;
+  uint base = gl_WorkGroupID.x * 512u;
+  temp[2u * t] = base + 2u * t < count ? values[base + 2u * t] : 0u;
+  temp[2u * t + 1u] = base + 2u * t + 1u < count ? values[base + 2u * t + 1u] : 0u;
+  uint offset = 1u;
+  for (uint d = 256u; d > 0u; d >>= 1u) {
+    barrier();
+    if (t < d) {
+      uint ai = offset * (2u * t + 1u) - 1u, bi = offset * (2u * t + 2u) - 1u;
+      temp[bi] += temp[ai];
+    }
+    offset <<= 1u;
+  }
+  if (t == 0u) {
+    block_sums[gl_WorkGroupID.x] = temp[511];
+    temp[511] = 0u;
+  }
+  for (uint d = 1u; d < 512u; d <<= 1u) {
+    offset >>= 1u;
+    barrier();
+    if (t < d) {
+      uint ai = offset * (2u * t + 1u) - 1u, bi = offset * (2u * t + 2u) - 1u;
+      uint x = temp[ai];
+      temp[ai] = temp[bi];
+      temp[bi] += x;
+    }
+  }
+  barrier();
+  if (base + 2u * t < count) values[base + 2u * t] = temp[2u * t];
+  if (base + 2u * t + 1u < count) values[base + 2u * t + 1u] = temp[2u * t + 1u];
+}
