@@ -1,0 +1,134 @@
+#include "sampler/gpu_relaxer.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace ts::sampler {
+
+GpuRelaxer::GpuRelaxer(gpu::Context& context, const sdf::DenseSdf& field, bool timings)
+    : context_(context),
+      spec_(field.spec),
+      queue_(timings, context.debug()),
+      relax_(gpu::Program::compute(library_, "sampler/relax.comp")),
+      project_(gpu::Program::compute(library_, "sampler/project.comp")),
+      reduce_(gpu::Program::compute(library_, "sampler/reduce_steps.comp")),
+      grid_(library_) {
+  const int max_side = context.limits().max_3d_texture_size;
+  if (spec_.dims.maxCoeff() > max_side) {
+    throw GpuError("sampler SDF of " + std::to_string(spec_.dims.maxCoeff()) +
+                   " voxels per side exceeds this GPU's 3D texture limit (" + std::to_string(max_side) +
+                   "); use a larger --voxel or --radius");
+  }
+  glCreateTextures(GL_TEXTURE_3D, 1, &texture_);
+  glTextureStorage3D(texture_, 1, GL_RGBA32F, spec_.dims.x(), spec_.dims.y(), spec_.dims.z());
+  if (glGetError() == GL_OUT_OF_MEMORY) throw GpuError("out of GPU memory for the sampler's SDF texture");
+  glTextureSubImage3D(texture_, 0, 0, 0, 0, spec_.dims.x(), spec_.dims.y(), spec_.dims.z(), GL_RGBA, GL_FLOAT,
+                      field.values.data());
+  glTextureParameteri(texture_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(texture_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  for (GLenum axis : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+    glTextureParameteri(texture_, axis, GL_CLAMP_TO_EDGE);
+}
+
+GpuRelaxer::~GpuRelaxer() {
+  if (texture_) glDeleteTextures(1, &texture_);
+}
+
+std::size_t GpuRelaxer::gpu_bytes() const {
+  return spec_.voxel_count() * 16 + positions_[0].bytes() * 2 + step_info_.bytes() + partials_.bytes() + grid_.bytes();
+}
+
+void GpuRelaxer::bind_sdf(const gpu::Program& program) const {
+  glBindTextureUnit(0, texture_);
+  program.set("sdf", 0);
+  program.set("voxel_size", static_cast<float>(spec_.voxel_size));
+  program.set("sdf_dims", static_cast<float>(spec_.dims.x()), static_cast<float>(spec_.dims.y()),
+              static_cast<float>(spec_.dims.z()));
+}
+
+void GpuRelaxer::project(std::uint32_t count, int steps) {
+  positions_[0].bind(0);
+  bind_sdf(project_);
+  project_.set("count", count);
+  for (int s = 0; s < steps; ++s) queue_.dispatch_items(project_, count);
+}
+
+RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const RelaxSettings& settings,
+                             const std::function<void(int, std::size_t, double)>& progress) {
+  if (!(settings.spacing > 0.0)) throw InputError("sampler spacing must be positive");
+  const double sigma = settings.sigma_over_spacing * settings.spacing;
+  const double cutoff = sigma * std::sqrt(2.0 * std::log(1.0 / settings.kernel_epsilon));
+  RelaxStats stats;
+  auto upload = [&] {
+    const std::size_t n = std::max<std::size_t>(positions.size(), 1);
+    std::vector<Eigen::Vector4f> packed(n, Eigen::Vector4f::Zero());
+    for (std::size_t i = 0; i < positions.size(); ++i) packed[i] << positions[i], 0.0f;
+    if (positions_[0].bytes() < n * 16) {
+      positions_[0] = gpu::Buffer(n * 16);
+      positions_[1] = gpu::Buffer(n * 16);
+      step_info_ = gpu::Buffer(n * 16);
+      partials_ = gpu::Buffer(((n + 255) / 256) * 16);
+    }
+    positions_[0].upload(packed.data(), n * 16);
+  };
+  auto download = [&](std::uint32_t count) {
+    const auto packed = positions_[0].read<Eigen::Vector4f>(count);
+    positions.resize(count);
+    for (std::uint32_t i = 0; i < count; ++i) positions[i] = packed[i].head<3>();
+  };
+  upload();
+  std::uint32_t count = static_cast<std::uint32_t>(positions.size());
+
+  relax_.set("cell_size", static_cast<float>(cutoff));
+  relax_.set("inv_two_sigma2", static_cast<float>(1.0 / (2.0 * sigma * sigma)));
+  relax_.set("repulsion_gain", static_cast<float>(settings.repulsion_gain));
+  relax_.set("max_move", static_cast<float>(settings.max_move_over_cell * cutoff));
+  relax_.set("band_limit", static_cast<float>(settings.band_limit));
+  while (stats.iterations < settings.max_iterations && count > 0) {
+    grid_.build(queue_, positions_[0], count, static_cast<float>(cutoff));
+    positions_[0].bind(0);
+    positions_[1].bind(1);
+    grid_.bind();
+    step_info_.bind(6);
+    bind_sdf(relax_);
+    relax_.set("count", count);
+    relax_.set("table_size", grid_.table_size());
+    queue_.dispatch_items(relax_, count);
+    std::swap(positions_[0], positions_[1]);
+    ++stats.iterations;
+    if (stats.iterations % settings.check_every != 0 && stats.iterations < settings.max_iterations) continue;
+
+    step_info_.bind(6);
+    partials_.bind(7);
+    reduce_.set("count", count);
+    queue_.dispatch_items(reduce_, count);
+    const auto partials = partials_.read<Eigen::Vector4f>((count + 255) / 256);
+    double moved = 0.0, outside = 0.0;
+    for (const auto& p : partials) moved += p.x(), outside += p.z();
+    stats.mean_move_over_spacing = moved / count / settings.spacing;
+    if (progress) progress(stats.iterations, count, stats.mean_move_over_spacing);
+    if (outside > 0.0) {
+      // Drop particles that left the band (rare: seeds start on the surface), on the CPU.
+      const auto info = step_info_.read<Eigen::Vector4f>(count);
+      download(count);
+      std::size_t kept = 0;
+      for (std::uint32_t i = 0; i < count; ++i)
+        if (info[i].z() == 0.0f) positions[kept++] = positions[i];
+      stats.removed += count - kept;
+      positions.resize(kept);
+      upload();
+      count = static_cast<std::uint32_t>(kept);
+    }
+    if (stats.mean_move_over_spacing < settings.tolerance) {
+      stats.converged = true;
+      break;
+    }
+  }
+  project(count, settings.projection_steps);
+  download(count);
+  return stats;
+}
+
+}  // namespace ts::sampler

@@ -1,0 +1,68 @@
+#pragma once
+// The GPU half of the repulsion sampler: relaxes particles on the zero level set of an SDF held in a
+// 3D texture, with neighbours from a hashed grid rebuilt every step (thesis 6.3). Seeding, coverage
+// repair and output live in sampler/sample_mesh.h; this class only moves particles.
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "gpu/context.h"
+#include "gpu/gl.h"
+#include "gpu/hash_grid.h"
+#include "sdf/scan_convert.h"
+
+namespace ts::sampler {
+
+struct RelaxSettings {
+  double spacing = 0.0;             // target distance between neighbours [m] (the hexagonal spacing)
+  double sigma_over_spacing = 0.45;  // Gaussian width; formulas.md: 0.4-0.5 d_hex relaxes best
+  // Kernel cut-off: exp(-R^2 / (2 sigma^2)) = kernel_epsilon, i.e. R = sigma sqrt(2 ln(1/eps))
+  // (thesis appendix A.2 with A = 1). The hashed grid's cell equals R, so 27 cells hold all neighbours.
+  double kernel_epsilon = 1e-3;
+  double repulsion_gain = 0.5;       // step on the kernel sum (dimensionless)
+  double max_move_over_cell = 0.25;  // CFL guard: no particle moves more than this fraction of a cell
+  double band_limit = 0.0;           // |phi| at which a particle has left the band [m]
+  int max_iterations = 2000;
+  int check_every = 10;              // convergence read back every k steps
+  double tolerance = 2e-4;           // converged when mean |move| per step < tolerance * spacing
+  int projection_steps = 4;          // final p <- p - phi grad(phi) iterations
+};
+
+struct RelaxStats {
+  int iterations = 0;
+  bool converged = false;
+  double mean_move_over_spacing = 0.0;  // at the last check
+  std::size_t removed = 0;              // left the band and were dropped
+};
+
+class GpuRelaxer {
+ public:
+  // Uploads the dense SDF (xyz gradient, w distance) as an RGBA32F 3D texture with trilinear filtering.
+  GpuRelaxer(gpu::Context& context, const sdf::DenseSdf& field, bool timings = false);
+  ~GpuRelaxer();
+  GpuRelaxer(const GpuRelaxer&) = delete;
+  GpuRelaxer& operator=(const GpuRelaxer&) = delete;
+
+  // Positions are relative to the SDF's voxel (0,0,0) centre [m]; on return they are relaxed and
+  // projected, without the particles that left the band. `progress(iteration, count, residual)`.
+  RelaxStats relax(std::vector<Eigen::Vector3f>& positions, const RelaxSettings& settings,
+                   const std::function<void(int, std::size_t, double)>& progress = {});
+
+  std::string timing_report() { return queue_.timing_report(); }
+  std::size_t gpu_bytes() const;
+
+ private:
+  void bind_sdf(const gpu::Program& program) const;
+  void project(std::uint32_t count, int steps);
+  gpu::Context& context_;
+  sdf::GridSpec spec_;
+  GLuint texture_ = 0;
+  gpu::ShaderLibrary library_;
+  gpu::Queue queue_;
+  gpu::Program relax_, project_, reduce_;
+  gpu::HashGrid grid_;
+  gpu::Buffer positions_[2], step_info_, partials_;
+};
+
+}  // namespace ts::sampler
