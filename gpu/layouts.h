@@ -19,7 +19,10 @@ static_assert(sizeof(SamplerGrid) == 32);
 static_assert(offsetof(SamplerGrid, dims) == 16);
 static_assert(sizeof(SimMaterial) == 32);
 static_assert(offsetof(SimMaterial, damping) == 16);
-static_assert(sizeof(SimPlane) == 32);
+static_assert(sizeof(SimPlane) == 48);
 static_assert(offsetof(SimPlane, extent) == 16);
+static_assert(offsetof(SimPlane, material) == 32);
+static_assert(sizeof(SimCylinder) == 48);
+static_assert(offsetof(SimCylinder, material) == 32);
 
 }  // namespace ts::gpu::layout

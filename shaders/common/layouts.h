@@ -49,7 +49,17 @@ TS_LAYOUT(SimMaterial) {
 // ---- sim: an implicit boundary plane (smooth wall): n . x >= offset is the allowed side.
 TS_LAYOUT(SimPlane) {
   vec4 normal_offset;     // xyz: unit normal into the allowed side; w: offset [m]
-  vec4 extent;            // xyz: centre of the finite patch [m] (unused if w < 0); w: patch radius [m], <0 infinite
+  // xyz: a point of the plane [m]. w > 0: the wall is only the disc of radius w about that point;
+  // w < 0: the wall has a circular hole of radius -w there (a silo orifice); w == 0: infinite.
+  vec4 extent;
+  uvec4 material;         // x: material index
+};
+
+// ---- sim: an implicit cylindrical wall about an axis (smooth): keeps particles inside radius.
+TS_LAYOUT(SimCylinder) {
+  vec4 point_radius;      // xyz: a point on the axis [m]; w: radius [m]
+  vec4 axis;              // xyz: unit axis direction; w: unused
+  uvec4 material;         // x: material index
 };
 
 #ifdef __cplusplus
@@ -60,5 +70,31 @@ TS_LAYOUT(SimPlane) {
 // Buffer binding points, shared by host and kernels.
 #define TS_BINDING_SDF_TRIANGLES 0
 #define TS_BINDING_SDF_PRISMS 1
+
+// Simulator state, one vec4 (or uvec4) buffer per quantity (structure of arrays). The hashed grid
+// (gpu/hash_grid.h) uses bindings 0-5 while it builds and 2, 4, 5 when neighbour kernels read it.
+#define TS_SIM_PARTICLE_POSITION 0   // xyz: world position [m]; w: radius [m] (the grid's input)
+#define TS_SIM_PARTICLE_VELOCITY 6   // xyz: velocity of the sphere centre [m/s]
+#define TS_SIM_PARTICLE_INFO 7       // uvec4: x body index, y material index
+#define TS_SIM_PARTICLE_LOCAL 8      // xyz: offset from the body's centre of mass in its frame [m]; w: radius [m]
+#define TS_SIM_BODY_POSITION 9       // xyz: centre of mass [m]; w: inverse mass [1/kg] (0 unless dynamic)
+#define TS_SIM_BODY_ORIENTATION 10   // unit quaternion (x, y, z, w); body axes = principal axes
+#define TS_SIM_BODY_VELOCITY 11      // xyz: [m/s]; w: motion type (0 dynamic, 1 kinematic, 2 static)
+#define TS_SIM_BODY_OMEGA 12         // xyz: angular velocity [rad/s] (derived from the momentum)
+#define TS_SIM_BODY_INV_INERTIA 13   // xyz: inverse principal moments [1/(kg m^2)]
+#define TS_SIM_BODY_RANGE 14         // uvec4: x first particle, y particle count
+#define TS_SIM_PARTICLE_FORCE 15     // xyz: contact force on the particle [N]
+#define TS_SIM_PARTICLE_TORQUE 16    // xyz: its torque about the body's centre of mass [N m]
+#define TS_SIM_MATERIALS 17          // SimMaterial[]
+#define TS_SIM_PLANES 18             // SimPlane[]
+#define TS_SIM_CYLINDERS 19          // SimCylinder[]
+#define TS_SIM_PARTICLE_STATS 20     // x: contacts, y: largest overlap / radius
+#define TS_SIM_COUNTERS 21           // uint[]: 0 velocity clamps, 1 overlap clamps
+#define TS_SIM_BODY_MOMENTUM 22      // xyz: angular momentum [kg m^2/s] (world frame)
+
+// Motion types (TS_SIM_BODY_VELOCITY.w)
+#define TS_MOTION_DYNAMIC 0
+#define TS_MOTION_KINEMATIC 1
+#define TS_MOTION_STATIC 2
 
 #endif  // TETRASAND_COMMON_LAYOUTS_H

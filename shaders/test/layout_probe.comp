@@ -8,6 +8,7 @@ layout(std430, binding = 1) buffer SamplerGrids { SamplerGrid sampler_grids[]; }
 layout(std430, binding = 2) buffer SimMaterials { SimMaterial sim_materials[]; };
 layout(std430, binding = 3) buffer SimPlanes { SimPlane sim_planes[]; };
 layout(std430, binding = 4) buffer SdfPrisms { SdfPrism sdf_prisms[]; };
+layout(std430, binding = 5) buffer SimCylinders { SimCylinder sim_cylinders[]; };
 void main() {
   // Touch each block so no compiler drops it.
   sdf_triangles[0].face_normal.w += 1.0;
@@ -15,4 +16,5 @@ void main() {
   sim_materials[0].damping.w += 1.0;
   sim_planes[0].extent.w += 1.0;
   sdf_prisms[0].normal_margin.w += 1.0;
+  sim_cylinders[0].material.x += 1u;
 }

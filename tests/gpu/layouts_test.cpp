@@ -66,6 +66,10 @@ TEST_F(GpuLayouts, SimStructsMatchCpp) {
   EXPECT_EQ(query(probe, "sim_materials[0].damping").offset, static_cast<GLint>(offsetof(SimMaterial, damping)));
   EXPECT_EQ(query(probe, "sim_planes[0].normal_offset").top_level_stride, static_cast<GLint>(sizeof(SimPlane)));
   EXPECT_EQ(query(probe, "sim_planes[0].extent").offset, static_cast<GLint>(offsetof(SimPlane, extent)));
+  EXPECT_EQ(query(probe, "sim_planes[0].material").offset, static_cast<GLint>(offsetof(SimPlane, material)));
+  using layout::SimCylinder;
+  EXPECT_EQ(query(probe, "sim_cylinders[0].point_radius").top_level_stride, static_cast<GLint>(sizeof(SimCylinder)));
+  EXPECT_EQ(query(probe, "sim_cylinders[0].material").offset, static_cast<GLint>(offsetof(SimCylinder, material)));
 }
 
 }  // namespace

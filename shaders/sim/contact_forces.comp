@@ -1,0 +1,135 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Step 3: contact forces gathered per particle over the 27 surrounding cells in a fixed order (cells
+// in a fixed sweep, ids sorted within cells), so there are no float atomics and results are bitwise
+// reproducible. Only particles of different bodies touch; walls are implicit (no particle storage).
+#include "common/hash_grid.glsl"
+#include "common/layouts.h"
+#include "sim/contact.glsl"
+#include "sim/rigid.glsl"
+layout(local_size_x = 128) in;
+layout(std430, binding = TS_SIM_PARTICLE_POSITION) readonly buffer P { vec4 particle_position[]; };
+layout(std430, binding = 2) readonly buffer CellCount { uint cell_count[]; };
+layout(std430, binding = 4) readonly buffer CellStart { uint cell_start[]; };
+layout(std430, binding = 5) readonly buffer Sorted { uint sorted_ids[]; };
+layout(std430, binding = TS_SIM_PARTICLE_VELOCITY) readonly buffer V { real4 particle_velocity[]; };
+layout(std430, binding = TS_SIM_PARTICLE_INFO) readonly buffer I { uvec4 particle_info[]; };
+layout(std430, binding = TS_SIM_BODY_POSITION) readonly buffer BP { real4 body_position[]; };
+layout(std430, binding = TS_SIM_BODY_OMEGA) readonly buffer BW { real4 body_omega[]; };
+layout(std430, binding = TS_SIM_PARTICLE_FORCE) writeonly buffer F { real4 particle_force[]; };
+layout(std430, binding = TS_SIM_PARTICLE_TORQUE) writeonly buffer T { real4 particle_torque[]; };
+layout(std430, binding = TS_SIM_MATERIALS) readonly buffer M { SimMaterial materials[]; };
+layout(std430, binding = TS_SIM_PLANES) readonly buffer Planes { SimPlane planes[]; };
+layout(std430, binding = TS_SIM_CYLINDERS) readonly buffer Cylinders { SimCylinder cylinders[]; };
+layout(std430, binding = TS_SIM_PARTICLE_STATS) writeonly buffer S { vec4 particle_stats[]; };
+#ifdef TS_FP64
+layout(std430, binding = 23) readonly buffer PX { dvec4 particle_position_exact[]; };
+#define POSITION(k) particle_position_exact[k]
+#else
+#define POSITION(k) particle_position[k]
+#endif
+
+uniform uint particle_count;
+uniform float cell_size;
+uniform uint table_size;
+uniform uint plane_count;
+uniform uint cylinder_count;
+uniform int damping_model;
+uniform float max_overlap_ratio;  // overlap clamp (thesis 3.3.1): delta <= ratio * radius
+
+real mass_of(real inverse_mass) { return inverse_mass > 0.0 ? 1.0 / inverse_mass : 0.0; }
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= particle_count) return;
+  uint body_i = particle_info[i].x;
+  real4 xi4 = POSITION(i);
+  real3 xi = xi4.xyz;
+  real ri = xi4.w;
+  real3 vi = particle_velocity[i].xyz;
+  real3 wi = body_omega[body_i].xyz;
+  real inv_mass_i = body_position[body_i].w;
+  SimMaterial mat_i = materials[particle_info[i].y];
+  real3 force = real3(0.0), torque = real3(0.0);
+  real3 arm_i = xi - body_position[body_i].xyz;
+  float contacts = 0.0, worst_overlap = 0.0;
+
+  ivec3 c = cell_of_position(particle_position[i].xyz, cell_size);
+  uint visited[27];
+  int visited_count = 0;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        uint h = hash_cell(c + ivec3(dx, dy, dz), table_size);
+        bool seen = false;
+        for (int v = 0; v < visited_count; ++v) seen = seen || visited[v] == h;
+        if (seen) continue;
+        visited[visited_count++] = h;
+        uint begin = cell_start[h], end = begin + cell_count[h];
+        for (uint k = begin; k < end; ++k) {
+          uint j = sorted_ids[k];
+          uint body_j = particle_info[j].x;
+          if (body_j == body_i) continue;
+          real inv_mass_j = body_position[body_j].w;
+          if (inv_mass_i + inv_mass_j == 0.0) continue;  // two bodies that never move
+          real4 xj4 = POSITION(j);
+          real3 d = xi - xj4.xyz;
+          real dist2 = dot(d, d);
+          real reach = ri + xj4.w;
+          if (dist2 >= reach * reach || dist2 == 0.0) continue;
+          real dist = sqrt(dist2);
+          real3 n = d / dist;
+          real delta = min(reach - dist, real(max_overlap_ratio) * min(ri, xj4.w));
+          real3 vc = (vi + cross(wi, -ri * n)) - (particle_velocity[j].xyz + cross(body_omega[body_j].xyz, xj4.w * n));
+          ContactPair pair = ContactPair(ri, xj4.w, 1.0 / (inv_mass_i + inv_mass_j), mat_i, materials[particle_info[j].y]);
+          real3 f = contact_force(pair, delta, n, vc, damping_model);
+          force += f;
+          torque += cross(arm_i - ri * n, f);
+          contacts += 1.0;
+          worst_overlap = max(worst_overlap, float((reach - dist) / ri));
+        }
+      }
+
+  if (inv_mass_i > 0.0) {
+    for (uint k = 0u; k < plane_count; ++k) {
+      SimPlane plane = planes[k];
+      real3 n = real3(plane.normal_offset.xyz);
+      real s = dot(n, xi) - real(plane.normal_offset.w);
+      real reach_delta = ri - s;
+      if (reach_delta <= 0.0 || s < -ri) continue;  // no contact, or already behind the wall
+      real3 along = (xi - real3(plane.extent.xyz)) - dot(xi - real3(plane.extent.xyz), n) * n;
+      real lateral = length(along);
+      if (plane.extent.w > 0.0 && lateral > real(plane.extent.w)) continue;
+      if (plane.extent.w < 0.0 && lateral < real(-plane.extent.w)) continue;
+      real delta = min(reach_delta, real(max_overlap_ratio) * ri);
+      real3 vc = vi + cross(wi, -ri * n);
+      ContactPair pair = ContactPair(ri, 0.0, mass_of(inv_mass_i), mat_i, materials[plane.material.x]);
+      real3 f = contact_force(pair, delta, n, vc, damping_model);
+      force += f;
+      torque += cross(arm_i - ri * n, f);
+      contacts += 1.0;
+      worst_overlap = max(worst_overlap, float(reach_delta / ri));
+    }
+    for (uint k = 0u; k < cylinder_count; ++k) {
+      SimCylinder cyl = cylinders[k];
+      real3 axis = real3(cyl.axis.xyz);
+      real3 rel = xi - real3(cyl.point_radius.xyz);
+      real3 radial = rel - dot(rel, axis) * axis;
+      real r = length(radial);
+      real reach_delta = r + ri - real(cyl.point_radius.w);
+      if (reach_delta <= 0.0 || r < 1e-12) continue;
+      real3 n = -radial / r;  // from the wall towards the particle (inwards)
+      real delta = min(reach_delta, real(max_overlap_ratio) * ri);
+      real3 vc = vi + cross(wi, -ri * n);
+      ContactPair pair = ContactPair(ri, 0.0, mass_of(inv_mass_i), mat_i, materials[cyl.material.x]);
+      real3 f = contact_force(pair, delta, n, vc, damping_model);
+      force += f;
+      torque += cross(arm_i - ri * n, f);
+      contacts += 1.0;
+      worst_overlap = max(worst_overlap, float(reach_delta / ri));
+    }
+  }
+  particle_force[i] = real4(force, 0.0);
+  particle_torque[i] = real4(torque, 0.0);
+  particle_stats[i] = vec4(contacts, worst_overlap, 0.0, 0.0);
+}
