@@ -25,8 +25,14 @@ bool same_file(const fs::path& a, const fs::path& b) {
 // A temporary name in the target's directory, so the final rename never crosses file systems.
 fs::path temporary_sibling(const fs::path& target) {
   std::random_device device;
-  const auto tag = std::to_string(::getpid()) + "." + std::to_string(device() & 0xffffff);
-  return target.parent_path() / ("." + target.filename().string() + ".tmp." + tag);
+  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "." + std::string temporaries.
+  std::string name(".");
+  name.append(target.filename().string());
+  name.append(".tmp.");
+  name.append(std::to_string(::getpid()));
+  name.append(".");
+  name.append(std::to_string(device() & 0xffffff));
+  return target.parent_path() / name;
 }
 
 }  // namespace

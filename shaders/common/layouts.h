@@ -40,10 +40,11 @@ TS_LAYOUT(SamplerGrid) {
   uvec4 dims;             // xyz: cells along each axis of the hashed grid; w: hash table size
 };
 
-// ---- sim: one material as the contact kernel reads it (SI units).
-TS_LAYOUT(SimMaterial) {
-  vec4 elastic;           // x: E [Pa], y: Poisson ratio, z: restitution, w: friction coefficient mu
-  vec4 damping;           // x: gamma_s [N s/m], y: thesis gamma_n [N s/m^1.5], z: density [kg/m^3], w: unused
+// ---- sim: contact coefficients of one pair of materials (sim::PairCoefficients), in a table indexed
+// by material_i * material_count + material_j.
+TS_LAYOUT(SimPair) {
+  vec4 coefficients;      // x: E* [Pa], y: friction mu, z: gamma_s [N s/m], w: dimensionless damping strength c
+  vec4 extra;             // x: thesis reference speed [m/s]; yzw unused
 };
 
 // ---- sim: an implicit boundary plane (smooth wall): n . x >= offset is the allowed side.
@@ -85,7 +86,7 @@ TS_LAYOUT(SimCylinder) {
 #define TS_SIM_BODY_RANGE 14         // uvec4: x first particle, y particle count
 #define TS_SIM_PARTICLE_FORCE 15     // xyz: contact force on the particle [N]
 #define TS_SIM_PARTICLE_TORQUE 16    // xyz: its torque about the body's centre of mass [N m]
-#define TS_SIM_MATERIALS 17          // SimMaterial[]
+#define TS_SIM_PAIRS 17              // SimPair[material_count^2]
 #define TS_SIM_PLANES 18             // SimPlane[]
 #define TS_SIM_CYLINDERS 19          // SimCylinder[]
 #define TS_SIM_PARTICLE_STATS 20     // x: contacts, y: largest overlap / radius

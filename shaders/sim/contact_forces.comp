@@ -18,7 +18,7 @@ layout(std430, binding = TS_SIM_BODY_POSITION) readonly buffer BP { real4 body_p
 layout(std430, binding = TS_SIM_BODY_OMEGA) readonly buffer BW { real4 body_omega[]; };
 layout(std430, binding = TS_SIM_PARTICLE_FORCE) writeonly buffer F { real4 particle_force[]; };
 layout(std430, binding = TS_SIM_PARTICLE_TORQUE) writeonly buffer T { real4 particle_torque[]; };
-layout(std430, binding = TS_SIM_MATERIALS) readonly buffer M { SimMaterial materials[]; };
+layout(std430, binding = TS_SIM_PAIRS) readonly buffer M { SimPair pairs[]; };
 layout(std430, binding = TS_SIM_PLANES) readonly buffer Planes { SimPlane planes[]; };
 layout(std430, binding = TS_SIM_CYLINDERS) readonly buffer Cylinders { SimCylinder cylinders[]; };
 layout(std430, binding = TS_SIM_PARTICLE_STATS) writeonly buffer S { vec4 particle_stats[]; };
@@ -35,9 +35,9 @@ uniform uint table_size;
 uniform uint plane_count;
 uniform uint cylinder_count;
 uniform int damping_model;
-uniform float max_overlap_ratio;  // overlap clamp (thesis 3.3.1): delta <= ratio * radius
+uniform float max_overlap_ratio;  // overlap clamp (thesis 3.3.1): delta <= ratio * min radius
+uniform uint material_count;
 
-real mass_of(real inverse_mass) { return inverse_mass > 0.0 ? 1.0 / inverse_mass : 0.0; }
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -49,7 +49,7 @@ void main() {
   real3 vi = particle_velocity[i].xyz;
   real3 wi = body_omega[body_i].xyz;
   real inv_mass_i = body_position[body_i].w;
-  SimMaterial mat_i = materials[particle_info[i].y];
+  uint pair_row = particle_info[i].y * material_count;
   real3 force = real3(0.0), torque = real3(0.0);
   real3 arm_i = xi - body_position[body_i].xyz;
   float contacts = 0.0, worst_overlap = 0.0;
@@ -79,14 +79,17 @@ void main() {
           if (dist2 >= reach * reach || dist2 == 0.0) continue;
           real dist = sqrt(dist2);
           real3 n = d / dist;
-          real delta = min(reach - dist, real(max_overlap_ratio) * min(ri, xj4.w));
-          real3 vc = (vi + cross(wi, -ri * n)) - (particle_velocity[j].xyz + cross(body_omega[body_j].xyz, xj4.w * n));
-          ContactPair pair = ContactPair(ri, xj4.w, 1.0 / (inv_mass_i + inv_mass_j), mat_i, materials[particle_info[j].y]);
-          real3 f = contact_force(pair, delta, n, vc, damping_model);
+          real raw = reach - dist;
+          real delta = min(raw, real(max_overlap_ratio) * min(ri, xj4.w));
+          real3 arm1 = -(ri - 0.5 * raw) * n;
+          real3 arm2 = (xj4.w - 0.5 * raw) * n;
+          real3 vc = (vi + cross(wi, arm1)) - (particle_velocity[j].xyz + cross(body_omega[body_j].xyz, arm2));
+          real3 f = hertz_contact_force(n, delta, vc, ri * xj4.w / (ri + xj4.w), 1.0 / (inv_mass_i + inv_mass_j),
+                                        pairs[pair_row + particle_info[j].y], damping_model);
           force += f;
-          torque += cross(arm_i - ri * n, f);
+          torque += cross(arm_i + arm1, f);
           contacts += 1.0;
-          worst_overlap = max(worst_overlap, float((reach - dist) / ri));
+          worst_overlap = max(worst_overlap, float(raw / ri));
         }
       }
 
@@ -102,11 +105,11 @@ void main() {
       if (plane.extent.w > 0.0 && lateral > real(plane.extent.w)) continue;
       if (plane.extent.w < 0.0 && lateral < real(-plane.extent.w)) continue;
       real delta = min(reach_delta, real(max_overlap_ratio) * ri);
-      real3 vc = vi + cross(wi, -ri * n);
-      ContactPair pair = ContactPair(ri, 0.0, mass_of(inv_mass_i), mat_i, materials[plane.material.x]);
-      real3 f = contact_force(pair, delta, n, vc, damping_model);
+      real3 arm = -(ri - 0.5 * reach_delta) * n;
+      real3 f = hertz_contact_force(n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i, pairs[pair_row + plane.material.x],
+                                    damping_model);
       force += f;
-      torque += cross(arm_i - ri * n, f);
+      torque += cross(arm_i + arm, f);
       contacts += 1.0;
       worst_overlap = max(worst_overlap, float(reach_delta / ri));
     }
@@ -120,11 +123,11 @@ void main() {
       if (reach_delta <= 0.0 || r < 1e-12) continue;
       real3 n = -radial / r;  // from the wall towards the particle (inwards)
       real delta = min(reach_delta, real(max_overlap_ratio) * ri);
-      real3 vc = vi + cross(wi, -ri * n);
-      ContactPair pair = ContactPair(ri, 0.0, mass_of(inv_mass_i), mat_i, materials[cyl.material.x]);
-      real3 f = contact_force(pair, delta, n, vc, damping_model);
+      real3 arm = -(ri - 0.5 * reach_delta) * n;
+      real3 f = hertz_contact_force(n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i, pairs[pair_row + cyl.material.x],
+                                    damping_model);
       force += f;
-      torque += cross(arm_i - ri * n, f);
+      torque += cross(arm_i + arm, f);
       contacts += 1.0;
       worst_overlap = max(worst_overlap, float(reach_delta / ri));
     }

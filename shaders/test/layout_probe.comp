@@ -5,7 +5,7 @@
 layout(local_size_x = 1) in;
 layout(std430, binding = 0) buffer SdfTriangles { SdfTriangle sdf_triangles[]; };
 layout(std430, binding = 1) buffer SamplerGrids { SamplerGrid sampler_grids[]; };
-layout(std430, binding = 2) buffer SimMaterials { SimMaterial sim_materials[]; };
+layout(std430, binding = 2) buffer SimPairs { SimPair sim_pairs[]; };
 layout(std430, binding = 3) buffer SimPlanes { SimPlane sim_planes[]; };
 layout(std430, binding = 4) buffer SdfPrisms { SdfPrism sdf_prisms[]; };
 layout(std430, binding = 5) buffer SimCylinders { SimCylinder sim_cylinders[]; };
@@ -13,7 +13,7 @@ void main() {
   // Touch each block so no compiler drops it.
   sdf_triangles[0].face_normal.w += 1.0;
   sampler_grids[0].dims.w += 1u;
-  sim_materials[0].damping.w += 1.0;
+  sim_pairs[0].extra.w += 1.0;
   sim_planes[0].extent.w += 1.0;
   sdf_prisms[0].normal_margin.w += 1.0;
   sim_cylinders[0].material.x += 1u;

@@ -60,10 +60,10 @@ TEST_F(GpuLayouts, SamplerGridMatchesCpp) {
 }
 
 TEST_F(GpuLayouts, SimStructsMatchCpp) {
-  using layout::SimMaterial;
+  using layout::SimPair;
   using layout::SimPlane;
-  EXPECT_EQ(query(probe, "sim_materials[0].elastic").top_level_stride, static_cast<GLint>(sizeof(SimMaterial)));
-  EXPECT_EQ(query(probe, "sim_materials[0].damping").offset, static_cast<GLint>(offsetof(SimMaterial, damping)));
+  EXPECT_EQ(query(probe, "sim_pairs[0].coefficients").top_level_stride, static_cast<GLint>(sizeof(SimPair)));
+  EXPECT_EQ(query(probe, "sim_pairs[0].extra").offset, static_cast<GLint>(offsetof(SimPair, extra)));
   EXPECT_EQ(query(probe, "sim_planes[0].normal_offset").top_level_stride, static_cast<GLint>(sizeof(SimPlane)));
   EXPECT_EQ(query(probe, "sim_planes[0].extent").offset, static_cast<GLint>(offsetof(SimPlane, extent)));
   EXPECT_EQ(query(probe, "sim_planes[0].material").offset, static_cast<GLint>(offsetof(SimPlane, material)));
