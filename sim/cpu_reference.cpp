@@ -1,0 +1,287 @@
+#include "sim/cpu_reference.h"
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace ts::sim {
+
+std::uint32_t hash_cell(const Eigen::Vector3i& c, std::uint32_t table_size) {
+  const std::uint32_t h = (static_cast<std::uint32_t>(c.x()) * 73856093u) ^
+                          (static_cast<std::uint32_t>(c.y()) * 19349663u) ^
+                          (static_cast<std::uint32_t>(c.z()) * 83492791u);
+  return h & (table_size - 1u);
+}
+
+void build_neighbour_grid(const std::vector<Eigen::Vector3d>& positions, double cell_size, NeighbourGrid& grid) {
+  const auto n = static_cast<std::uint32_t>(positions.size());
+  grid.cell_size = cell_size;
+  grid.table_size = std::bit_ceil(std::max<std::uint32_t>(2 * n, 2));
+  grid.cell.resize(n);
+  std::vector<std::uint32_t> bucket(n);
+  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
+    grid.cell[i] = (positions[i] / cell_size).array().floor().cast<int>();
+    bucket[i] = hash_cell(grid.cell[i], grid.table_size);
+  });
+  // Counting sort: count, exclusive scan, scatter in particle order (buckets list ids ascending).
+  grid.bucket_start.assign(grid.table_size + 1, 0);
+  for (std::uint32_t i = 0; i < n; ++i) ++grid.bucket_start[bucket[i] + 1];
+  for (std::uint32_t b = 0; b < grid.table_size; ++b) grid.bucket_start[b + 1] += grid.bucket_start[b];
+  std::vector<std::uint32_t> fill(grid.bucket_start.begin(), grid.bucket_start.end() - 1);
+  grid.sorted.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) grid.sorted[fill[bucket[i]]++] = i;
+}
+
+CpuStepper::CpuStepper(const World& world, const StepSettings& settings) : settings_(settings) {
+  reset_energy_reference(world);
+}
+
+void CpuStepper::reset_energy_reference(const World& world) {
+  if (world.materials.size() != material_count_) {
+    material_count_ = world.materials.size();
+    pairs_.clear();
+    for (const Material& a : world.materials) {
+      for (const Material& b : world.materials) {
+        const PairCoefficients p =
+            make_pair_coefficients(a, b, settings_.normal_damping, settings_.thesis_reference_speed);
+        pairs_.push_back(ContactCoefficients<double>::from(p, settings_.normal_damping));
+      }
+    }
+  }
+  const Energy e = energy(world);
+  double mass = 0, diameter = 0;
+  for (std::size_t i = 0; i < world.bodies.size(); ++i) {
+    if (world.bodies.motion[i] == MotionType::Dynamic) mass += 1.0 / world.bodies.inverse_mass[i];
+  }
+  for (double r : world.particles.radius) diameter = std::max(diameter, 2 * r);
+  energy_reference_ = e.total();
+  energy_scale_ = e.translational + e.rotational + mass * world.gravity.norm() * diameter;
+}
+
+namespace {
+
+// Everything one particle's gather produces.
+struct ParticleContacts {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();   // N
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();  // N m, about the particle centre
+  std::uint32_t pairs = 0, walls = 0, overlap_clamps = 0;
+  double max_overlap_ratio = 0;
+
+  void add(const ContactForce<double>& c, double smaller_radius, bool count) {
+    if (!c.touching) return;
+    force += c.force;
+    torque += c.arm.cross(c.force);
+    if (!count) return;
+    max_overlap_ratio = std::max(max_overlap_ratio, c.overlap / smaller_radius);
+    overlap_clamps += c.overlap_clamped ? 1 : 0;
+  }
+};
+
+double max_radius(const World& world) {
+  double r = 0;
+  for (double x : world.particles.radius) r = std::max(r, x);
+  return r;
+}
+
+}  // namespace
+
+void CpuStepper::compute_forces(const World& world, StepStats& stats) {
+  const Bodies& b = world.bodies;
+  const Particles& p = world.particles;
+  const auto n = static_cast<std::uint32_t>(p.size());
+  position_.resize(n);
+  velocity_.resize(n);
+  force_.resize(n);
+  torque_.resize(n);
+
+  // Particle world positions and velocities from the body poses (eqs. 3.42, 3.43).
+  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
+    const std::uint32_t k = p.body[i];
+    const Eigen::Vector3d arm = b.orientation[k] * p.offset[i];
+    position_[i] = b.position[k] + arm;
+    velocity_[i] = b.linear_velocity[k] + b.angular_velocity[k].cross(arm);
+  });
+  const double cell = n > 0 ? 2 * max_radius(world) : 1.0;  // m
+  build_neighbour_grid(position_, cell, grid_);
+
+  const double overlap_ratio_cap = settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30;
+  std::vector<ParticleContacts> contacts(n);
+  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
+    ParticleContacts& out = contacts[i];
+    const std::uint32_t bi = p.body[i];
+    const double ri = p.radius[i];
+    const Eigen::Vector3d& wi = b.angular_velocity[bi];
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Eigen::Vector3i c = grid_.cell[i] + Eigen::Vector3i(dx, dy, dz);
+          const std::uint32_t h = hash_cell(c, grid_.table_size);
+          for (std::uint32_t s = grid_.bucket_start[h]; s < grid_.bucket_start[h + 1]; ++s) {
+            const std::uint32_t j = grid_.sorted[s];
+            const std::uint32_t bj = p.body[j];
+            // Another cell hashed to this bucket, or a partner that cannot receive a force.
+            if (grid_.cell[j] != c || bj == bi) continue;
+            if (b.inverse_mass[bi] == 0 && b.inverse_mass[bj] == 0) continue;
+            const double rj = p.radius[j];
+            const auto& coefficients = pairs_[p.material[i] * material_count_ + p.material[j]];
+            const double smaller = std::min(ri, rj);
+            const ContactForce<double> f = sphere_sphere_contact(
+                position_[i], velocity_[i], wi, ri, b.inverse_mass[bi], position_[j], velocity_[j],
+                b.angular_velocity[bj], rj, b.inverse_mass[bj], overlap_ratio_cap * smaller, coefficients);
+            out.add(f, smaller, i < j);  // each pair is counted by its lower id
+            out.pairs += (f.touching && i < j) ? 1 : 0;
+          }
+        }
+      }
+    }
+    // Smooth walls, in declaration order: planes, then cylinders.
+    const double inverse_mass = b.inverse_mass[bi];
+    const double max_overlap = overlap_ratio_cap * ri;
+    for (const PlaneWall& wall : world.walls.planes) {
+      const auto& coefficients = pairs_[p.material[i] * material_count_ + wall.material];
+      const double gap = wall.normal.dot(position_[i] - wall.point);
+      const ContactForce<double> f =
+          sphere_wall_contact(wall.normal, gap, velocity_[i], wi, ri, inverse_mass, max_overlap, coefficients);
+      out.add(f, ri, true);
+      out.walls += f.touching ? 1 : 0;
+    }
+    for (const CylinderWall& wall : world.walls.cylinders) {
+      const Eigen::Vector3d& x = position_[i];
+      if (x.z() < wall.z_min || x.z() > wall.z_max) continue;
+      const Eigen::Vector2d radial = x.head<2>() - wall.axis;
+      const double distance = radial.norm();
+      if (distance <= 0) continue;
+      const Eigen::Vector3d normal(-radial.x() / distance, -radial.y() / distance, 0.0);
+      const auto& coefficients = pairs_[p.material[i] * material_count_ + wall.material];
+      const ContactForce<double> f = sphere_wall_contact(normal, wall.radius - distance, velocity_[i], wi, ri,
+                                                         inverse_mass, max_overlap, coefficients);
+      out.add(f, ri, true);
+      out.walls += f.touching ? 1 : 0;
+    }
+  });
+
+  // Statistics in particle order.
+  for (std::uint32_t i = 0; i < n; ++i) {
+    force_[i] = contacts[i].force;
+    torque_[i] = contacts[i].torque;
+    stats.contacts += contacts[i].pairs;
+    stats.wall_contacts += contacts[i].walls;
+    stats.overlap_clamps += contacts[i].overlap_clamps;
+    stats.max_overlap_ratio = std::max(stats.max_overlap_ratio, contacts[i].max_overlap_ratio);
+  }
+}
+
+namespace {
+
+// q + 1/2 [w, 0] q dt, normalised (eq. 3.50).
+Eigen::Quaterniond advance_orientation(const Eigen::Quaterniond& q, const Eigen::Vector3d& w, double dt) {
+  const Eigen::Quaterniond spin = Eigen::Quaterniond(0.0, w.x(), w.y(), w.z()) * q;
+  Eigen::Quaterniond next(q.coeffs() + 0.5 * dt * spin.coeffs());
+  next.normalize();
+  return next;
+}
+
+// I(t)^-1 = R I0^-1 R^T (eq. 3.48).
+Eigen::Matrix3d world_inverse_inertia(const Eigen::Quaterniond& q, const Eigen::Matrix3d& body_inverse_inertia) {
+  const Eigen::Matrix3d r = q.toRotationMatrix();
+  return r * body_inverse_inertia * r.transpose();
+}
+
+}  // namespace
+
+void CpuStepper::integrate(World& world, StepStats& stats) const {
+  Bodies& b = world.bodies;
+  const double dt = settings_.dt;
+  const double max_speed = settings_.cfl > 0 ? settings_.cfl * grid_.cell_size / dt : 1e300;  // m/s
+  const auto count = static_cast<std::uint32_t>(b.size());
+  std::vector<std::uint8_t> clamped(count, 0);  // bit 0: linear, bit 1: angular
+
+  tbb::parallel_for(std::uint32_t{0}, count, [&](std::uint32_t k) {
+    if (b.motion[k] == MotionType::Static) return;
+    if (b.motion[k] == MotionType::Kinematic) {
+      b.position[k] += b.linear_velocity[k] * dt;
+      b.orientation[k] = advance_orientation(b.orientation[k], b.angular_velocity[k], dt);
+      return;
+    }
+    // Per-body sums in particle order (deterministic).
+    Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
+    for (std::uint32_t i = b.first_particle[k]; i < b.first_particle[k] + b.particle_count[k]; ++i) {
+      force += force_[i];
+      torque += (position_[i] - b.position[k]).cross(force_[i]) + torque_[i];
+    }
+    const Eigen::Vector3d acceleration = world.gravity + b.inverse_mass[k] * force;
+    // Rotation first (eqs. 3.47-3.50) through the angular momentum, which is what the torque
+    // changes; for the isotropic grains this is plain w += I^-1 tau dt.
+    const Eigen::Matrix3d inverse_inertia_now = world_inverse_inertia(b.orientation[k], b.inverse_inertia[k]);
+    const Eigen::Vector3d momentum = inverse_inertia_now.inverse() * b.angular_velocity[k] + torque * dt;
+    Eigen::Vector3d w_move = b.angular_velocity[k];
+    if (settings_.integrator == Integrator::SemiImplicitEuler) w_move = inverse_inertia_now * momentum;
+    b.orientation[k] = advance_orientation(b.orientation[k], w_move, dt);
+    Eigen::Vector3d w = world_inverse_inertia(b.orientation[k], b.inverse_inertia[k]) * momentum;
+
+    Eigen::Vector3d v = b.linear_velocity[k] + acceleration * dt;
+    const Eigen::Vector3d v_move = settings_.integrator == Integrator::SemiImplicitEuler ? v : b.linear_velocity[k];
+    b.position[k] += v_move * dt;
+
+    const double reach = b.bounding_radius[k];
+    if (v.norm() > max_speed) {
+      v *= max_speed / v.norm();
+      clamped[k] |= 1;
+    }
+    if (w.norm() * reach > max_speed) {
+      w *= max_speed / (w.norm() * reach);
+      clamped[k] |= 2;
+    }
+    if (settings_.angular_damping_rate > 0 && v.norm() + w.norm() * reach < settings_.angular_damping_speed) {
+      w *= std::max(0.0, 1.0 - settings_.angular_damping_rate * dt);
+    }
+    b.linear_velocity[k] = v;
+    b.angular_velocity[k] = w;
+  });
+  for (std::uint8_t c : clamped) {
+    stats.velocity_clamps += c & 1;
+    stats.angular_velocity_clamps += (c >> 1) & 1;
+  }
+}
+
+void CpuStepper::check_stability(const World& world, const StepStats& stats) const {
+  const Bodies& b = world.bodies;
+  bool any_kinematic = false;
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    any_kinematic |= b.motion[k] == MotionType::Kinematic;
+    const bool finite = b.position[k].allFinite() && b.linear_velocity[k].allFinite() &&
+                        b.angular_velocity[k].allFinite() && b.orientation[k].coeffs().allFinite();
+    if (!finite) {
+      throw Error(ExitCode::Unstable, fmt::format("simulation unstable at t = {:.6g} s: body {} has a non-finite "
+                                                  "state (reduce dt; see the time-step bound)",
+                                                  world.time, k));
+    }
+  }
+  if (!settings_.check_energy || any_kinematic) return;  // kinematic bodies do work on the system
+  const double growth = stats.energy.total() - energy_reference_;
+  if (growth > settings_.energy_growth_tolerance * energy_scale_) {
+    throw Error(ExitCode::Unstable,
+                fmt::format("simulation unstable at t = {:.6g} s: mechanical energy grew by {:.3g} J with no work "
+                            "done (allowed {:.3g} J); reduce dt (see the time-step bound)",
+                            world.time, growth, settings_.energy_growth_tolerance * energy_scale_));
+  }
+}
+
+StepStats CpuStepper::step(World& world) {
+  if (world.materials.size() != material_count_) reset_energy_reference(world);
+  StepStats stats;
+  compute_forces(world, stats);
+  integrate(world, stats);
+  world.time += settings_.dt;
+  stats.energy = energy(world);
+  check_stability(world, stats);
+  return stats;
+}
+
+}  // namespace ts::sim

@@ -1,0 +1,46 @@
+#include "sim/time_step.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace ts::sim {
+
+double hertz_contact_duration(double effective_mass, double effective_radius, double effective_modulus,
+                              double impact_speed) {
+  const double k_n = 4.0 / 3.0 * effective_modulus * std::sqrt(effective_radius);  // N/m^1.5
+  return 3.21 * std::pow(effective_mass / k_n, 0.4) * std::pow(impact_speed, -0.2);
+}
+
+double rayleigh_time(double radius, const Material& m) {
+  const double shear_modulus = m.youngs_modulus / (2 * (1 + m.poisson_ratio));  // Pa
+  return std::numbers::pi * radius * std::sqrt(m.density / shear_modulus) / (0.1631 * m.poisson_ratio + 0.8766);
+}
+
+TimeStepBound time_step_bound(const std::vector<ContactCase>& cases, const std::vector<ParticleKind>& particles,
+                              double max_impact_speed) {
+  TimeStepBound b;
+  b.max_impact_speed = max_impact_speed;
+  b.contact_duration = std::numeric_limits<double>::infinity();
+  b.rayleigh = std::numeric_limits<double>::infinity();
+  for (const ContactCase& c : cases) {
+    b.contact_duration = std::min(
+        b.contact_duration,
+        hertz_contact_duration(c.effective_mass, c.effective_radius, c.effective_modulus, max_impact_speed));
+  }
+  for (const ParticleKind& p : particles) b.rayleigh = std::min(b.rayleigh, rayleigh_time(p.radius, p.material));
+  b.recommended = std::min(b.contact_duration / 20, 0.2 * b.rayleigh);
+  return b;
+}
+
+std::string check_time_step(double dt, const TimeStepBound& b) {
+  if (dt <= b.recommended) return {};
+  return fmt::format("dt = {:.3g} s exceeds the stable bound {:.3g} s (t_c/20 = {:.3g} s at {:.3g} m/s impacts, "
+                     "0.2 t_R = {:.3g} s)",
+                     dt, b.recommended, b.contact_duration / 20, b.max_impact_speed, 0.2 * b.rayleigh);
+}
+
+}  // namespace ts::sim

@@ -1,0 +1,46 @@
+#pragma once
+// Time-step bounds for Hertz contacts (thesis 3.2.3; notes/formulas.md).
+#include <string>
+#include <vector>
+
+#include "sim/contact_model.h"
+
+namespace ts::sim {
+
+// Hertz elastic contact duration at normal impact speed v_n (eq. 3.22):
+// t_c = 3.21 (m*/k_n)^(2/5) v_n^(-1/5), k_n = 4/3 E* sqrt(R*). Masses kg, radius m, modulus Pa,
+// speed m/s; returns s.
+double hertz_contact_duration(double effective_mass, double effective_radius, double effective_modulus,
+                              double impact_speed);
+
+// Rayleigh wave time across a sphere of radius r (m): t_R = pi r sqrt(rho/G) / (0.1631 nu + 0.8766),
+// G = E / (2 (1 + nu)). Returns s.
+double rayleigh_time(double radius, const Material& material);
+
+// One kind of contact the scene will see (grain-grain, grain-wall, grain-prop...).
+struct ContactCase {
+  double effective_mass;     // m*, kg
+  double effective_radius;   // R*, m
+  double effective_modulus;  // E*, Pa
+};
+
+struct TimeStepBound {
+  double contact_duration = 0;  // s: shortest t_c over the cases at max_impact_speed
+  double rayleigh = 0;          // s: shortest t_R over the particle materials
+  double max_impact_speed = 0;  // m/s
+  double recommended = 0;       // s: min(t_c / 20, 0.2 t_R)
+};
+
+// `particles`: radius (m) and material of each kind of particle in the scene (for t_R).
+struct ParticleKind {
+  double radius;
+  Material material;
+};
+TimeStepBound time_step_bound(const std::vector<ContactCase>& cases, const std::vector<ParticleKind>& particles,
+                              double max_impact_speed);
+
+// Empty when dt (s) respects the bound, else a warning naming dt and the bound, e.g.
+// "dt = 1e-4 s exceeds the stable bound 2.3e-6 s (t_c/20 = ... at 10 m/s, 0.2 t_R = ...)".
+std::string check_time_step(double dt, const TimeStepBound& bound);
+
+}  // namespace ts::sim

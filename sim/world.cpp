@@ -1,0 +1,102 @@
+#include "sim/world.h"
+
+#include <algorithm>
+#include <cassert>
+
+namespace ts::sim {
+
+std::uint32_t add_body(World& world, const BodyDesc& desc, const std::vector<Eigen::Vector3d>& offsets,
+                       const std::vector<double>& radii, std::uint16_t material) {
+  assert(offsets.size() == radii.size() && !offsets.empty());
+  Bodies& b = world.bodies;
+  Particles& p = world.particles;
+  const auto index = static_cast<std::uint32_t>(b.size());
+  const bool dynamic = desc.motion == MotionType::Dynamic;
+  b.position.push_back(desc.position);
+  b.orientation.push_back(desc.orientation.normalized());
+  b.linear_velocity.push_back(desc.motion == MotionType::Static ? Eigen::Vector3d::Zero() : desc.linear_velocity);
+  b.angular_velocity.push_back(desc.motion == MotionType::Static ? Eigen::Vector3d::Zero() : desc.angular_velocity);
+  b.inverse_mass.push_back(dynamic ? desc.inverse_mass : 0.0);
+  b.inverse_inertia.push_back(dynamic ? desc.inverse_inertia : Eigen::Matrix3d::Zero());
+  b.motion.push_back(desc.motion);
+  b.first_particle.push_back(static_cast<std::uint32_t>(p.size()));
+  b.particle_count.push_back(static_cast<std::uint32_t>(offsets.size()));
+  double bound = 0;
+  for (std::size_t i = 0; i < offsets.size(); ++i) {
+    p.body.push_back(index);
+    p.offset.push_back(offsets[i]);
+    p.radius.push_back(radii[i]);
+    p.material.push_back(material);
+    bound = std::max(bound, offsets[i].norm() + radii[i]);
+  }
+  b.bounding_radius.push_back(bound);
+  return index;
+}
+
+std::uint32_t add_grain(World& world, const GrainShape& grain, std::uint16_t material,
+                        const Eigen::Vector3d& position, const Eigen::Quaterniond& orientation,
+                        const Eigen::Vector3d& linear_velocity, const Eigen::Vector3d& angular_velocity) {
+  BodyDesc desc;
+  desc.position = position;
+  desc.orientation = orientation;
+  desc.linear_velocity = linear_velocity;
+  desc.angular_velocity = angular_velocity;
+  desc.inverse_mass = 1.0 / grain.mass;
+  desc.inverse_inertia = Eigen::Matrix3d::Identity() / grain.inertia;
+  desc.motion = MotionType::Dynamic;
+  const std::vector<Eigen::Vector3d> offsets(grain.offsets.begin(), grain.offsets.end());
+  return add_body(world, desc, offsets, std::vector<double>(4, grain.particle_radius), material);
+}
+
+std::vector<Eigen::Vector3d> particle_positions(const World& world) {
+  std::vector<Eigen::Vector3d> out(world.particles.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::uint32_t b = world.particles.body[i];
+    out[i] = world.bodies.position[b] + world.bodies.orientation[b] * world.particles.offset[i];
+  }
+  return out;
+}
+
+namespace {
+
+// World-frame inertia tensor I = R I0 R^T of a dynamic body (kg m^2).
+Eigen::Matrix3d world_inertia(const Bodies& b, std::size_t i) {
+  const Eigen::Matrix3d r = b.orientation[i].toRotationMatrix();
+  return r * b.inverse_inertia[i].inverse() * r.transpose();
+}
+
+}  // namespace
+
+Energy energy(const World& world) {
+  const Bodies& b = world.bodies;
+  Energy e;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (b.motion[i] != MotionType::Dynamic) continue;
+    const double mass = 1.0 / b.inverse_mass[i];
+    e.translational += 0.5 * mass * b.linear_velocity[i].squaredNorm();
+    e.rotational += 0.5 * b.angular_velocity[i].dot(world_inertia(b, i) * b.angular_velocity[i]);
+    e.potential -= mass * world.gravity.dot(b.position[i]);
+  }
+  return e;
+}
+
+Eigen::Vector3d linear_momentum(const World& world) {
+  const Bodies& b = world.bodies;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (b.motion[i] == MotionType::Dynamic) p += b.linear_velocity[i] / b.inverse_mass[i];
+  }
+  return p;
+}
+
+Eigen::Vector3d angular_momentum(const World& world) {
+  const Bodies& b = world.bodies;
+  Eigen::Vector3d l = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (b.motion[i] != MotionType::Dynamic) continue;
+    l += b.position[i].cross(b.linear_velocity[i] / b.inverse_mass[i]) + world_inertia(b, i) * b.angular_velocity[i];
+  }
+  return l;
+}
+
+}  // namespace ts::sim

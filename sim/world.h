@@ -1,0 +1,116 @@
+#pragma once
+// Simulation state as plain data: structures of arrays indexed by body and by particle, so the GPU
+// pipeline can upload each array as one buffer (positions as vec4, quaternions as vec4 xyzw...).
+// Double precision here (the CPU reference); the GPU converts on upload.
+//
+// Frames: a body's position is its centre of mass in the world frame; its orientation rotates body
+// coordinates into world coordinates (p_world = position + orientation * offset). Velocities are
+// world-frame. Particles of one body are contiguous: [first_particle, first_particle + particle_count).
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <vector>
+
+#include "sim/contact_model.h"
+#include "sim/grain.h"
+
+namespace ts::sim {
+
+enum class MotionType : std::uint8_t {
+  Dynamic,    // integrated from forces
+  Kinematic,  // moves with its prescribed velocity and angular velocity; forces do not affect it
+  Static,     // never moves (floors, rough walls)
+};
+
+struct Bodies {
+  std::vector<Eigen::Vector3d> position;          // m, centre of mass
+  std::vector<Eigen::Quaterniond> orientation;    // body -> world, unit
+  std::vector<Eigen::Vector3d> linear_velocity;   // m/s
+  std::vector<Eigen::Vector3d> angular_velocity;  // rad/s, world frame
+  std::vector<double> inverse_mass;               // 1/kg; 0 for kinematic and static bodies
+  std::vector<Eigen::Matrix3d> inverse_inertia;   // 1/(kg m^2), body frame; 0 for kinematic and static
+  std::vector<double> bounding_radius;            // m: every particle sphere lies within it of position
+  std::vector<MotionType> motion;
+  std::vector<std::uint32_t> first_particle;
+  std::vector<std::uint32_t> particle_count;
+
+  std::size_t size() const { return position.size(); }
+};
+
+struct Particles {
+  std::vector<std::uint32_t> body;        // owning body
+  std::vector<Eigen::Vector3d> offset;    // m, body frame, from the body's centre of mass
+  std::vector<double> radius;             // m
+  std::vector<std::uint16_t> material;    // index into World::materials
+
+  std::size_t size() const { return body.size(); }
+};
+
+// Smooth implicit walls (thesis 4.4.4 "implicit rigid bodies"): infinite mass, no particles.
+// A half-space wall: particles stay on the side n . (x - point) >= 0.
+struct PlaneWall {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // m, a point on the plane
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, into the free side
+  std::uint16_t material = 0;
+};
+
+// The inside of a vertical (z-axis) cylinder wall between z_min and z_max; outside that range of
+// heights it does not act (particles can fall out of an open-bottomed silo).
+struct CylinderWall {
+  Eigen::Vector2d axis = Eigen::Vector2d::Zero();  // m, (x, y) of the axis
+  double radius = 1;                               // m
+  double z_min = -1e30, z_max = 1e30;              // m
+  std::uint16_t material = 0;
+};
+
+struct Walls {
+  std::vector<PlaneWall> planes;
+  std::vector<CylinderWall> cylinders;
+};
+
+struct World {
+  Bodies bodies;
+  Particles particles;
+  Walls walls;                               // rough walls are static bodies made of particles
+  std::vector<Material> materials;
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2
+  double time = 0;                           // s
+};
+
+// Appends a body made of the given particles (offsets relative to its centre of mass, body frame)
+// and returns its index. inverse_inertia is body-frame; both inverse quantities are ignored (set
+// to 0) unless motion is Dynamic.
+struct BodyDesc {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  double inverse_mass = 0;                                     // 1/kg
+  Eigen::Matrix3d inverse_inertia = Eigen::Matrix3d::Zero();  // 1/(kg m^2), body frame
+  MotionType motion = MotionType::Dynamic;
+};
+std::uint32_t add_body(World& world, const BodyDesc& body, const std::vector<Eigen::Vector3d>& offsets,
+                       const std::vector<double>& radii, std::uint16_t material);
+
+// Appends a dynamic tetrahedral grain.
+std::uint32_t add_grain(World& world, const GrainShape& grain, std::uint16_t material,
+                        const Eigen::Vector3d& position, const Eigen::Quaterniond& orientation,
+                        const Eigen::Vector3d& linear_velocity = Eigen::Vector3d::Zero(),
+                        const Eigen::Vector3d& angular_velocity = Eigen::Vector3d::Zero());
+
+// World position of every particle (m).
+std::vector<Eigen::Vector3d> particle_positions(const World& world);
+
+// Energies of the dynamic bodies (J). Potential energy is -m g . x (zero at the world origin).
+struct Energy {
+  double translational = 0, rotational = 0, potential = 0;
+  double total() const { return translational + rotational + potential; }
+};
+Energy energy(const World& world);
+
+// Total linear momentum (kg m/s) and angular momentum about the origin (kg m^2/s) of dynamic bodies.
+Eigen::Vector3d linear_momentum(const World& world);
+Eigen::Vector3d angular_momentum(const World& world);
+
+}  // namespace ts::sim
