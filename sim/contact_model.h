@@ -23,7 +23,10 @@ struct Material {
   double poisson_ratio = 0.3;       // nu, dimensionless, in [0, 0.5)
   double restitution = 0.65;        // e_n in (0, 1]: requested normal coefficient of restitution
   double friction = 0.5;            // mu, Coulomb cap of the tangential force, dimensionless
-  double tangential_damping = 10.0; // gamma_s, N s/m (thesis 4.5: 10)
+  // gamma_s, N s/m. The thesis's 10 (section 4.5) is in its rescaled units: for millimetre grains
+  // (m ~ 4e-5 kg) an explicit step is only stable below m_t / gamma_s (see time_step.h), which
+  // gamma_s = 10 would push under a microsecond.
+  double tangential_damping = 0.1;
   double density = 2600.0;          // kg/m^3 (quartz)
 };
 
@@ -95,6 +98,7 @@ struct ContactForce {
   Vec3<Real> force = Vec3<Real>::Zero();  // N, on particle 1
   Vec3<Real> arm = Vec3<Real>::Zero();    // m, from particle 1's centre to the point of application
   Real overlap = 0;                       // m, as used in the force (after the overlap clamp)
+  Real elastic_energy = 0;                // J, 2/5 k_n delta^(5/2) stored in the Hertz spring
   bool touching = false;
   bool overlap_clamped = false;
 };
@@ -133,6 +137,13 @@ Vec3<Real> hertz_contact_force(const Vec3<Real>& n, Real delta, const Vec3<Real>
   return normal_force * n + tangential;
 }
 
+// Energy stored in the Hertz spring (J): the integral of k_n delta^(3/2), 2/5 k_n delta^(5/2).
+template <typename Real>
+Real hertz_elastic_energy(Real delta, Real effective_radius, Real effective_modulus) {
+  const Real k_n = Real(4.0 / 3.0) * effective_modulus * std::sqrt(effective_radius);
+  return Real(0.4) * k_n * delta * delta * std::sqrt(delta);
+}
+
 // Sphere-sphere contact. Positions p (m), centre velocities v (m/s), angular velocities w (rad/s) of
 // the bodies the spheres belong to, radii r (m), inverse masses of those bodies (1/kg, 0 for static
 // or kinematic: the damping uses the rigid bodies' masses, as LAMMPS does with fix rigid). The
@@ -159,6 +170,7 @@ ContactForce<Real> sphere_sphere_contact(const Vec3<Real>& p1, const Vec3<Real>&
   const Real effective_mass = Real(1) / (inverse_mass1 + inverse_mass2);
   out.arm = arm1;
   out.force = hertz_contact_force(n, out.overlap, v_c, effective_radius, effective_mass, c);
+  out.elastic_energy = hertz_elastic_energy(out.overlap, effective_radius, c.effective_modulus);
   return out;
 }
 
@@ -178,6 +190,7 @@ ContactForce<Real> sphere_wall_contact(const Vec3<Real>& n, Real gap, const Vec3
   const Vec3<Real> v_c = v + w.cross(arm);
   out.arm = arm;
   out.force = hertz_contact_force(n, out.overlap, v_c, r, Real(1) / inverse_mass, c);
+  out.elastic_energy = hertz_elastic_energy(out.overlap, r, c.effective_modulus);
   return out;
 }
 

@@ -72,6 +72,7 @@ struct ParticleContacts {
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();  // N m, about the particle centre
   std::uint32_t pairs = 0, walls = 0, overlap_clamps = 0;
   double max_overlap_ratio = 0;
+  double elastic_energy = 0;  // J
 
   void add(const ContactForce<double>& c, double smaller_radius, bool count) {
     if (!c.touching) return;
@@ -79,6 +80,7 @@ struct ParticleContacts {
     torque += c.arm.cross(c.force);
     if (!count) return;
     max_overlap_ratio = std::max(max_overlap_ratio, c.overlap / smaller_radius);
+    elastic_energy += c.elastic_energy;
     overlap_clamps += c.overlap_clamped ? 1 : 0;
   }
 };
@@ -173,6 +175,7 @@ void CpuStepper::compute_forces(const World& world, StepStats& stats) {
     stats.contacts += contacts[i].pairs;
     stats.wall_contacts += contacts[i].walls;
     stats.overlap_clamps += contacts[i].overlap_clamps;
+    stats.elastic_energy += contacts[i].elastic_energy;
     stats.max_overlap_ratio = std::max(stats.max_overlap_ratio, contacts[i].max_overlap_ratio);
   }
 }

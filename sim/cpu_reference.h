@@ -42,6 +42,7 @@ struct StepSettings {
 
 struct StepStats {
   Energy energy;                          // J, after the step
+  double elastic_energy = 0;              // J, in the contact springs at the start of the step
   std::size_t contacts = 0;               // particle pairs in contact (each pair once)
   std::size_t wall_contacts = 0;          // particle-wall contacts
   double max_overlap_ratio = 0;           // largest overlap / smaller radius

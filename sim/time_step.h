@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "sim/contact_model.h"
+#include "sim/grain.h"
 
 namespace ts::sim {
 
@@ -22,13 +23,23 @@ struct ContactCase {
   double effective_mass;     // m*, kg
   double effective_radius;   // R*, m
   double effective_modulus;  // E*, Pa
+  // The viscous tangential force is explicit too: slip decays as (1 - gamma_s dt / m_t) per step,
+  // so dt <= m_t / gamma_s keeps it from flipping sign every step (an oscillation the Coulomb cap
+  // bounds but does not damp). m_t (kg) is the pair's effective mass for a tangential push at the
+  // contact point, including rotation: 1/m_t = sum over partners of (1/m + arm^2 / I).
+  double tangential_mass = 0;     // kg; 0: no tangential bound
+  double tangential_damping = 0;  // gamma_s, N s/m
 };
+
+// One grain's share of 1/m_t (1/kg) for a push at its far end (arm R + r): 1/m + (R + r)^2 / I.
+double grain_tangential_inverse_mass(const GrainShape& grain);
 
 struct TimeStepBound {
   double contact_duration = 0;  // s: shortest t_c over the cases at max_impact_speed
   double rayleigh = 0;          // s: shortest t_R over the particle materials
+  double tangential = 0;        // s: shortest m_t / gamma_s over the cases (inf without friction damping)
   double max_impact_speed = 0;  // m/s
-  double recommended = 0;       // s: min(t_c / 20, 0.2 t_R)
+  double recommended = 0;       // s: min(t_c / 20, 0.2 t_R, m_t / gamma_s)
 };
 
 // `particles`: radius (m) and material of each kind of particle in the scene (for t_R).

@@ -1,0 +1,314 @@
+#include "sim/gpu_stepper.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+#include "gpu/layouts.h"
+
+namespace ts::sim {
+namespace {
+
+using gpu::layout::SimCylinder;
+using gpu::layout::SimPair;
+using gpu::layout::SimPlane;
+
+std::vector<std::string> precision_defines(Precision precision) {
+  return precision == Precision::Double ? std::vector<std::string>{"TS_FP64 1"} : std::vector<std::string>{};
+}
+
+void append(std::vector<double>& out, const Eigen::Vector3d& v, double w) {
+  out.insert(out.end(), {v.x(), v.y(), v.z(), w});
+}
+
+struct EnergyCheck {
+  double reference = 0.0, scale = 0.0;
+};
+
+EnergyCheck energy_check(const World& world) {
+  // The same reference and scale as CpuStepper: total energy now, and kinetic energy plus the
+  // potential energy of lifting every dynamic body by one particle diameter.
+  const Energy e = energy(world);
+  double mass = 0.0, diameter = 0.0;
+  for (std::size_t k = 0; k < world.bodies.size(); ++k)
+    if (world.bodies.motion[k] == MotionType::Dynamic) mass += 1.0 / world.bodies.inverse_mass[k];
+  for (double r : world.particles.radius) diameter = std::max(diameter, 2 * r);
+  return {e.total(), e.translational + e.rotational + mass * world.gravity.norm() * diameter};
+}
+
+}  // namespace
+
+GpuStepper::GpuStepper(gpu::Context& context, const World& world, const StepSettings& settings, Precision precision,
+                       bool timings)
+    : context_(context),
+      settings_(settings),
+      precision_(precision),
+      queue_(timings, context.debug()),
+      update_(gpu::Program::compute(library_, "sim/update_particles.comp", precision_defines(precision))),
+      contacts_(gpu::Program::compute(library_, "sim/contact_forces.comp", precision_defines(precision))),
+      integrate_(gpu::Program::compute(library_, "sim/integrate_bodies.comp", precision_defines(precision))),
+      metrics_(gpu::Program::compute(library_, "sim/reduce_metrics.comp", precision_defines(precision))),
+      particle_stats_(gpu::Program::compute(library_, "sim/reduce_particle_stats.comp")),
+      grid_(library_) {
+  upload(world);
+}
+
+template <typename T>
+gpu::Buffer GpuStepper::real_buffer(const std::vector<T>& values) const {
+  if (precision_ == Precision::Double) return gpu::Buffer::from<double>(std::vector<double>(values.begin(), values.end()));
+  const std::vector<float> narrow(values.begin(), values.end());
+  return gpu::Buffer::from<float>(narrow);
+}
+
+std::vector<double> GpuStepper::read_real(const gpu::Buffer& buffer, std::size_t count) const {
+  if (precision_ == Precision::Double) return buffer.read<double>(count);
+  const auto values = buffer.read<float>(count);
+  return {values.begin(), values.end()};
+}
+
+void GpuStepper::upload(const World& world) {
+  const Bodies& b = world.bodies;
+  const Particles& p = world.particles;
+  body_count_ = static_cast<std::uint32_t>(b.size());
+  particle_count_ = static_cast<std::uint32_t>(p.size());
+  time_ = world.time;
+  gravity_ = world.gravity;
+  const EnergyCheck check = energy_check(world);
+  energy_reference_ = check.reference;
+  energy_scale_ = check.scale;
+  any_kinematic_ = std::find(b.motion.begin(), b.motion.end(), MotionType::Kinematic) != b.motion.end();
+  const std::size_t real_size = precision_ == Precision::Double ? 8 : 4;
+
+  std::vector<double> position, orientation, velocity, omega, inverse_inertia, momentum;
+  std::vector<std::uint32_t> range;
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    const bool dynamic = b.motion[k] == MotionType::Dynamic;
+    append(position, b.position[k], dynamic ? b.inverse_mass[k] : 0.0);
+    orientation.insert(orientation.end(), {b.orientation[k].x(), b.orientation[k].y(), b.orientation[k].z(),
+                                           b.orientation[k].w()});
+    append(velocity, b.linear_velocity[k], static_cast<double>(b.motion[k] == MotionType::Dynamic     ? TS_MOTION_DYNAMIC
+                                                               : b.motion[k] == MotionType::Kinematic ? TS_MOTION_KINEMATIC
+                                                                                                      : TS_MOTION_STATIC));
+    append(omega, b.angular_velocity[k], 0.0);
+    const Eigen::Matrix3d inv = dynamic ? b.inverse_inertia[k] : Eigen::Matrix3d::Zero();
+    for (int row = 0; row < 3; ++row) append(inverse_inertia, inv.row(row).transpose(), row == 0 ? b.bounding_radius[k] : 0.0);
+    // The GPU integrates the angular momentum L = I_world omega (omega = R I0^-1 R^T L).
+    Eigen::Vector3d l = Eigen::Vector3d::Zero();
+    if (dynamic) {
+      const Eigen::Matrix3d r = b.orientation[k].toRotationMatrix();
+      l = (r * b.inverse_inertia[k] * r.transpose()).inverse() * b.angular_velocity[k];
+    }
+    append(momentum, l, 0.0);
+    range.insert(range.end(), {b.first_particle[k], b.particle_count[k], 0u, 0u});
+  }
+  std::vector<double> local;
+  std::vector<std::uint32_t> info;
+  double max_radius = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    append(local, p.offset[i], p.radius[i]);
+    info.insert(info.end(), {p.body[i], p.material[i], 0u, 0u});
+    max_radius = std::max(max_radius, p.radius[i]);
+  }
+  cell_size_ = particle_count_ > 0 ? 2.0 * max_radius : 1.0;
+
+  body_position_ = real_buffer(position);
+  body_orientation_ = real_buffer(orientation);
+  body_velocity_ = real_buffer(velocity);
+  body_omega_ = real_buffer(omega);
+  body_inverse_inertia_ = real_buffer(inverse_inertia);
+  body_momentum_ = real_buffer(momentum);
+  body_range_ = gpu::Buffer::from<std::uint32_t>(range);
+  particle_local_ = real_buffer(local);
+  particle_info_ = gpu::Buffer::from<std::uint32_t>(info);
+  particle_position_ = gpu::Buffer(particle_count_ * 16);
+  particle_position_exact_ = gpu::Buffer(precision_ == Precision::Double ? particle_count_ * 32 : 16);
+  particle_velocity_ = gpu::Buffer(particle_count_ * 4 * real_size);
+  particle_force_ = gpu::Buffer(particle_count_ * 4 * real_size);
+  particle_torque_ = gpu::Buffer(particle_count_ * 4 * real_size);
+  particle_stats_buffer_ = gpu::Buffer(particle_count_ * 16);
+  counters_ = gpu::Buffer(4 * sizeof(std::uint32_t));
+  counters_.fill_zero();
+  metric_partials_ = gpu::Buffer(((body_count_ + 255) / 256 + 1) * 32);
+  stat_partials_ = gpu::Buffer(((particle_count_ + 255) / 256 + 1) * 16);
+
+  material_count_ = static_cast<std::uint32_t>(world.materials.size());
+  std::vector<SimPair> pairs;
+  for (const Material& a : world.materials) {
+    for (const Material& c : world.materials) {
+      const PairCoefficients k =
+          make_pair_coefficients(a, c, settings_.normal_damping, settings_.thesis_reference_speed);
+      SimPair pair{};
+      pair.coefficients = {static_cast<float>(k.effective_modulus), static_cast<float>(k.friction),
+                           static_cast<float>(k.tangential_damping), static_cast<float>(k.damping_strength)};
+      pair.extra = {static_cast<float>(k.thesis_reference_speed), 0.0f, 0.0f, 0.0f};
+      pairs.push_back(pair);
+    }
+  }
+  pairs_ = gpu::Buffer::from<SimPair>(pairs);
+  std::vector<SimPlane> planes;
+  for (const PlaneWall& w : world.walls.planes) {
+    SimPlane plane{};
+    plane.normal_offset = {static_cast<float>(w.normal.x()), static_cast<float>(w.normal.y()),
+                           static_cast<float>(w.normal.z()), static_cast<float>(w.normal.dot(w.point))};
+    plane.extent = {0.0f, 0.0f, 0.0f, 0.0f};
+    plane.material = {w.material, 0u, 0u, 0u};
+    planes.push_back(plane);
+  }
+  std::vector<SimCylinder> cylinders;
+  for (const CylinderWall& w : world.walls.cylinders) {
+    SimCylinder c{};
+    c.axis_radius = {static_cast<float>(w.axis.x()), static_cast<float>(w.axis.y()), 0.0f, static_cast<float>(w.radius)};
+    c.range = {static_cast<float>(std::max(w.z_min, -1e30)), static_cast<float>(std::min(w.z_max, 1e30)), 0.0f, 0.0f};
+    c.material = {w.material, 0u, 0u, 0u};
+    cylinders.push_back(c);
+  }
+  plane_count_ = static_cast<std::uint32_t>(planes.size());
+  cylinder_count_ = static_cast<std::uint32_t>(cylinders.size());
+  planes_ = gpu::Buffer::from<SimPlane>(planes);
+  cylinders_ = gpu::Buffer::from<SimCylinder>(cylinders);
+
+  const float dt = static_cast<float>(settings_.dt);
+  const double max_speed = settings_.cfl > 0 ? settings_.cfl * cell_size_ / settings_.dt : 1e30;
+  update_.set("particle_count", particle_count_);
+  contacts_.set("particle_count", particle_count_);
+  contacts_.set("cell_size", static_cast<float>(cell_size_));
+  contacts_.set("plane_count", plane_count_);
+  contacts_.set("cylinder_count", cylinder_count_);
+  contacts_.set("material_count", material_count_);
+  contacts_.set("damping_model", settings_.normal_damping == NormalDamping::Tsuji ? 0 : 1);
+  contacts_.set("max_overlap_ratio", static_cast<float>(settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30));
+  integrate_.set("body_count", body_count_);
+  if (precision_ == Precision::Double) {
+    integrate_.set_double("dt", settings_.dt);
+    integrate_.set_double("gravity", gravity_.x(), gravity_.y(), gravity_.z());
+  } else {
+    integrate_.set("dt", dt);
+    integrate_.set("gravity", static_cast<float>(gravity_.x()), static_cast<float>(gravity_.y()),
+                   static_cast<float>(gravity_.z()));
+  }
+  integrate_.set("semi_implicit", settings_.integrator == Integrator::SemiImplicitEuler ? 1 : 0);
+  integrate_.set("max_speed", static_cast<float>(std::min(max_speed, 1e30)));
+  integrate_.set("angular_damping_rate", static_cast<float>(settings_.angular_damping_rate));
+  integrate_.set("angular_damping_speed", static_cast<float>(settings_.angular_damping_speed));
+  metrics_.set("body_count", body_count_);
+  metrics_.set("gravity", static_cast<float>(gravity_.x()), static_cast<float>(gravity_.y()), static_cast<float>(gravity_.z()));
+  particle_stats_.set("particle_count", particle_count_);
+}
+
+void GpuStepper::bind_state() const {
+  particle_position_.bind(TS_SIM_PARTICLE_POSITION);
+  particle_velocity_.bind(TS_SIM_PARTICLE_VELOCITY);
+  particle_info_.bind(TS_SIM_PARTICLE_INFO);
+  particle_local_.bind(TS_SIM_PARTICLE_LOCAL);
+  body_position_.bind(TS_SIM_BODY_POSITION);
+  body_orientation_.bind(TS_SIM_BODY_ORIENTATION);
+  body_velocity_.bind(TS_SIM_BODY_VELOCITY);
+  body_omega_.bind(TS_SIM_BODY_OMEGA);
+  body_inverse_inertia_.bind(TS_SIM_BODY_INV_INERTIA);
+  body_range_.bind(TS_SIM_BODY_RANGE);
+  particle_force_.bind(TS_SIM_PARTICLE_FORCE);
+  particle_torque_.bind(TS_SIM_PARTICLE_TORQUE);
+  pairs_.bind(TS_SIM_PAIRS);
+  planes_.bind(TS_SIM_PLANES);
+  cylinders_.bind(TS_SIM_CYLINDERS);
+  particle_stats_buffer_.bind(TS_SIM_PARTICLE_STATS);
+  counters_.bind(TS_SIM_COUNTERS);
+  body_momentum_.bind(TS_SIM_BODY_MOMENTUM);
+  particle_position_exact_.bind(23);
+}
+
+void GpuStepper::step(int steps) {
+  if (particle_count_ == 0) {
+    time_ += steps * settings_.dt;
+    return;
+  }
+  for (int s = 0; s < steps; ++s) {
+    bind_state();
+    queue_.dispatch_items(update_, particle_count_);
+    grid_.build(queue_, particle_position_, particle_count_, static_cast<float>(cell_size_));
+    bind_state();
+    grid_.bind();
+    contacts_.set("table_size", grid_.table_size());
+    queue_.dispatch_items(contacts_, particle_count_);
+    queue_.dispatch_items(integrate_, body_count_);
+    time_ += settings_.dt;
+  }
+}
+
+StepStats GpuStepper::statistics() {
+  StepStats stats;
+  bind_state();
+  metric_partials_.bind(24);
+  stat_partials_.bind(25);
+  queue_.dispatch_items(metrics_, body_count_);
+  queue_.dispatch_items(particle_stats_, particle_count_);
+  const auto energies = metric_partials_.read<double>(4 * ((body_count_ + 255) / 256));
+  double bad = 0.0;
+  for (std::size_t g = 0; g < energies.size(); g += 4) {
+    stats.energy.translational += energies[g];
+    stats.energy.rotational += energies[g + 1];
+    stats.energy.potential += energies[g + 2];
+    bad += energies[g + 3];
+  }
+  const auto contact = stat_partials_.read<float>(4 * ((particle_count_ + 255) / 256));
+  for (std::size_t g = 0; g < contact.size(); g += 4) {
+    stats.contacts += static_cast<std::size_t>(contact[g]);
+    stats.wall_contacts += static_cast<std::size_t>(contact[g + 1]);
+    stats.max_overlap_ratio = std::max(stats.max_overlap_ratio, static_cast<double>(contact[g + 2]));
+    stats.overlap_clamps += static_cast<std::size_t>(contact[g + 3]);
+  }
+  const auto counters = counters_.read<std::uint32_t>(4);
+  stats.velocity_clamps = counters[0];
+  stats.angular_velocity_clamps = counters[1];
+  counters_.fill_zero();
+  if (bad > 0.0 || !std::isfinite(stats.energy.total())) {
+    throw Error(ExitCode::Unstable, fmt::format("simulation unstable at t = {:.6g} s: {} bodies have a non-finite "
+                                                "state (reduce dt; see the time-step bound)",
+                                                time_, static_cast<std::size_t>(bad)));
+  }
+  const double growth = stats.energy.total() - energy_reference_;
+  if (settings_.check_energy && !any_kinematic_ && growth > settings_.energy_growth_tolerance * energy_scale_) {
+    throw Error(ExitCode::Unstable,
+                fmt::format("simulation unstable at t = {:.6g} s: mechanical energy grew by {:.3g} J with no work "
+                            "done (allowed {:.3g} J); reduce dt (see the time-step bound)",
+                            time_, growth, settings_.energy_growth_tolerance * energy_scale_));
+  }
+  return stats;
+}
+
+void GpuStepper::download(World& world) const {
+  Bodies& b = world.bodies;
+  const auto position = read_real(body_position_, 4 * body_count_);
+  const auto orientation = read_real(body_orientation_, 4 * body_count_);
+  const auto velocity = read_real(body_velocity_, 4 * body_count_);
+  const auto omega = read_real(body_omega_, 4 * body_count_);
+  for (std::uint32_t k = 0; k < body_count_; ++k) {
+    b.position[k] = {position[4 * k], position[4 * k + 1], position[4 * k + 2]};
+    b.orientation[k] = Eigen::Quaterniond(orientation[4 * k + 3], orientation[4 * k], orientation[4 * k + 1],
+                                          orientation[4 * k + 2]);
+    b.linear_velocity[k] = {velocity[4 * k], velocity[4 * k + 1], velocity[4 * k + 2]};
+    b.angular_velocity[k] = {omega[4 * k], omega[4 * k + 1], omega[4 * k + 2]};
+  }
+  world.time = time_;
+}
+
+std::vector<Eigen::Vector3d> GpuStepper::particle_forces() const {
+  const auto values = read_real(particle_force_, 4 * particle_count_);
+  std::vector<Eigen::Vector3d> out(particle_count_);
+  for (std::uint32_t i = 0; i < particle_count_; ++i) out[i] = {values[4 * i], values[4 * i + 1], values[4 * i + 2]};
+  return out;
+}
+
+std::size_t GpuStepper::gpu_bytes() const {
+  std::size_t total = grid_.bytes();
+  for (const gpu::Buffer* b : {&particle_position_, &particle_position_exact_, &particle_velocity_, &particle_info_,
+                               &particle_local_, &body_position_, &body_orientation_, &body_velocity_, &body_omega_,
+                               &body_inverse_inertia_, &body_range_, &body_momentum_, &particle_force_,
+                               &particle_torque_, &pairs_, &planes_, &cylinders_, &particle_stats_buffer_})
+    total += b->bytes();
+  return total;
+}
+
+}  // namespace ts::sim
