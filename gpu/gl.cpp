@@ -178,6 +178,10 @@ void Program::set(const char* name, float x, float y, float z, float w) const {
   glProgramUniform4f(id_, uniform(name), x, y, z, w);
 }
 void Program::set(const char* name, int x, int y, int z) const { glProgramUniform3i(id_, uniform(name), x, y, z); }
+void Program::set_double(const char* name, double value) const { glProgramUniform1d(id_, uniform(name), value); }
+void Program::set_double(const char* name, double x, double y, double z) const {
+  glProgramUniform3d(id_, uniform(name), x, y, z);
+}
 void Program::set_matrix4(const char* name, const float* m) const {
   glProgramUniformMatrix4fv(id_, uniform(name), 1, GL_FALSE, m);
 }

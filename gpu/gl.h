@@ -80,6 +80,9 @@ class Program {
   void set(const char* name, float x, float y, float z, float w) const;
   void set(const char* name, int x, int y, int z) const;
   void set_matrix4(const char* name, const float* column_major) const;
+  // Double-precision uniforms (GLSL `double`/`dvec3`, core since GL 4.0).
+  void set_double(const char* name, double value) const;
+  void set_double(const char* name, double x, double y, double z) const;
   // Work-group size declared by a compute kernel (layout(local_size_x = ...)).
   std::array<int, 3> local_size() const;
 

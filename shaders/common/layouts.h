@@ -56,10 +56,10 @@ TS_LAYOUT(SimPlane) {
   uvec4 material;         // x: material index
 };
 
-// ---- sim: an implicit cylindrical wall about an axis (smooth): keeps particles inside radius.
+// ---- sim: the inside of a vertical (z) cylindrical wall (smooth), acting between two heights.
 TS_LAYOUT(SimCylinder) {
-  vec4 point_radius;      // xyz: a point on the axis [m]; w: radius [m]
-  vec4 axis;              // xyz: unit axis direction; w: unused
+  vec4 axis_radius;       // xy: the axis [m]; z unused; w: radius [m]
+  vec4 range;             // x: lowest z [m], y: highest z [m]
   uvec4 material;         // x: material index
 };
 
@@ -82,14 +82,14 @@ TS_LAYOUT(SimCylinder) {
 #define TS_SIM_BODY_ORIENTATION 10   // unit quaternion (x, y, z, w); body axes = principal axes
 #define TS_SIM_BODY_VELOCITY 11      // xyz: [m/s]; w: motion type (0 dynamic, 1 kinematic, 2 static)
 #define TS_SIM_BODY_OMEGA 12         // xyz: angular velocity [rad/s] (derived from the momentum)
-#define TS_SIM_BODY_INV_INERTIA 13   // xyz: inverse principal moments [1/(kg m^2)]
+#define TS_SIM_BODY_INV_INERTIA 13   // 3 vec4 per body: rows of I0^-1 (body frame) [1/(kg m^2)]; row 0 w: bounding radius [m]
 #define TS_SIM_BODY_RANGE 14         // uvec4: x first particle, y particle count
 #define TS_SIM_PARTICLE_FORCE 15     // xyz: contact force on the particle [N]
 #define TS_SIM_PARTICLE_TORQUE 16    // xyz: its torque about the body's centre of mass [N m]
 #define TS_SIM_PAIRS 17              // SimPair[material_count^2]
 #define TS_SIM_PLANES 18             // SimPlane[]
 #define TS_SIM_CYLINDERS 19          // SimCylinder[]
-#define TS_SIM_PARTICLE_STATS 20     // x: contacts, y: largest overlap / radius
+#define TS_SIM_PARTICLE_STATS 20     // x: pair contacts (counted by the lower id), y: wall contacts, z: largest overlap / smaller radius, w: overlap clamps
 #define TS_SIM_COUNTERS 21           // uint[]: 0 velocity clamps, 1 overlap clamps
 #define TS_SIM_BODY_MOMENTUM 22      // xyz: angular momentum [kg m^2/s] (world frame)
 

@@ -18,7 +18,7 @@ layout(std430, binding = TS_SIM_BODY_POSITION) readonly buffer BP { real4 body_p
 layout(std430, binding = TS_SIM_BODY_OMEGA) readonly buffer BW { real4 body_omega[]; };
 layout(std430, binding = TS_SIM_PARTICLE_FORCE) writeonly buffer F { real4 particle_force[]; };
 layout(std430, binding = TS_SIM_PARTICLE_TORQUE) writeonly buffer T { real4 particle_torque[]; };
-layout(std430, binding = TS_SIM_PAIRS) readonly buffer M { SimPair pairs[]; };
+layout(std430, binding = TS_SIM_PAIRS) readonly buffer M { SimPair pair_table[]; };
 layout(std430, binding = TS_SIM_PLANES) readonly buffer Planes { SimPlane planes[]; };
 layout(std430, binding = TS_SIM_CYLINDERS) readonly buffer Cylinders { SimCylinder cylinders[]; };
 layout(std430, binding = TS_SIM_PARTICLE_STATS) writeonly buffer S { vec4 particle_stats[]; };
@@ -32,7 +32,7 @@ layout(std430, binding = 23) readonly buffer PX { dvec4 particle_position_exact[
 uniform uint particle_count;
 uniform float cell_size;
 uniform uint table_size;
-uniform uint plane_count;
+uniform uint plane_count;  // walls
 uniform uint cylinder_count;
 uniform int damping_model;
 uniform float max_overlap_ratio;  // overlap clamp (thesis 3.3.1): delta <= ratio * min radius
@@ -52,87 +52,90 @@ void main() {
   uint pair_row = particle_info[i].y * material_count;
   real3 force = real3(0.0), torque = real3(0.0);
   real3 arm_i = xi - body_position[body_i].xyz;
-  float contacts = 0.0, worst_overlap = 0.0;
 
   ivec3 c = cell_of_position(particle_position[i].xyz, cell_size);
-  uint visited[27];
-  int visited_count = 0;
+  float pair_contacts = 0.0, walls = 0.0, clamps = 0.0, worst_overlap = 0.0;
+  real overlap_cap = real(max_overlap_ratio);
+  // The 27 cells in a fixed sweep, like CpuStepper::compute_forces: a bucket shared with another
+  // cell is visited once per cell, keeping only that cell's particles.
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
-        uint h = hash_cell(c + ivec3(dx, dy, dz), table_size);
-        bool seen = false;
-        for (int v = 0; v < visited_count; ++v) seen = seen || visited[v] == h;
-        if (seen) continue;
-        visited[visited_count++] = h;
+        ivec3 cell = c + ivec3(dx, dy, dz);
+        uint h = hash_cell(cell, table_size);
         uint begin = cell_start[h], end = begin + cell_count[h];
         for (uint k = begin; k < end; ++k) {
           uint j = sorted_ids[k];
           uint body_j = particle_info[j].x;
-          if (body_j == body_i) continue;
+          if (body_j == body_i || cell_of_position(particle_position[j].xyz, cell_size) != cell) continue;
           real inv_mass_j = body_position[body_j].w;
-          if (inv_mass_i + inv_mass_j == 0.0) continue;  // two bodies that never move
+          if (inv_mass_i == 0.0 && inv_mass_j == 0.0) continue;  // neither body can move
           real4 xj4 = POSITION(j);
           real3 d = xi - xj4.xyz;
-          real dist2 = dot(d, d);
-          real reach = ri + xj4.w;
-          if (dist2 >= reach * reach || dist2 == 0.0) continue;
-          real dist = sqrt(dist2);
+          real dist = length(d);
+          real raw = ri + xj4.w - dist;
+          if (raw <= 0.0 || dist <= 0.0) continue;
           real3 n = d / dist;
-          real raw = reach - dist;
-          real delta = min(raw, real(max_overlap_ratio) * min(ri, xj4.w));
+          real smaller = min(ri, xj4.w);
+          real delta = min(raw, overlap_cap * smaller);
           real3 arm1 = -(ri - 0.5 * raw) * n;
           real3 arm2 = (xj4.w - 0.5 * raw) * n;
           real3 vc = (vi + cross(wi, arm1)) - (particle_velocity[j].xyz + cross(body_omega[body_j].xyz, arm2));
           real3 f = hertz_contact_force(n, delta, vc, ri * xj4.w / (ri + xj4.w), 1.0 / (inv_mass_i + inv_mass_j),
-                                        pairs[pair_row + particle_info[j].y], damping_model);
+                                        pair_table[pair_row + particle_info[j].y], damping_model);
           force += f;
           torque += cross(arm_i + arm1, f);
-          contacts += 1.0;
-          worst_overlap = max(worst_overlap, float(raw / ri));
+          if (i < j) {  // each pair is counted once, by its lower id
+            pair_contacts += 1.0;
+            worst_overlap = max(worst_overlap, float(delta / smaller));
+            clamps += raw > delta ? 1.0 : 0.0;
+          }
         }
       }
 
   if (inv_mass_i > 0.0) {
+    // Smooth walls in declaration order: planes, then cylinders (as the CPU reference).
     for (uint k = 0u; k < plane_count; ++k) {
       SimPlane plane = planes[k];
       real3 n = real3(plane.normal_offset.xyz);
-      real s = dot(n, xi) - real(plane.normal_offset.w);
-      real reach_delta = ri - s;
-      if (reach_delta <= 0.0 || s < -ri) continue;  // no contact, or already behind the wall
-      real3 along = (xi - real3(plane.extent.xyz)) - dot(xi - real3(plane.extent.xyz), n) * n;
-      real lateral = length(along);
-      if (plane.extent.w > 0.0 && lateral > real(plane.extent.w)) continue;
-      if (plane.extent.w < 0.0 && lateral < real(-plane.extent.w)) continue;
-      real delta = min(reach_delta, real(max_overlap_ratio) * ri);
-      real3 arm = -(ri - 0.5 * reach_delta) * n;
-      real3 f = hertz_contact_force(n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i, pairs[pair_row + plane.material.x],
+      real raw = ri - (dot(n, xi) - real(plane.normal_offset.w));
+      if (raw <= 0.0) continue;
+      if (plane.extent.w != 0.0) {
+        real3 rel = xi - real3(plane.extent.xyz);
+        real lateral = length(rel - dot(rel, n) * n);
+        if (plane.extent.w > 0.0 ? lateral > real(plane.extent.w) : lateral < real(-plane.extent.w)) continue;
+      }
+      real delta = min(raw, overlap_cap * ri);
+      real3 arm = -(ri - 0.5 * raw) * n;
+      real3 f = hertz_contact_force(n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i, pair_table[pair_row + plane.material.x],
                                     damping_model);
       force += f;
       torque += cross(arm_i + arm, f);
-      contacts += 1.0;
-      worst_overlap = max(worst_overlap, float(reach_delta / ri));
+      walls += 1.0;
+      worst_overlap = max(worst_overlap, float(delta / ri));
+      clamps += raw > delta ? 1.0 : 0.0;
     }
     for (uint k = 0u; k < cylinder_count; ++k) {
       SimCylinder cyl = cylinders[k];
-      real3 axis = real3(cyl.axis.xyz);
-      real3 rel = xi - real3(cyl.point_radius.xyz);
-      real3 radial = rel - dot(rel, axis) * axis;
-      real r = length(radial);
-      real reach_delta = r + ri - real(cyl.point_radius.w);
-      if (reach_delta <= 0.0 || r < 1e-12) continue;
-      real3 n = -radial / r;  // from the wall towards the particle (inwards)
-      real delta = min(reach_delta, real(max_overlap_ratio) * ri);
-      real3 arm = -(ri - 0.5 * reach_delta) * n;
-      real3 f = hertz_contact_force(n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i, pairs[pair_row + cyl.material.x],
+      if (xi.z < real(cyl.range.x) || xi.z > real(cyl.range.y)) continue;
+      real2 radial = xi.xy - real2(cyl.axis_radius.xy);
+      real distance = length(radial);
+      if (distance <= 0.0) continue;
+      real raw = ri - (real(cyl.axis_radius.w) - distance);
+      if (raw <= 0.0) continue;
+      real3 n = real3(-radial / distance, 0.0);
+      real delta = min(raw, overlap_cap * ri);
+      real3 arm = -(ri - 0.5 * raw) * n;
+      real3 f = hertz_contact_force(n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i, pair_table[pair_row + cyl.material.x],
                                     damping_model);
       force += f;
       torque += cross(arm_i + arm, f);
-      contacts += 1.0;
-      worst_overlap = max(worst_overlap, float(reach_delta / ri));
+      walls += 1.0;
+      worst_overlap = max(worst_overlap, float(delta / ri));
+      clamps += raw > delta ? 1.0 : 0.0;
     }
   }
   particle_force[i] = real4(force, 0.0);
   particle_torque[i] = real4(torque, 0.0);
-  particle_stats[i] = vec4(contacts, worst_overlap, 0.0, 0.0);
+  particle_stats[i] = vec4(pair_contacts, walls, worst_overlap, clamps);
 }

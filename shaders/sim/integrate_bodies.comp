@@ -1,9 +1,10 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Steps 4 and 5: per-body sum of its particles' forces and torques (in particle order: deterministic),
-// then integration. Forward Euler as the thesis (eqs. 3.44-3.50: rotation before translation, angular
-// momentum L updated and omega = R I0^-1 R^T L) or semi-implicit Euler (velocities first). Static
-// bodies are skipped; kinematic bodies follow their prescribed velocities.
+// Steps 4 and 5, per body: sum its particles' forces and torques in particle order (deterministic),
+// then integrate, mirroring CpuStepper::integrate (sim/cpu_reference.cpp). Rotation first (thesis eqs.
+// 3.47-3.50) through the angular momentum L, omega = R I0^-1 R^T L; forward Euler moves with the old
+// velocities, semi-implicit Euler with the new ones. Static bodies are skipped; kinematic bodies
+// follow their prescribed velocities. Velocity clamps (thesis 3.3.1) are counted, never silent.
 #include "common/layouts.h"
 #include "sim/rigid.glsl"
 layout(local_size_x = 64) in;
@@ -19,26 +20,23 @@ layout(std430, binding = TS_SIM_COUNTERS) buffer C { uint counters[]; };
 layout(std430, binding = TS_SIM_BODY_MOMENTUM) buffer BL { real4 body_momentum[]; };
 
 uniform uint body_count;
-uniform float dt;              // [s]
-uniform vec3 gravity;          // [m/s^2]
-uniform int semi_implicit;     // 0: forward Euler (thesis), 1: semi-implicit Euler
-uniform float max_speed;       // velocity clamp [m/s] (thesis 3.3.1); every clamp is counted
-uniform float angular_damping_speed;  // thesis pseudocode 4.4: below this |omega| [rad/s], damp; 0 = off
-uniform float angular_damping_factor;
+uniform real dt;                       // [s]
+uniform real3 gravity;                 // [m/s^2]
+uniform int semi_implicit;             // 0: forward Euler (thesis), 1: semi-implicit Euler
+uniform float max_speed;               // CFL clamp: cfl * cell / dt [m/s]
+uniform float angular_damping_rate;    // [1/s], 0 = off (thesis pseudocode 4.4)
+uniform float angular_damping_speed;   // [m/s]: damp when |v| + |w| reach is below it
 
 void main() {
   uint b = gl_GlobalInvocationID.x;
   if (b >= body_count) return;
   uint motion = uint(body_velocity[b].w);
   if (motion == TS_MOTION_STATIC) return;
+  real h = dt;
   real4 q = body_orientation[b];
-  real3 x = body_position[b].xyz;
-  real3 v = body_velocity[b].xyz;
-  real3 omega = body_omega[b].xyz;
-  real h = real(dt);
   if (motion == TS_MOTION_KINEMATIC) {
-    body_position[b].xyz = x + h * v;
-    body_orientation[b] = integrate_orientation(q, omega, h);
+    body_position[b].xyz += h * body_velocity[b].xyz;
+    body_orientation[b] = integrate_orientation(q, body_omega[b].xyz, h);
     return;
   }
   real3 force = real3(0.0), torque = real3(0.0);
@@ -47,30 +45,35 @@ void main() {
     force += particle_force[k].xyz;
     torque += particle_torque[k].xyz;
   }
-  real inverse_mass = body_position[b].w;
-  force += real3(gravity) / inverse_mass;
-  real3 inverse_principal = body_inverse_inertia[b].xyz;
-  real3 momentum = body_momentum[b].xyz;
+  real3 row0 = body_inverse_inertia[3u * b].xyz, row1 = body_inverse_inertia[3u * b + 1u].xyz,
+        row2 = body_inverse_inertia[3u * b + 2u].xyz;
+  real reach = body_inverse_inertia[3u * b].w;
+  real3 acceleration = gravity + body_position[b].w * force;
+  real3 momentum = body_momentum[b].xyz + torque * h;
+  real3 w_move = semi_implicit != 0 ? apply_world_inverse_inertia(q, row0, row1, row2, momentum) : body_omega[b].xyz;
+  real4 q_new = integrate_orientation(q, w_move, h);
+  real3 w = apply_world_inverse_inertia(q_new, row0, row1, row2, momentum);
+  real3 v = body_velocity[b].xyz + acceleration * h;
+  body_position[b].xyz += (semi_implicit != 0 ? v : body_velocity[b].xyz) * h;
 
-  real3 v_new = v + h * inverse_mass * force;
-  real3 momentum_new = momentum + h * torque;
-  real speed = length(v_new);
-  if (speed > real(max_speed)) {
-    v_new *= real(max_speed) / speed;
+  real limit = real(max_speed);
+  if (length(v) > limit) {
+    v *= limit / length(v);
     atomicAdd(counters[0], 1u);
   }
-  // Rotation before translation (thesis). Forward Euler moves with the old velocities.
-  real3 omega_step = semi_implicit != 0 ? apply_world_inverse_inertia(q, inverse_principal, momentum_new) : omega;
-  real3 v_step = semi_implicit != 0 ? v_new : v;
-  real4 q_new = integrate_orientation(q, omega_step, h);
-  real3 omega_new = apply_world_inverse_inertia(q_new, inverse_principal, momentum_new);
-  if (angular_damping_speed > 0.0 && length(omega_new) < real(angular_damping_speed)) {
-    omega_new *= real(angular_damping_factor);
-    momentum_new = rotate(q_new, rotate_inverse(q_new, omega_new) / inverse_principal);
+  if (length(w) * reach > limit) {
+    real factor = limit / (length(w) * reach);
+    w *= factor;
+    momentum *= factor;  // omega is linear in L
+    atomicAdd(counters[1], 1u);
+  }
+  if (angular_damping_rate > 0.0 && length(v) + length(w) * reach < real(angular_damping_speed)) {
+    real factor = max(real(0.0), 1.0 - real(angular_damping_rate) * h);
+    w *= factor;
+    momentum *= factor;
   }
   body_orientation[b] = q_new;
-  body_position[b].xyz = x + h * v_step;
-  body_velocity[b].xyz = v_new;
-  body_omega[b].xyz = omega_new;
-  body_momentum[b].xyz = momentum_new;
+  body_velocity[b].xyz = v;
+  body_omega[b].xyz = w;
+  body_momentum[b].xyz = momentum;
 }

@@ -5,10 +5,12 @@
 #define TETRASAND_SIM_PRECISION_GLSL
 #ifdef TS_FP64
 #define real double
+#define real2 dvec2
 #define real3 dvec3
 #define real4 dvec4
 #else
 #define real float
+#define real2 vec2
 #define real3 vec3
 #define real4 vec4
 #endif

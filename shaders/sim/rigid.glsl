@@ -10,9 +10,10 @@ real3 rotate(real4 q, real3 v) {
 
 real3 rotate_inverse(real4 q, real3 v) { return rotate(real4(-q.xyz, q.w), v); }
 
-// omega = R I0^-1 R^T L for a body whose frame holds the principal axes.
-real3 apply_world_inverse_inertia(real4 q, real3 inverse_principal, real3 world_vector) {
-  return rotate(q, inverse_principal * rotate_inverse(q, world_vector));
+// R I0^-1 R^T applied to a world-frame vector; I0^-1 given by its rows (body frame).
+real3 apply_world_inverse_inertia(real4 q, real3 row0, real3 row1, real3 row2, real3 world_vector) {
+  real3 local = rotate_inverse(q, world_vector);
+  return rotate(q, real3(dot(row0, local), dot(row1, local), dot(row2, local)));
 }
 
 // q(t + dt) = q + dt/2 [omega, 0] q, renormalised (thesis eqs. 3.47-3.50).

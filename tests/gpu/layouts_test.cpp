@@ -68,7 +68,7 @@ TEST_F(GpuLayouts, SimStructsMatchCpp) {
   EXPECT_EQ(query(probe, "sim_planes[0].extent").offset, static_cast<GLint>(offsetof(SimPlane, extent)));
   EXPECT_EQ(query(probe, "sim_planes[0].material").offset, static_cast<GLint>(offsetof(SimPlane, material)));
   using layout::SimCylinder;
-  EXPECT_EQ(query(probe, "sim_cylinders[0].point_radius").top_level_stride, static_cast<GLint>(sizeof(SimCylinder)));
+  EXPECT_EQ(query(probe, "sim_cylinders[0].axis_radius").top_level_stride, static_cast<GLint>(sizeof(SimCylinder)));
   EXPECT_EQ(query(probe, "sim_cylinders[0].material").offset, static_cast<GLint>(offsetof(SimCylinder, material)));
 }
 

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "sim/cpu_reference.h"
@@ -131,8 +132,10 @@ TEST_F(GpuStepperTest, FreeFallMatchesAnalyticSolutionToTheChosenPrecision) {
   // Semi-implicit Euler under constant g: z_n = z0 + v0 t + g dt^2 n(n+1)/2, exactly.
   const double t = steps * settings.dt;
   const double z = 1.0 + 2.0 * t - 9.81 * settings.dt * settings.dt * steps * (steps + 1) / 2.0;
-  // Double: rounding only. Float: 3000 additions of ~1e-3 to ~1 accumulate ~1e-7 * sqrt(3000) * ... ~1e-5.
-  const double tolerance = precision == Precision::Double ? 1e-11 : 2e-5;
+  // Each step rounds once per update: the bound is steps * machine epsilon * the largest magnitude (~2).
+  const double epsilon = precision == Precision::Double ? std::numeric_limits<double>::epsilon()
+                                                        : std::numeric_limits<float>::epsilon();
+  const double tolerance = steps * epsilon * 2.0;
   EXPECT_NEAR(out.bodies.position[0].z(), z, tolerance);
   EXPECT_NEAR(out.bodies.position[0].x(), 0.3 * t, tolerance);
   EXPECT_NEAR(out.bodies.linear_velocity[0].z(), 2.0 - 9.81 * t, tolerance);

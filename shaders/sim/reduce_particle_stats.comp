@@ -1,0 +1,22 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Contact statistics per work group (the host adds partials in order): x pair contacts, y wall
+// contacts, z largest overlap ratio (max), w overlap clamps.
+#include "common/layouts.h"
+layout(local_size_x = 256) in;
+layout(std430, binding = TS_SIM_PARTICLE_STATS) readonly buffer S { vec4 particle_stats[]; };
+layout(std430, binding = 25) writeonly buffer Partials { vec4 partials[]; };
+uniform uint particle_count;
+shared vec4 scratch[256];
+void main() {
+  uint i = gl_GlobalInvocationID.x, t = gl_LocalInvocationID.x;
+  scratch[t] = i < particle_count ? particle_stats[i] : vec4(0.0);
+  for (uint stride = 128u; stride > 0u; stride >>= 1u) {
+    barrier();
+    if (t < stride) {
+      vec4 a = scratch[t], b = scratch[t + stride];
+      scratch[t] = vec4(a.x + b.x, a.y + b.y, max(a.z, b.z), a.w + b.w);
+    }
+  }
+  if (t == 0u) partials[gl_WorkGroupID.x] = scratch[0];
+}
