@@ -1,0 +1,400 @@
+// Scene file parsing: a small reader per TOML table that knows the file, its path of keys and
+// which keys it has consumed, so every message reads "file:line: table.key: problem".
+#include "sim/scene.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#define TOML_EXCEPTIONS 1
+#include <toml++/toml.h>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace ts::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Levenshtein distance, for "did you mean" on unknown keys.
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      const bool same = std::tolower(a[i - 1]) == std::tolower(b[j - 1]);
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
+
+class TableReader {
+ public:
+  TableReader(const toml::table& table, std::string path, const fs::path& file)
+      : table_(table), path_(std::move(path)), file_(file) {}
+
+  [[noreturn]] void fail(std::string_view key, const std::string& problem) const {
+    const toml::node* node = key.empty() ? nullptr : table_.get(key);
+    const int line = node ? line_of(*node) : line_of(table_);
+    const std::string name = key.empty() ? path_ : (path_.empty() ? std::string(key) : path_ + "." + std::string(key));
+    throw InputError(fmt::format("{}:{}: {}: {}", file_.string(), line, name, problem));
+  }
+
+  bool has(std::string_view key) {
+    used_.insert(std::string(key));
+    return table_.contains(key);
+  }
+
+  const toml::node* node(std::string_view key) {
+    used_.insert(std::string(key));
+    return table_.get(key);
+  }
+
+  std::optional<double> optional_number(std::string_view key) {
+    const toml::node* n = node(key);
+    if (!n) return std::nullopt;
+    if (!n->is_number()) fail(key, "must be a number");
+    const double value = *n->value<double>();
+    if (!std::isfinite(value)) fail(key, "must be finite");
+    return value;
+  }
+  double number(std::string_view key, double fallback) { return optional_number(key).value_or(fallback); }
+  double required_number(std::string_view key) {
+    const auto value = optional_number(key);
+    if (!value) fail(key, "missing (required)");
+    return *value;
+  }
+  double positive(std::string_view key, std::optional<double> fallback = std::nullopt) {
+    const auto value = has(key) ? optional_number(key) : fallback;
+    if (!value) fail(key, "missing (required)");
+    if (!(*value > 0)) fail(key, fmt::format("must be > 0 (got {})", *value));
+    return *value;
+  }
+  double non_negative(std::string_view key, double fallback) {
+    const double value = number(key, fallback);
+    if (value < 0) fail(key, fmt::format("must be >= 0 (got {})", value));
+    return value;
+  }
+  std::int64_t integer(std::string_view key, std::optional<std::int64_t> fallback, std::int64_t min_value) {
+    const toml::node* n = node(key);
+    if (!n && !fallback) fail(key, "missing (required)");
+    if (!n) return *fallback;
+    if (!n->is_integer()) fail(key, "must be an integer");
+    const std::int64_t value = *n->value<std::int64_t>();
+    if (value < min_value) fail(key, fmt::format("must be >= {} (got {})", min_value, value));
+    return value;
+  }
+  bool boolean(std::string_view key, bool fallback) {
+    const toml::node* n = node(key);
+    if (!n) return fallback;
+    if (!n->is_boolean()) fail(key, "must be true or false");
+    return *n->value<bool>();
+  }
+  std::optional<std::string> optional_string(std::string_view key) {
+    const toml::node* n = node(key);
+    if (!n) return std::nullopt;
+    if (!n->is_string()) fail(key, "must be a string");
+    return *n->value<std::string>();
+  }
+  std::string required_string(std::string_view key) {
+    auto s = optional_string(key);
+    if (!s) fail(key, "missing (required)");
+    return *s;
+  }
+  // One of `choices`; returns its index.
+  std::size_t choice(std::string_view key, const std::vector<std::string>& choices, std::optional<std::size_t> fallback) {
+    const auto s = optional_string(key);
+    if (!s && !fallback) fail(key, fmt::format("missing (required; one of: {})", fmt::join(choices, ", ")));
+    if (!s) return *fallback;
+    const auto it = std::find(choices.begin(), choices.end(), *s);
+    if (it == choices.end()) fail(key, fmt::format("\"{}\" is not one of: {}", *s, fmt::join(choices, ", ")));
+    return static_cast<std::size_t>(it - choices.begin());
+  }
+  template <int N>
+  std::optional<Eigen::Matrix<double, N, 1>> optional_vector(std::string_view key) {
+    const toml::node* n = node(key);
+    if (!n) return std::nullopt;
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != N) fail(key, fmt::format("must be an array of {} numbers", N));
+    Eigen::Matrix<double, N, 1> v;
+    for (int i = 0; i < N; ++i) {
+      const toml::node& element = *a->get(static_cast<std::size_t>(i));
+      if (!element.is_number()) fail(key, fmt::format("must be an array of {} numbers", N));
+      v[i] = *element.value<double>();
+      if (!std::isfinite(v[i])) fail(key, "must be finite");
+    }
+    return v;
+  }
+  template <int N>
+  Eigen::Matrix<double, N, 1> vector(std::string_view key, std::optional<Eigen::Matrix<double, N, 1>> fallback) {
+    auto v = optional_vector<N>(key);
+    if (!v && !fallback) fail(key, "missing (required)");
+    return v ? *v : *fallback;
+  }
+  Eigen::Vector3d unit_vector(std::string_view key, const Eigen::Vector3d& fallback) {
+    const Eigen::Vector3d v = vector<3>(key, fallback);
+    if (v.norm() < 1e-12) fail(key, "must not be the zero vector");
+    return v.normalized();
+  }
+
+  // Rejects keys nobody asked for: a typo must not be silently ignored.
+  void reject_unknown_keys() const {
+    for (const auto& [key, value] : table_) {
+      const std::string name(key.str());
+      if (used_.count(name)) continue;
+      std::string hint;
+      std::size_t best = 3;
+      for (const std::string& known : used_) {
+        const std::size_t d = edit_distance(name, known);
+        if (d < best) {
+          best = d;
+          hint = fmt::format(" (did you mean \"{}\"?)", known);
+        }
+      }
+      const int line = line_of(value);
+      const std::string full = path_.empty() ? name : path_ + "." + name;
+      throw InputError(fmt::format("{}:{}: {}: unknown key{}; expected one of: {}", file_.string(), line, full, hint,
+                                   fmt::join(used_, ", ")));
+    }
+  }
+
+  const toml::table& table() const { return table_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  const toml::table& table_;
+  std::string path_;
+  const fs::path& file_;
+  std::set<std::string> used_;
+};
+
+// Calls `each` with a reader for every table of the array-of-tables `key` (absent: none).
+template <typename Fn>
+void for_each_table(TableReader& parent, std::string_view key, Fn&& each) {
+  const toml::node* n = parent.node(key);
+  if (!n) return;
+  const toml::array* array = n->as_array();
+  if (!array || !array->is_array_of_tables()) parent.fail(key, fmt::format("must be [[{}]] tables", key));
+  for (std::size_t i = 0; i < array->size(); ++i) each(*array->get(i)->as_table());
+}
+
+std::uint16_t material_index(TableReader& r, const Scene& scene, std::string_view key) {
+  const std::string name = r.required_string(key);
+  for (std::size_t i = 0; i < scene.material_names.size(); ++i) {
+    if (scene.material_names[i] == name) return static_cast<std::uint16_t>(i);
+  }
+  r.fail(key, fmt::format("no [[material]] named \"{}\" (have: {})", name, fmt::join(scene.material_names, ", ")));
+}
+
+void read_material(const toml::table& t, const fs::path& file, Scene& scene) {
+  TableReader r(t, "material", file);
+  Material m;
+  const std::string name = r.required_string("name");
+  if (std::find(scene.material_names.begin(), scene.material_names.end(), name) != scene.material_names.end()) {
+    r.fail("name", fmt::format("\"{}\" is defined twice", name));
+  }
+  m.youngs_modulus = r.required_number("E");
+  m.poisson_ratio = r.required_number("nu");
+  m.restitution = r.required_number("restitution");
+  m.friction = r.required_number("mu");
+  m.tangential_damping = r.number("gamma_s", m.tangential_damping);
+  m.density = r.required_number("density");
+  r.reject_unknown_keys();
+  if (const std::string problem = validate(m); !problem.empty()) {
+    const std::string key = problem.substr(0, problem.find(':'));
+    r.fail(key, problem.substr(problem.find(':') + 2));
+  }
+  if (scene.materials.size() >= 65535) r.fail("", "too many materials");
+  scene.materials.push_back(m);
+  scene.material_names.push_back(name);
+}
+
+void read_grain(TableReader& root, const fs::path& file, Scene& scene) {
+  const toml::node* n = root.node("grain");
+  if (!n || !n->is_table()) root.fail("grain", "missing [grain] table (radius, edge, material)");
+  TableReader r(*n->as_table(), "grain", file);
+  scene.grain.radius = r.positive("radius");
+  scene.grain.edge = r.positive("edge", 2 * scene.grain.radius);
+  if (scene.grain.edge > 2 * scene.grain.radius * (1 + 1e-9)) {
+    r.fail("edge", fmt::format("{} m leaves the spheres apart: must be <= 2 radius = {} m", scene.grain.edge,
+                               2 * scene.grain.radius));
+  }
+  scene.grain.material = material_index(r, scene, "material");
+  r.reject_unknown_keys();
+}
+
+void read_emitter(const toml::table& t, const fs::path& file, Scene& scene) {
+  TableReader r(t, "emitter", file);
+  Emitter e;
+  e.line = line_of(t);
+  e.type = static_cast<EmitterType>(r.choice("type", {"fill", "pour", "column"}, std::nullopt));
+  e.count = static_cast<std::size_t>(r.integer("count", std::nullopt, 1));
+  e.velocity = r.vector<3>("velocity", Eigen::Vector3d::Zero());
+  e.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0));
+  if (e.type == EmitterType::Column) {
+    e.centre = r.vector<3>("centre", std::nullopt);
+    e.radius = r.positive("radius");
+  } else {
+    e.min = r.vector<3>("min", std::nullopt);
+    e.max = r.vector<3>("max", std::nullopt);
+    if (!(e.max.array() > e.min.array()).all()) r.fail("max", "must exceed min in x, y and z");
+  }
+  if (e.type == EmitterType::Pour) {
+    e.rate = r.positive("rate");
+    e.start = r.non_negative("start", 0.0);
+  }
+  r.reject_unknown_keys();
+  scene.emitters.push_back(e);
+}
+
+void read_prop(const toml::table& t, const fs::path& file, Scene& scene) {
+  TableReader r(t, "prop", file);
+  Prop p;
+  p.line = line_of(t);
+  const std::string body = r.required_string("body");
+  p.body_file = file.parent_path() / body;
+  if (!fs::exists(p.body_file)) r.fail("body", fmt::format("{} does not exist", p.body_file.string()));
+  p.position = r.vector<3>("position", Eigen::Vector3d::Zero());
+  const Eigen::Vector4d q = r.vector<4>("orientation", Eigen::Vector4d(1, 0, 0, 0));
+  if (q.norm() < 1e-12) r.fail("orientation", "quaternion [w, x, y, z] must not be zero");
+  p.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+  p.motion = static_cast<MotionType>(r.choice("motion", {"dynamic", "kinematic", "static"}, 2));
+  p.velocity = r.vector<3>("velocity", Eigen::Vector3d::Zero());
+  p.angular_velocity = r.vector<3>("angular_velocity", Eigen::Vector3d::Zero());
+  if (p.motion == MotionType::Static && (p.velocity.norm() > 0 || p.angular_velocity.norm() > 0)) {
+    r.fail("velocity", "a static prop cannot move (use motion = \"kinematic\")");
+  }
+  p.material = material_index(r, scene, "material");
+  r.reject_unknown_keys();
+  scene.props.push_back(p);
+}
+
+void read_roughness(TableReader& r, Boundary& b) {
+  b.rough = r.boolean("rough", false);
+  if (!b.rough) return;
+  b.particle_radius = r.positive("particle_radius");
+  b.spacing = r.positive("spacing", 2 * b.particle_radius);
+}
+
+void read_boundary(const toml::table& t, const fs::path& file, Scene& scene) {
+  TableReader r(t, "boundary", file);
+  Boundary b;
+  b.line = line_of(t);
+  b.type = static_cast<BoundaryType>(r.choice("type", {"plane", "box", "cylinder"}, std::nullopt));
+  b.material = material_index(r, scene, "material");
+  read_roughness(r, b);
+  switch (b.type) {
+    case BoundaryType::Plane:
+      b.point = r.vector<3>("point", Eigen::Vector3d::Zero());
+      b.normal = r.unit_vector("normal", Eigen::Vector3d::UnitZ());
+      if (b.rough) {
+        b.size = r.vector<2>("size", std::nullopt);
+        if (!(b.size.array() > 0).all()) r.fail("size", "must be > 0 in both directions");
+        b.hole_radius = r.non_negative("hole_radius", 0.0);
+      }
+      break;
+    case BoundaryType::Box:
+      b.min = r.vector<3>("min", std::nullopt);
+      b.max = r.vector<3>("max", std::nullopt);
+      if (!(b.max.array() > b.min.array()).all()) r.fail("max", "must exceed min in x, y and z");
+      break;
+    case BoundaryType::Cylinder:
+      b.axis = r.vector<2>("centre", Eigen::Vector2d::Zero());
+      b.radius = r.positive("radius");
+      b.z_min = r.required_number("z_min");
+      b.z_max = r.required_number("z_max");
+      if (!(b.z_max > b.z_min)) r.fail("z_max", "must exceed z_min");
+      break;
+  }
+  r.reject_unknown_keys();
+  scene.boundaries.push_back(b);
+}
+
+void read_simulation(TableReader& root, const fs::path& file, Scene& scene) {
+  const toml::node* n = root.node("simulation");
+  if (!n) return;
+  if (!n->is_table()) root.fail("simulation", "must be a table");
+  TableReader r(*n->as_table(), "simulation", file);
+  SimulationSettings& s = scene.simulation;
+  s.duration = r.positive("duration", s.duration);
+  if (const toml::node* dt = r.node("dt")) {
+    if (dt->is_string() && *dt->value<std::string>() == "auto") {
+      s.dt = 0;
+    } else if (dt->is_number() && *dt->value<double>() > 0) {
+      s.dt = *dt->value<double>();
+    } else {
+      r.fail("dt", "must be a time step > 0 (s) or \"auto\"");
+    }
+  }
+  s.max_impact_speed = r.non_negative("max_impact_speed", 0.0);
+  s.step.normal_damping = static_cast<NormalDamping>(r.choice("normal_damping", {"tsuji", "thesis"}, 0));
+  s.step.thesis_reference_speed = r.positive("thesis_reference_speed", s.step.thesis_reference_speed);
+  s.step.integrator = static_cast<Integrator>(r.choice("integrator", {"euler", "symplectic"}, 0));
+  s.step.cfl = r.non_negative("cfl", s.step.cfl);
+  s.step.max_overlap_ratio = r.non_negative("max_overlap_ratio", s.step.max_overlap_ratio);
+  s.step.angular_damping_rate = r.non_negative("angular_damping_rate", 0.0);
+  s.step.angular_damping_speed = r.non_negative("angular_damping_speed", 0.0);
+  s.step.check_energy = r.boolean("check_energy", true);
+  r.reject_unknown_keys();
+}
+
+void read_output(TableReader& root, const fs::path& file, Scene& scene) {
+  const toml::node* n = root.node("output");
+  if (!n) return;
+  if (!n->is_table()) root.fail("output", "must be a table");
+  TableReader r(*n->as_table(), "output", file);
+  OutputSettings& o = scene.output;
+  o.every = r.integer("every", o.every, 1);
+  o.frames = r.boolean("frames", o.frames);
+  o.ply = r.boolean("ply", o.ply);
+  o.vtp = r.boolean("vtp", o.vtp);
+  o.csv = r.boolean("csv", o.csv);
+  o.contacts = r.boolean("contacts", o.contacts);
+  r.reject_unknown_keys();
+}
+
+Scene read_scene(const toml::table& root_table, const fs::path& file) {
+  Scene scene;
+  scene.file = file;
+  TableReader root(root_table, "", file);
+  scene.gravity = root.vector<3>("gravity", scene.gravity);
+  for_each_table(root, "material", [&](const toml::table& t) { read_material(t, file, scene); });
+  if (scene.materials.empty()) root.fail("material", "no [[material]] table: a scene needs at least one");
+  read_grain(root, file, scene);
+  for_each_table(root, "emitter", [&](const toml::table& t) { read_emitter(t, file, scene); });
+  for_each_table(root, "prop", [&](const toml::table& t) { read_prop(t, file, scene); });
+  for_each_table(root, "boundary", [&](const toml::table& t) { read_boundary(t, file, scene); });
+  read_simulation(root, file, scene);
+  read_output(root, file, scene);
+  root.reject_unknown_keys();
+  return scene;
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
+  toml::table table;
+  try {
+    table = toml::parse(text, file.string());
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}: {}", file.string(), e.source().begin.line, e.description()));
+  }
+  return read_scene(table, file);
+}
+
+Scene load_scene(const std::filesystem::path& file) { return parse_scene(read_file(file), file); }
+
+}  // namespace ts::sim

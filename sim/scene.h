@@ -1,0 +1,158 @@
+#pragma once
+// Hand-written scene files (TOML, SI units: m, kg, s, Pa). Every key is checked: a misspelt key is
+// an error, never silently ignored, and every error names the file, the line and the key:
+//   "pile.toml:12: material.E: must be > 0 (Pa)".
+// The format, by example, is in assets/scenes/*.toml; load_scene() documents the keys it accepts
+// through its error messages ("expected one of: ...").
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <random>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sim/contact_model.h"
+#include "sim/cpu_reference.h"
+#include "sim/time_step.h"
+#include "sim/world.h"
+
+namespace ts::sim {
+
+struct GrainSpec {
+  double radius = 1e-3;  // m, each of the four spheres
+  double edge = 2e-3;    // m, sphere centre distance (default 2 radius: touching spheres)
+  std::uint16_t material = 0;
+};
+
+enum class EmitterType {
+  Fill,    // `count` grains on a jittered lattice filling the box [min, max] at t = 0
+  Pour,    // `count` grains released from the box [min, max] at `rate` grains/s from `start`
+  Column,  // `count` grains stacked in a vertical cylinder (centre = base centre, radius) at t = 0
+};
+
+struct Emitter {
+  EmitterType type = EmitterType::Fill;
+  Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();  // m (fill, pour)
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // m, column base centre
+  double radius = 0;                                 // m, column radius
+  std::size_t count = 0;                             // grains
+  double rate = 0;                                   // grains/s (pour)
+  double start = 0;                                  // s (pour)
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s, initial velocity of every grain
+  std::uint64_t seed = 1;                            // jitter and orientations
+  int line = 0;                                      // where it was declared, for messages
+};
+
+struct Prop {
+  std::filesystem::path body_file;  // NAME.body.json, resolved against the scene's folder
+  // Pose of the mesh frame (the body file's coordinates): x_world = position + orientation * x_mesh.
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();              // m
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // scene key: [w, x, y, z]
+  MotionType motion = MotionType::Static;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          // m/s (kinematic: prescribed; dynamic: initial)
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // rad/s, world frame
+  std::uint16_t material = 0;
+  int line = 0;
+};
+
+enum class BoundaryType { Plane, Box, Cylinder };
+
+struct Boundary {
+  BoundaryType type = BoundaryType::Plane;
+  bool rough = false;  // sampled as a static body of particles (thesis 4.4.4), else an implicit wall
+  std::uint16_t material = 0;
+  // plane: a point and the normal into the free side; rough planes cover `size` around `point`.
+  Eigen::Vector3d point = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  // m, unit
+  Eigen::Vector2d size = Eigen::Vector2d::Zero();  // m (rough plane extent along two in-plane axes)
+  double hole_radius = 0;                          // m, a round hole around `point` (rough plane: an orifice)
+  // box: open top; grains stay inside [min, max].
+  Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();  // m
+  // cylinder: inside of a vertical wall.
+  Eigen::Vector2d axis = Eigen::Vector2d::Zero();  // m, (x, y)
+  double radius = 0, z_min = 0, z_max = 0;         // m
+  // rough sampling: particle radius and lattice spacing (default: touching particles).
+  double particle_radius = 0;  // m
+  double spacing = 0;          // m
+  int line = 0;
+};
+
+struct SimulationSettings {
+  double duration = 1.0;          // s
+  double dt = 0;                  // s; 0 = "auto" (TimeStepBound::recommended)
+  double max_impact_speed = 0;    // m/s for the contact-duration bound; 0 = from gravity and the scene height
+  StepSettings step;              // dt filled in by make_world
+};
+
+struct OutputSettings {
+  std::int64_t every = 1000;  // steps between outputs
+  bool frames = false;        // PNG frames through the preview renderer
+  bool ply = false;           // particle positions per output
+  bool vtp = false;           // VTK PolyData per output
+  bool csv = true;            // metrics.csv: one row per output
+  bool contacts = false;      // per-contact dump
+};
+
+struct Scene {
+  std::filesystem::path file;
+  std::vector<Material> materials;
+  std::vector<std::string> material_names;
+  GrainSpec grain;
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2
+  std::vector<Emitter> emitters;
+  std::vector<Prop> props;
+  std::vector<Boundary> boundaries;
+  SimulationSettings simulation;
+  OutputSettings output;
+};
+
+// Parses and validates a scene file. Throws ts::InputError naming file, line and key.
+Scene load_scene(const std::filesystem::path& file);
+// The same from text (`file` is only used in messages and to resolve relative paths).
+Scene parse_scene(std::string_view text, const std::filesystem::path& file);
+
+// A particle rigid body as the sampler writes it (NAME.body.json + NAME.particles.ply): particles in
+// mesh coordinates, mass properties about the centre of mass in mesh axes.
+struct ParticleBody {
+  std::vector<Eigen::Vector3d> particles;  // m, mesh coordinates
+  double particle_radius = 0;              // m
+  double mass = 0;                         // kg
+  Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();  // m, mesh coordinates
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();         // kg m^2, about the centre of mass
+};
+// Reads body.json and the PLY it names (binary little-endian, float x y z [nx ny nz ...]).
+ParticleBody load_particle_body(const std::filesystem::path& body_json);
+
+// The initial world of a scene: materials, smooth walls, rough walls as static particle bodies,
+// props, and the grains of the fill and column emitters. Pour emitters run through PourEmitter.
+World make_world(const Scene& scene);
+
+// The time-step bound for the scene's contact kinds (grain-grain, grain-wall, grain-prop).
+TimeStepBound scene_time_step_bound(const Scene& scene, const World& world);
+
+// Releases a pour emitter's grains as time passes, at free lattice sites of its region.
+class PourEmitter {
+ public:
+  PourEmitter(const Scene& scene, const Emitter& emitter);
+  // Adds the grains due by world.time whose site is free; returns how many were added.
+  std::size_t emit(World& world);
+  bool finished() const { return emitted_ == emitter_.count; }
+
+ private:
+  GrainShape grain_;
+  Emitter emitter_;
+  std::uint16_t material_;
+  std::vector<Eigen::Vector3d> sites_;  // m, lattice sites of the region
+  std::size_t next_site_ = 0, emitted_ = 0;
+  std::mt19937_64 rng_;
+};
+
+// Lattice sites (m) for grains of bounding radius `bound` in a box: spacing >= 2.22 d so that
+// no two grains overlap whatever their orientation (notes/peers.md), jittered by `rng`.
+std::vector<Eigen::Vector3d> grain_sites_in_box(const Eigen::Vector3d& min, const Eigen::Vector3d& max, double bound,
+                                                std::mt19937_64& rng);
+
+}  // namespace ts::sim

@@ -1,0 +1,292 @@
+// From a parsed scene to the initial World: walls (smooth planes/cylinders, or rough particle
+// lattices as static bodies), props, and grains placed by the emitters.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/error.h"
+#include "sim/scene.h"
+
+namespace ts::sim {
+namespace {
+
+// Grains are spaced 10 % beyond their bounding diameter (2.22 d for touching spheres) and jittered
+// by at most 2 % of the spacing per axis, so no two start in contact whatever their orientation.
+constexpr double kSiteMargin = 1.1;
+constexpr double kJitter = 0.02;
+
+Eigen::Quaterniond random_orientation(std::mt19937_64& rng) {
+  std::normal_distribution<double> normal;
+  // Four independent normals, normalised: uniform over rotations.
+  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+  return q.normalized();
+}
+
+std::string where(const Scene& scene, int line, std::string_view key) {
+  return fmt::format("{}:{}: {}", scene.file.string(), line, key);
+}
+
+// A static body of touching (or `spacing`-spaced) spheres on a rectangular lattice whose tops lie
+// in the plane through `surface` with normal n; particles reaching into the hole are left out.
+void add_rough_rectangle(World& world, const Eigen::Vector3d& surface, const Eigen::Vector3d& n,
+                         const Eigen::Vector3d& t1, const Eigen::Vector3d& t2, const Eigen::Vector2d& size,
+                         double hole_radius, double radius, double spacing, std::uint16_t material) {
+  const int n1 = static_cast<int>(std::floor(size.x() / spacing)) + 1;
+  const int n2 = static_cast<int>(std::floor(size.y() / spacing)) + 1;
+  std::vector<Eigen::Vector3d> offsets;
+  for (int j = 0; j < n2; ++j) {
+    for (int i = 0; i < n1; ++i) {
+      const double a = (i - 0.5 * (n1 - 1)) * spacing, b = (j - 0.5 * (n2 - 1)) * spacing;
+      if (hole_radius > 0 && std::hypot(a, b) < hole_radius + radius) continue;
+      offsets.push_back(a * t1 + b * t2 - radius * n);
+    }
+  }
+  if (offsets.empty()) return;
+  BodyDesc desc;
+  desc.position = surface;
+  desc.motion = MotionType::Static;
+  add_body(world, desc, offsets, std::vector<double>(offsets.size(), radius), material);
+}
+
+// In-plane axes for a plane normal; for a horizontal plane t1 = x and t2 = y.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> plane_axes(const Eigen::Vector3d& n) {
+  const Eigen::Vector3d reference = std::abs(n.x()) > 0.9 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d t1 = (reference - reference.dot(n) * n).normalized();
+  return {t1, n.cross(t1)};
+}
+
+void add_rough_cylinder(World& world, const Boundary& b) {
+  const double ring = b.radius + b.particle_radius;  // m, particle centres: the inner surface is at b.radius
+  const int around = static_cast<int>(std::ceil(2 * std::numbers::pi * ring / b.spacing));
+  const int up = static_cast<int>(std::floor((b.z_max - b.z_min) / b.spacing)) + 1;
+  const Eigen::Vector3d centre(b.axis.x(), b.axis.y(), b.z_min);
+  std::vector<Eigen::Vector3d> offsets;
+  for (int k = 0; k < up; ++k) {
+    for (int i = 0; i < around; ++i) {
+      const double angle = 2 * std::numbers::pi * (i + 0.5 * (k % 2)) / around;
+      offsets.emplace_back(ring * std::cos(angle), ring * std::sin(angle), k * b.spacing);
+    }
+  }
+  BodyDesc desc;
+  desc.position = centre;
+  desc.motion = MotionType::Static;
+  add_body(world, desc, offsets, std::vector<double>(offsets.size(), b.particle_radius), b.material);
+}
+
+// The five faces of an open-topped box, inward normals.
+struct Face {
+  Eigen::Vector3d point, normal, t1, t2;
+  Eigen::Vector2d size;
+};
+std::vector<Face> box_faces(const Boundary& b) {
+  const Eigen::Vector3d c = 0.5 * (b.min + b.max), e = b.max - b.min;
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), y = Eigen::Vector3d::UnitY(), z = Eigen::Vector3d::UnitZ();
+  const double zc = c.z();
+  return {{{c.x(), c.y(), b.min.z()}, z, x, y, {e.x(), e.y()}},
+          {{b.min.x(), c.y(), zc}, x, y, z, {e.y(), e.z()}},
+          {{b.max.x(), c.y(), zc}, -x, y, z, {e.y(), e.z()}},
+          {{c.x(), b.min.y(), zc}, y, x, z, {e.x(), e.z()}},
+          {{c.x(), b.max.y(), zc}, -y, x, z, {e.x(), e.z()}}};
+}
+
+void add_boundary(World& world, const Boundary& b) {
+  switch (b.type) {
+    case BoundaryType::Plane:
+      if (b.rough) {
+        const auto [t1, t2] = plane_axes(b.normal);
+        add_rough_rectangle(world, b.point, b.normal, t1, t2, b.size, b.hole_radius, b.particle_radius, b.spacing,
+                            b.material);
+      } else {
+        world.walls.planes.push_back({b.point, b.normal, b.material});
+      }
+      break;
+    case BoundaryType::Box:
+      for (const Face& f : box_faces(b)) {
+        if (b.rough) {
+          add_rough_rectangle(world, f.point, f.normal, f.t1, f.t2, f.size, 0.0, b.particle_radius, b.spacing,
+                              b.material);
+        } else {
+          world.walls.planes.push_back({f.point, f.normal, b.material});
+        }
+      }
+      break;
+    case BoundaryType::Cylinder:
+      if (b.rough) {
+        add_rough_cylinder(world, b);
+      } else {
+        world.walls.cylinders.push_back({b.axis, b.radius, b.z_min, b.z_max, b.material});
+      }
+      break;
+  }
+}
+
+void add_prop(World& world, const Prop& p) {
+  const ParticleBody body = load_particle_body(p.body_file);
+  std::vector<Eigen::Vector3d> offsets;
+  offsets.reserve(body.particles.size());
+  for (const Eigen::Vector3d& x : body.particles) offsets.push_back(x - body.center_of_mass);
+  BodyDesc desc;
+  desc.position = p.position + p.orientation * body.center_of_mass;
+  desc.orientation = p.orientation;
+  desc.linear_velocity = p.velocity;
+  desc.angular_velocity = p.angular_velocity;
+  desc.motion = p.motion;
+  desc.inverse_mass = 1.0 / body.mass;
+  desc.inverse_inertia = body.inertia.inverse();
+  add_body(world, desc, offsets, std::vector<double>(offsets.size(), body.particle_radius), p.material);
+}
+
+void add_grains(World& world, const GrainShape& grain, std::uint16_t material, const std::vector<Eigen::Vector3d>& sites,
+                const Emitter& e, std::mt19937_64& rng) {
+  for (std::size_t i = 0; i < e.count; ++i) {
+    add_grain(world, grain, material, sites[i], random_orientation(rng), e.velocity);
+  }
+}
+
+std::vector<Eigen::Vector3d> column_sites(const Emitter& e, double bound, std::mt19937_64& rng) {
+  // Grow the column a layer at a time until it holds `count` grains.
+  const double spacing = 2 * bound * kSiteMargin;
+  const Eigen::Vector3d half(e.radius, e.radius, 0);
+  for (double height = spacing;; height += spacing) {
+    std::vector<Eigen::Vector3d> sites = grain_sites_in_box(e.centre - half, e.centre + half + Eigen::Vector3d(0, 0, height),
+                                                            bound, rng);
+    std::erase_if(sites, [&](const Eigen::Vector3d& s) { return (s - e.centre).head<2>().norm() > e.radius - bound; });
+    if (sites.size() >= e.count) return sites;
+    if (height > 1e6 * spacing) return sites;  // the radius holds no grain at all
+  }
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> grain_sites_in_box(const Eigen::Vector3d& min, const Eigen::Vector3d& max, double bound,
+                                                std::mt19937_64& rng) {
+  const double spacing = 2 * bound * kSiteMargin;  // m
+  const Eigen::Vector3d lo = min.array() + bound * kSiteMargin, hi = max.array() - bound * kSiteMargin;
+  if (!(hi.array() >= lo.array()).all()) return {};
+  const Eigen::Vector3i n = ((hi - lo) / spacing).array().floor().cast<int>() + 1;
+  std::uniform_real_distribution<double> jitter(-kJitter * spacing, kJitter * spacing);
+  std::vector<Eigen::Vector3d> sites;
+  sites.reserve(static_cast<std::size_t>(n.x()) * n.y() * n.z());
+  for (int k = 0; k < n.z(); ++k) {
+    for (int j = 0; j < n.y(); ++j) {
+      for (int i = 0; i < n.x(); ++i) {
+        const Eigen::Vector3d jittered(jitter(rng), jitter(rng), jitter(rng));
+        sites.push_back(lo + spacing * Eigen::Vector3d(i, j, k) + jittered);
+      }
+    }
+  }
+  return sites;
+}
+
+World make_world(const Scene& scene) {
+  World world;
+  world.materials = scene.materials;
+  world.gravity = scene.gravity;
+  for (const Boundary& b : scene.boundaries) add_boundary(world, b);
+  for (const Prop& p : scene.props) add_prop(world, p);
+  const GrainShape grain = make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
+                                                  scene.materials[scene.grain.material].density);
+  for (const Emitter& e : scene.emitters) {
+    if (e.type == EmitterType::Pour) continue;
+    std::mt19937_64 rng(e.seed);
+    const std::vector<Eigen::Vector3d> sites = e.type == EmitterType::Fill
+                                                   ? grain_sites_in_box(e.min, e.max, grain.bounding_radius, rng)
+                                                   : column_sites(e, grain.bounding_radius, rng);
+    if (sites.size() < e.count) {
+      throw InputError(fmt::format("{}: the region holds only {} grains without overlap (spacing {:.3g} m = 2.2 "
+                                   "bounding radii), count = {}",
+                                   where(scene, e.line, "emitter.count"), sites.size(),
+                                   2 * grain.bounding_radius * kSiteMargin, e.count));
+    }
+    add_grains(world, grain, scene.grain.material, sites, e, rng);
+  }
+  return world;
+}
+
+PourEmitter::PourEmitter(const Scene& scene, const Emitter& emitter)
+    : grain_(make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
+                                    scene.materials[scene.grain.material].density)),
+      emitter_(emitter),
+      material_(scene.grain.material),
+      rng_(emitter.seed) {
+  sites_ = grain_sites_in_box(emitter.min, emitter.max, grain_.bounding_radius, rng_);
+  if (sites_.empty()) {
+    throw InputError(fmt::format("{}: the region is smaller than one grain (bounding diameter {:.3g} m)",
+                                 where(scene, emitter.line, "emitter.max"), 2 * grain_.bounding_radius));
+  }
+}
+
+std::size_t PourEmitter::emit(World& world) {
+  if (finished() || world.time < emitter_.start) return 0;
+  const double released = std::floor((world.time - emitter_.start) * emitter_.rate) + 1;
+  const std::size_t due = std::min(emitter_.count, static_cast<std::size_t>(released));
+  std::size_t added = 0;
+  for (std::size_t tries = 0; emitted_ < due && tries < sites_.size(); ++tries) {
+    const Eigen::Vector3d& site = sites_[next_site_];
+    next_site_ = (next_site_ + 1) % sites_.size();
+    bool free = true;
+    for (std::size_t b = 0; b < world.bodies.size() && free; ++b) {
+      if (world.bodies.motion[b] != MotionType::Dynamic) continue;
+      const double clearance = (grain_.bounding_radius + world.bodies.bounding_radius[b]) * 1.02;  // m
+      free = (world.bodies.position[b] - site).norm() >= clearance;
+    }
+    if (!free) continue;
+    add_grain(world, grain_, material_, site, random_orientation(rng_), emitter_.velocity);
+    ++emitted_;
+    ++added;
+  }
+  return added;
+}
+
+TimeStepBound scene_time_step_bound(const Scene& scene, const World& world) {
+  const GrainShape g = make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
+                                              scene.materials[scene.grain.material].density);
+  const Material& sand = scene.materials[scene.grain.material];
+  const double inverse_tangential = grain_tangential_inverse_mass(g);  // 1/kg
+  auto pair = [&](std::uint16_t other) {
+    return make_pair_coefficients(sand, scene.materials[other], scene.simulation.step.normal_damping);
+  };
+  std::vector<ContactCase> cases;
+  std::vector<ParticleKind> kinds{{g.particle_radius, sand}};
+  const PairCoefficients grains = pair(scene.grain.material);
+  const double r = g.particle_radius;
+  cases.push_back({g.mass / 2, r / 2, grains.effective_modulus, 1 / (2 * inverse_tangential),
+                   grains.tangential_damping});
+  for (const Boundary& b : scene.boundaries) {
+    const PairCoefficients c = pair(b.material);
+    const double radius = b.rough ? r * b.particle_radius / (r + b.particle_radius) : r;
+    cases.push_back({g.mass, radius, c.effective_modulus, 1 / inverse_tangential, c.tangential_damping});
+    if (b.rough) kinds.push_back({b.particle_radius, scene.materials[b.material]});
+  }
+  for (std::size_t k = 0; k < world.bodies.size(); ++k) {
+    const std::uint32_t first = world.bodies.first_particle[k];
+    if (world.bodies.particle_count[k] == 4 && world.particles.radius[first] == r) continue;  // a grain
+    const PairCoefficients c = pair(world.particles.material[first]);
+    const double rp = world.particles.radius[first];
+    const double inverse_mass = world.bodies.inverse_mass[k];
+    cases.push_back({1 / (1 / g.mass + inverse_mass), r * rp / (r + rp), c.effective_modulus,
+                     1 / inverse_tangential, c.tangential_damping});
+  }
+  double speed = scene.simulation.max_impact_speed;
+  if (speed <= 0) {
+    // Free fall over the scene's height, plus the fastest launched grain or moving prop.
+    double z_min = 0, z_max = 0, launched = 0;
+    bool first = true;
+    for (const Eigen::Vector3d& x : particle_positions(world)) {
+      z_min = first ? x.z() : std::min(z_min, x.z());
+      z_max = first ? x.z() : std::max(z_max, x.z());
+      first = false;
+    }
+    for (const Emitter& e : scene.emitters) {
+      z_max = std::max(z_max, e.type == EmitterType::Column ? e.centre.z() : e.max.z());
+      launched = std::max(launched, e.velocity.norm());
+    }
+    for (const Prop& p : scene.props) launched = std::max(launched, p.velocity.norm());
+    speed = std::max(0.5, std::sqrt(2 * scene.gravity.norm() * (z_max - z_min)) + launched);
+  }
+  return time_step_bound(cases, kinds, speed);
+}
+
+}  // namespace ts::sim

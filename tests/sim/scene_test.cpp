@@ -1,0 +1,228 @@
+#include "sim/scene.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+
+#include "core/error.h"
+#include "tests/test_support.h"
+
+namespace ts::sim {
+namespace {
+
+const char* kMinimal = R"(# line 1
+[[material]]
+name = "sand"
+E = 1.0e7
+nu = 0.3
+restitution = 0.65
+mu = 0.5
+density = 2600.0
+
+[grain]
+radius = 1.0e-3
+material = "sand"
+)";
+
+// The InputError message of parsing `text`, or "" when it parses.
+std::string parse_error(const std::string& text) {
+  try {
+    parse_scene(text, "scene.toml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Scene, MinimalSceneParsesWithDefaults) {
+  const Scene s = parse_scene(kMinimal, "scene.toml");
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.materials[0].youngs_modulus, 1e7);
+  EXPECT_DOUBLE_EQ(s.grain.edge, 2e-3);
+  EXPECT_EQ(s.simulation.dt, 0.0);  // auto
+  EXPECT_EQ(s.gravity, Eigen::Vector3d(0, 0, -9.81));
+}
+
+TEST(Scene, ErrorsNameFileLineAndKey) {
+  std::string text = kMinimal;
+  text.replace(text.find("E = 1.0e7"), 9, "E = -5.0");
+  EXPECT_EQ(parse_error(text), "scene.toml:4: material.E: must be > 0 (Pa)");
+}
+
+TEST(Scene, UnknownKeyIsRejectedWithASuggestion) {
+  std::string text = kMinimal;
+  text.replace(text.find("mu = 0.5"), 8, "mu = 0.5\nfricton = 0.4");
+  const std::string error = parse_error(text);
+  EXPECT_NE(error.find("scene.toml:8: material.fricton: unknown key"), std::string::npos) << error;
+  // Top-level typos too.
+  const std::string top = parse_error(std::string(kMinimal) + "\n[simulaton]\nduration = 1.0\n");
+  EXPECT_NE(top.find("simulaton: unknown key (did you mean \"simulation\"?)"), std::string::npos) << top;
+}
+
+TEST(Scene, SyntaxErrorNamesTheLine) {
+  const std::string error = parse_error(std::string(kMinimal) + "[simulation\n");
+  EXPECT_EQ(error.rfind("scene.toml:13:", 0), 0u) << error;
+}
+
+TEST(Scene, BadValuesAreRejected) {
+  const std::string base = kMinimal;
+  EXPECT_NE(parse_error(base + "[simulation]\ndt = \"fast\"\n").find("simulation.dt: must be a time step"),
+            std::string::npos);
+  EXPECT_NE(parse_error(base + "[simulation]\nnormal_damping = \"hertz\"\n").find("not one of: tsuji, thesis"),
+            std::string::npos);
+  EXPECT_NE(parse_error(base + "[[boundary]]\ntype = \"plane\"\nmaterial = \"rock\"\n").find("no [[material]] named"),
+            std::string::npos);
+  EXPECT_NE(parse_error(base + "[[emitter]]\ntype = \"fill\"\nmin = [0, 0, 0]\nmax = [1, 1]\ncount = 3\n")
+                .find("scene.toml:16: emitter.max: must be an array of 3 numbers"),
+            std::string::npos);
+  std::string no_grain = base.substr(0, base.find("[grain]"));
+  EXPECT_NE(parse_error(no_grain).find("missing [grain]"), std::string::npos);
+}
+
+TEST(Scene, FillEmitterPlacesGrainsWithoutOverlap) {
+  const Scene s = parse_scene(std::string(kMinimal) +
+                                  "[[emitter]]\ntype = \"fill\"\nmin = [0, 0, 0]\nmax = [0.03, 0.03, 0.03]\ncount = 100\n",
+                              "scene.toml");
+  const World w = make_world(s);
+  ASSERT_EQ(w.bodies.size(), 100u);
+  for (std::size_t a = 0; a < w.bodies.size(); ++a) {
+    for (std::size_t b = a + 1; b < w.bodies.size(); ++b) {
+      ASSERT_GT((w.bodies.position[a] - w.bodies.position[b]).norm(),
+                w.bodies.bounding_radius[a] + w.bodies.bounding_radius[b]);
+    }
+    EXPECT_TRUE((w.bodies.position[a].array() >= w.bodies.bounding_radius[a]).all());
+  }
+}
+
+TEST(Scene, FillRegionTooSmallNamesTheEmitter) {
+  const Scene s = parse_scene(std::string(kMinimal) +
+                                  "[[emitter]]\ntype = \"fill\"\nmin = [0, 0, 0]\nmax = [0.01, 0.01, 0.01]\ncount = 100\n",
+                              "scene.toml");
+  try {
+    make_world(s);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.toml:13: emitter.count: the region holds only 8 grains"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Scene, RoughFloorWithHoleIsAStaticLattice) {
+  const Scene s = parse_scene(std::string(kMinimal) + R"(
+[[boundary]]
+type = "plane"
+rough = true
+size = [0.02, 0.02]
+hole_radius = 0.004
+particle_radius = 1.0e-3
+material = "sand"
+)",
+                              "scene.toml");
+  const World w = make_world(s);
+  ASSERT_EQ(w.bodies.size(), 1u);
+  EXPECT_EQ(w.bodies.motion[0], MotionType::Static);
+  EXPECT_EQ(w.bodies.inverse_mass[0], 0.0);
+  const auto positions = particle_positions(w);
+  // 11 x 11 lattice, minus the particles reaching into the 4 mm hole.
+  EXPECT_LT(positions.size(), 121u);
+  EXPECT_GT(positions.size(), 90u);
+  for (const auto& p : positions) {
+    EXPECT_NEAR(p.z(), -1e-3, 1e-15);  // tops of the spheres at the plane
+    EXPECT_GE(p.head<2>().norm() + 1e-12, 0.004 + 1e-3);
+  }
+}
+
+TEST(Scene, SmoothBoxIsFiveInwardPlanes) {
+  const Scene s = parse_scene(
+      std::string(kMinimal) + "[[boundary]]\ntype = \"box\"\nmin = [0, 0, 0]\nmax = [1, 2, 3]\nmaterial = \"sand\"\n",
+      "scene.toml");
+  const World w = make_world(s);
+  ASSERT_EQ(w.walls.planes.size(), 5u);
+  const Eigen::Vector3d inside(0.5, 1, 1);
+  for (const PlaneWall& p : w.walls.planes) EXPECT_GT(p.normal.dot(inside - p.point), 0.4);
+}
+
+TEST(Scene, BundledScenesLoadAndBuild) {
+  for (const char* name : {"free_fall", "two_grain_collision", "pile", "hourglass"}) {
+    const Scene s = load_scene(test::asset(std::string("scenes/") + name + ".toml"));
+    const World w = make_world(s);
+    const TimeStepBound bound = scene_time_step_bound(s, w);
+    EXPECT_GT(bound.recommended, 0) << name;
+    if (s.simulation.dt > 0) {
+      EXPECT_EQ(check_time_step(s.simulation.dt, bound), "") << name;
+    }
+  }
+}
+
+TEST(Scene, PourEmitterReleasesGrainsAtItsRate) {
+  Scene s = load_scene(test::asset("scenes/pile.toml"));
+  World w = make_world(s);
+  const std::size_t floor_bodies = w.bodies.size();
+  PourEmitter pour(s, s.emitters.at(0));
+  w.time = 0.0;
+  EXPECT_EQ(pour.emit(w), 1u);
+  w.time = 2.0e-3;  // 4000 grains/s: 9 grains due by now
+  EXPECT_EQ(pour.emit(w), 8u);
+  EXPECT_EQ(w.bodies.size(), floor_bodies + 9);
+  EXPECT_FALSE(pour.finished());
+}
+
+TEST(Scene, TimeStepAboveTheBoundWarns) {
+  Scene s = parse_scene(std::string(kMinimal) + "[simulation]\ndt = 1.0e-3\n", "scene.toml");
+  const World w = make_world(s);
+  const TimeStepBound bound = scene_time_step_bound(s, w);
+  const std::string warning = check_time_step(s.simulation.dt, bound);
+  EXPECT_NE(warning.find("exceeds the stable bound"), std::string::npos) << warning;
+  EXPECT_NE(warning.find(fmt::format("{:.3g}", bound.recommended)), std::string::npos) << warning;
+}
+
+// A cube of 8 particles written the way the sampler writes bodies.
+std::filesystem::path write_cube_body(const std::filesystem::path& dir) {
+  std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+                    "property float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n";
+  for (int i = 0; i < 8; ++i) {
+    const float v[6] = {float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1), 0, 0, 1};
+    ply.append(reinterpret_cast<const char*>(v), sizeof v);
+  }
+  std::ofstream(dir / "cube.particles.ply", std::ios::binary) << ply;
+  std::ofstream(dir / "cube.body.json") << R"({"particle_radius": 0.1, "particle_count": 8,
+    "particles": "cube.particles.ply", "mass": 2.0, "center_of_mass": [0.5, 0.5, 0.5],
+    "inertia": [[0.5, 0, 0], [0, 0.5, 0], [0, 0, 0.5]]})";
+  return dir / "cube.body.json";
+}
+
+TEST(Scene, PropsComeFromBodyFilesWithTheirPose) {
+  const auto dir = test::temp_dir();
+  write_cube_body(dir);
+  const std::string text = std::string(kMinimal) + R"(
+[[prop]]
+body = "cube.body.json"
+position = [1.0, 0.0, 0.0]
+orientation = [0.7071067811865476, 0.0, 0.0, 0.7071067811865476]
+motion = "dynamic"
+material = "sand"
+)";
+  const Scene s = parse_scene(text, dir / "scene.toml");
+  const World w = make_world(s);
+  ASSERT_EQ(w.bodies.size(), 1u);
+  EXPECT_DOUBLE_EQ(w.bodies.inverse_mass[0], 0.5);
+  EXPECT_TRUE(w.bodies.inverse_inertia[0].isApprox(2.0 * Eigen::Matrix3d::Identity()));
+  // The mesh's (1, 0, 0) corner, turned 90 degrees about z and moved by (1, 0, 0), lands at (1, 1, 0).
+  const auto positions = particle_positions(w);
+  EXPECT_LT((positions[1] - Eigen::Vector3d(1, 1, 0)).norm(), 1e-12);
+  EXPECT_LT((w.bodies.position[0] - Eigen::Vector3d(0.5, 0.5, 0.5)).norm(), 1e-12);
+  // A body file with a missing key names it.
+  std::ofstream(dir / "cube.body.json") << R"({"particle_radius": 0.1, "particles": "cube.particles.ply"})";
+  try {
+    make_world(s);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cube.body.json: mass: missing"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace ts::sim
