@@ -85,6 +85,14 @@ struct ParticleContacts {
   }
 };
 
+// Each contact is counted once: walls and non-dynamic partners by the dynamic particle (the only
+// side that computes them), pairs of dynamic particles by the lower id.
+bool counted_here(const World& world, std::uint32_t i, std::int64_t partner) {
+  if (partner < 0) return true;
+  const auto j = static_cast<std::uint32_t>(partner);
+  return world.bodies.inverse_mass[world.particles.body[j]] == 0 || i < j;
+}
+
 double max_radius(const World& world) {
   double r = 0;
   for (double x : world.particles.radius) r = std::max(r, x);
@@ -93,7 +101,65 @@ double max_radius(const World& world) {
 
 }  // namespace
 
-void CpuStepper::compute_forces(const World& world, StepStats& stats) {
+template <typename Fn>
+void CpuStepper::visit_contacts(const World& world, std::uint32_t i, Fn&& fn) const {
+  const Bodies& b = world.bodies;
+  const Particles& p = world.particles;
+  const double overlap_ratio_cap = settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30;
+  const std::uint32_t bi = p.body[i];
+  const double ri = p.radius[i];
+  const Eigen::Vector3d& wi = b.angular_velocity[bi];
+  // Other bodies' particles in the 27 cells around, each bucket in increasing id.
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Eigen::Vector3i c = grid_.cell[i] + Eigen::Vector3i(dx, dy, dz);
+        const std::uint32_t h = hash_cell(c, grid_.table_size);
+        for (std::uint32_t s = grid_.bucket_start[h]; s < grid_.bucket_start[h + 1]; ++s) {
+          const std::uint32_t j = grid_.sorted[s];
+          const std::uint32_t bj = p.body[j];
+          // Another cell hashed to this bucket, or a partner that cannot receive a force.
+          if (grid_.cell[j] != c || bj == bi) continue;
+          if (b.inverse_mass[bi] == 0 && b.inverse_mass[bj] == 0) continue;
+          const double rj = p.radius[j];
+          const auto& coefficients = pairs_[p.material[i] * material_count_ + p.material[j]];
+          const double smaller = std::min(ri, rj);
+          const ContactForce<double> f = sphere_sphere_contact(
+              position_[i], velocity_[i], wi, ri, b.inverse_mass[bi], position_[j], velocity_[j],
+              b.angular_velocity[bj], rj, b.inverse_mass[bj], overlap_ratio_cap * smaller, coefficients);
+          if (f.touching) fn(f, static_cast<std::int64_t>(j), smaller);
+        }
+      }
+    }
+  }
+  // Smooth walls, in declaration order: planes, then cylinders (partner -1 - wall index).
+  const double inverse_mass = b.inverse_mass[bi];
+  const double max_overlap = overlap_ratio_cap * ri;
+  std::int64_t wall_index = 0;
+  for (const PlaneWall& wall : world.walls.planes) {
+    const auto& coefficients = pairs_[p.material[i] * material_count_ + wall.material];
+    const double gap = wall.normal.dot(position_[i] - wall.point);
+    const ContactForce<double> f =
+        sphere_wall_contact(wall.normal, gap, velocity_[i], wi, ri, inverse_mass, max_overlap, coefficients);
+    if (f.touching) fn(f, -1 - wall_index, ri);
+    ++wall_index;
+  }
+  for (const CylinderWall& wall : world.walls.cylinders) {
+    const Eigen::Vector3d& x = position_[i];
+    const Eigen::Vector2d radial = x.head<2>() - wall.axis;
+    const double distance = radial.norm();
+    if (x.z() >= wall.z_min && x.z() <= wall.z_max && distance > 0) {
+      const Eigen::Vector3d normal(-radial.x() / distance, -radial.y() / distance, 0.0);
+      const auto& coefficients = pairs_[p.material[i] * material_count_ + wall.material];
+      const ContactForce<double> f = sphere_wall_contact(normal, wall.radius - distance, velocity_[i], wi, ri,
+                                                         inverse_mass, max_overlap, coefficients);
+      if (f.touching) fn(f, -1 - wall_index, ri);
+    }
+    ++wall_index;
+  }
+}
+
+void CpuStepper::prepare_particles(const World& world) {
   const Bodies& b = world.bodies;
   const Particles& p = world.particles;
   const auto n = static_cast<std::uint32_t>(p.size());
@@ -101,7 +167,6 @@ void CpuStepper::compute_forces(const World& world, StepStats& stats) {
   velocity_.resize(n);
   force_.resize(n);
   torque_.resize(n);
-
   // Particle world positions and velocities from the body poses (eqs. 3.42, 3.43).
   tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
     const std::uint32_t k = p.body[i];
@@ -111,61 +176,38 @@ void CpuStepper::compute_forces(const World& world, StepStats& stats) {
   });
   const double cell = n > 0 ? 2 * max_radius(world) : 1.0;  // m
   build_neighbour_grid(position_, cell, grid_);
+}
 
-  const double overlap_ratio_cap = settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30;
+std::vector<ContactRecord> CpuStepper::contacts(const World& world) {
+  if (world.materials.size() != material_count_) reset_energy_reference(world);
+  prepare_particles(world);
+  std::vector<ContactRecord> records;
+  for (std::uint32_t i = 0; i < world.particles.size(); ++i) {
+    if (world.bodies.inverse_mass[world.particles.body[i]] == 0) continue;
+    visit_contacts(world, i, [&](const ContactForce<double>& f, std::int64_t partner, double) {
+      if (!counted_here(world, i, partner)) return;
+      records.push_back({i, partner, position_[i] + f.arm, f.force, f.overlap});
+    });
+  }
+  return records;
+}
+
+void CpuStepper::compute_forces(const World& world, StepStats& stats) {
+  prepare_particles(world);
+  const auto n = static_cast<std::uint32_t>(world.particles.size());
+
   std::vector<ParticleContacts> contacts(n);
   tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
     ParticleContacts& out = contacts[i];
-    const std::uint32_t bi = p.body[i];
-    const double ri = p.radius[i];
-    const Eigen::Vector3d& wi = b.angular_velocity[bi];
-    for (int dz = -1; dz <= 1; ++dz) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const Eigen::Vector3i c = grid_.cell[i] + Eigen::Vector3i(dx, dy, dz);
-          const std::uint32_t h = hash_cell(c, grid_.table_size);
-          for (std::uint32_t s = grid_.bucket_start[h]; s < grid_.bucket_start[h + 1]; ++s) {
-            const std::uint32_t j = grid_.sorted[s];
-            const std::uint32_t bj = p.body[j];
-            // Another cell hashed to this bucket, or a partner that cannot receive a force.
-            if (grid_.cell[j] != c || bj == bi) continue;
-            if (b.inverse_mass[bi] == 0 && b.inverse_mass[bj] == 0) continue;
-            const double rj = p.radius[j];
-            const auto& coefficients = pairs_[p.material[i] * material_count_ + p.material[j]];
-            const double smaller = std::min(ri, rj);
-            const ContactForce<double> f = sphere_sphere_contact(
-                position_[i], velocity_[i], wi, ri, b.inverse_mass[bi], position_[j], velocity_[j],
-                b.angular_velocity[bj], rj, b.inverse_mass[bj], overlap_ratio_cap * smaller, coefficients);
-            out.add(f, smaller, i < j);  // each pair is counted by its lower id
-            out.pairs += (f.touching && i < j) ? 1 : 0;
-          }
-        }
-      }
-    }
-    // Smooth walls, in declaration order: planes, then cylinders.
-    const double inverse_mass = b.inverse_mass[bi];
-    const double max_overlap = overlap_ratio_cap * ri;
-    for (const PlaneWall& wall : world.walls.planes) {
-      const auto& coefficients = pairs_[p.material[i] * material_count_ + wall.material];
-      const double gap = wall.normal.dot(position_[i] - wall.point);
-      const ContactForce<double> f =
-          sphere_wall_contact(wall.normal, gap, velocity_[i], wi, ri, inverse_mass, max_overlap, coefficients);
-      out.add(f, ri, true);
-      out.walls += f.touching ? 1 : 0;
-    }
-    for (const CylinderWall& wall : world.walls.cylinders) {
-      const Eigen::Vector3d& x = position_[i];
-      if (x.z() < wall.z_min || x.z() > wall.z_max) continue;
-      const Eigen::Vector2d radial = x.head<2>() - wall.axis;
-      const double distance = radial.norm();
-      if (distance <= 0) continue;
-      const Eigen::Vector3d normal(-radial.x() / distance, -radial.y() / distance, 0.0);
-      const auto& coefficients = pairs_[p.material[i] * material_count_ + wall.material];
-      const ContactForce<double> f = sphere_wall_contact(normal, wall.radius - distance, velocity_[i], wi, ri,
-                                                         inverse_mass, max_overlap, coefficients);
-      out.add(f, ri, true);
-      out.walls += f.touching ? 1 : 0;
-    }
+    // Static and kinematic particles need no force: their partners compute their own side.
+    if (world.bodies.inverse_mass[world.particles.body[i]] == 0) return;
+    visit_contacts(world, i, [&](const ContactForce<double>& f, std::int64_t partner, double smaller_radius) {
+      const bool wall = partner < 0;
+      const bool counted = counted_here(world, i, partner);
+      out.add(f, smaller_radius, counted);
+      out.pairs += (!wall && counted) ? 1 : 0;
+      out.walls += wall ? 1 : 0;
+    });
   });
 
   // Statistics in particle order.

@@ -64,6 +64,15 @@ void build_neighbour_grid(const std::vector<Eigen::Vector3d>& positions, double 
 // Teschner et al. 2003, identical to shaders/common/hash_grid.glsl.
 std::uint32_t hash_cell(const Eigen::Vector3i& cell, std::uint32_t table_size);
 
+// One contact of the current state, for dumps and tests.
+struct ContactRecord {
+  std::uint32_t particle = 0;
+  std::int64_t partner = 0;      // the other particle, or -1 - wall index (planes first, then cylinders)
+  Eigen::Vector3d point;         // m, middle of the overlap
+  Eigen::Vector3d force;         // N, on `particle`
+  double overlap = 0;            // m
+};
+
 class CpuStepper {
  public:
   // Precomputes the material-pair table; the energy reference is taken from `world`.
@@ -77,10 +86,17 @@ class CpuStepper {
   // restarts from the current state. Also rebuilds the pair table if materials were added.
   void reset_energy_reference(const World& world);
 
+  // Every contact of `world` as it stands (each particle pair once); off the stepping path.
+  std::vector<ContactRecord> contacts(const World& world);
+
   const StepSettings& settings() const { return settings_; }
   const NeighbourGrid& grid() const { return grid_; }
 
  private:
+  void prepare_particles(const World& world);
+  // Calls fn(force, partner, smaller radius) for each touching partner of particle i, in a fixed order.
+  template <typename Fn>
+  void visit_contacts(const World& world, std::uint32_t i, Fn&& fn) const;
   void compute_forces(const World& world, StepStats& stats);
   void integrate(World& world, StepStats& stats) const;
   void check_stability(const World& world, const StepStats& stats) const;

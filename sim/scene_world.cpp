@@ -279,6 +279,12 @@ TimeStepBound scene_time_step_bound(const Scene& scene, const World& world) {
       z_max = first ? x.z() : std::max(z_max, x.z());
       first = false;
     }
+    for (const Boundary& b : scene.boundaries) {
+      const double z = b.type == BoundaryType::Plane ? b.point.z() : b.type == BoundaryType::Box ? b.min.z() : b.z_min;
+      z_min = first ? z : std::min(z_min, z);
+      z_max = first ? z : std::max(z_max, z);
+      first = false;
+    }
     for (const Emitter& e : scene.emitters) {
       z_max = std::max(z_max, e.type == EmitterType::Column ? e.centre.z() : e.max.z());
       launched = std::max(launched, e.velocity.norm());
