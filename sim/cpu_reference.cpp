@@ -26,7 +26,11 @@ void build_neighbour_grid(const std::vector<Eigen::Vector3d>& positions, double 
   grid.cell.resize(n);
   std::vector<std::uint32_t> bucket(n);
   tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
-    grid.cell[i] = (positions[i] / cell_size).array().floor().cast<int>();
+    // A blown-up state still gets a cell (NaN or huge coordinates would overflow the int cast);
+    // the stability check rejects it after the step.
+    const Eigen::Array3d cell = (positions[i] / cell_size).array().floor();
+    grid.cell[i] = Eigen::Vector3i::Zero();
+    if (cell.allFinite()) grid.cell[i] = cell.max(-1e9).min(1e9).cast<int>().matrix();
     bucket[i] = hash_cell(grid.cell[i], grid.table_size);
   });
   // Counting sort: count, exclusive scan, scatter in particle order (buckets list ids ascending).
