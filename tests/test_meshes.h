@@ -1,14 +1,12 @@
 #pragma once
-// Small closed meshes built in code, for tests that must not depend on file loading.
+// Small closed meshes built in code (core/primitives.h), for tests that must not depend on files.
 #include <Eigen/Core>
 
-#include "core/mesh.h"
+#include "core/primitives.h"
 
 namespace ts::test {
 
-// Axis-aligned box, 12 outward triangles.
-TriangleMesh box_mesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
-// Icosahedron subdivided `subdivisions` times, vertices on the sphere of `radius` about the origin.
-TriangleMesh icosphere(double radius, int subdivisions);
+inline TriangleMesh box_mesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) { return make_box(lo, hi); }
+inline TriangleMesh icosphere(double radius, int subdivisions) { return make_icosphere(radius, subdivisions); }
 
 }  // namespace ts::test

@@ -1,0 +1,237 @@
+#include "core/mesh_report.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/box_intersection_d.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <unordered_map>
+
+#include "core/mass_properties.h"
+
+namespace ts {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+
+struct UnionFind {
+  std::vector<std::uint32_t> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+  std::uint32_t find(std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(std::uint32_t a, std::uint32_t b) { parent[find(a)] = find(b); }
+};
+
+std::uint64_t key(std::uint32_t a, std::uint32_t b) {
+  return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+}
+
+struct EdgeUse {
+  std::uint32_t count = 0, forward = 0;  // forward: traversals from the smaller to the larger index
+};
+
+// Triangle pairs that intersect, with CGAL's exact predicates. Manifold input goes through
+// Surface_mesh and PMP::self_intersections (which handles triangles sharing an edge or a vertex
+// exactly); other input is tested as a soup, skipping pairs that share a vertex.
+std::size_t count_self_intersections(const TriangleMesh& mesh, bool manifold, bool& exact) {
+  std::vector<Point> points;
+  points.reserve(mesh.vertex_count());
+  for (const auto& v : mesh.vertices) points.emplace_back(v.x(), v.y(), v.z());
+  std::vector<std::vector<std::size_t>> polygons;
+  polygons.reserve(mesh.triangle_count());
+  for (const auto& t : mesh.triangles) polygons.push_back({t[0], t[1], t[2]});
+  namespace PMP = CGAL::Polygon_mesh_processing;
+  if (manifold && PMP::is_polygon_soup_a_polygon_mesh(polygons)) {
+    CGAL::Surface_mesh<Point> surface;
+    PMP::polygon_soup_to_polygon_mesh(points, polygons, surface);
+    std::vector<std::pair<CGAL::Surface_mesh<Point>::Face_index, CGAL::Surface_mesh<Point>::Face_index>> pairs;
+    PMP::self_intersections<CGAL::Parallel_if_available_tag>(surface, std::back_inserter(pairs));
+    exact = true;
+    return pairs.size();
+  }
+  exact = false;
+  using Box = CGAL::Box_intersection_d::Box_with_handle_d<double, 3, std::size_t, CGAL::Box_intersection_d::ID_EXPLICIT>;
+  std::vector<Box> boxes;
+  for (std::size_t f = 0; f < polygons.size(); ++f) {
+    const auto& t = mesh.triangles[f];
+    const auto bbox = points[t[0]].bbox() + points[t[1]].bbox() + points[t[2]].bbox();
+    boxes.emplace_back(bbox, f);
+  }
+  std::size_t count = 0;
+  CGAL::box_self_intersection_d<CGAL::Sequential_tag>(boxes.begin(), boxes.end(), [&](const Box& a, const Box& b) {
+    const auto& ta = mesh.triangles[a.handle()];
+    const auto& tb = mesh.triangles[b.handle()];
+    for (auto u : ta)
+      for (auto v : tb)
+        if (u == v) return;
+    const Kernel::Triangle_3 x(points[ta[0]], points[ta[1]], points[ta[2]]), y(points[tb[0]], points[tb[1]], points[tb[2]]);
+    if (x.is_degenerate() || y.is_degenerate()) return;
+    if (CGAL::do_intersect(x, y)) ++count;
+  });
+  return count;
+}
+
+}  // namespace
+
+MeshReport analyze_mesh(const TriangleMesh& mesh, const ReportOptions& options) {
+  MeshReport r;
+  r.vertices = mesh.vertex_count();
+  r.triangles = mesh.triangle_count();
+  for (const auto& v : mesh.vertices) r.non_finite_vertices += v.allFinite() ? 0 : 1;
+  r.box = bounding_box(mesh);
+  r.area = surface_area(mesh);
+  r.signed_volume = signed_volume(mesh);
+  const double diagonal = r.box.valid() ? r.box.size().norm() : 0.0;
+
+  std::unordered_map<std::uint64_t, EdgeUse> edges;
+  edges.reserve(3 * mesh.triangle_count());
+  std::map<std::array<std::uint32_t, 3>, std::uint32_t> seen_faces;
+  UnionFind components(mesh.vertex_count());
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d& a = mesh.vertices[t[0]];
+    const double doubled_area = (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a).norm();
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || !(doubled_area > 1e-14 * diagonal * diagonal)) {
+      ++r.degenerate_triangles;
+    }
+    auto sorted = t;
+    std::sort(sorted.begin(), sorted.end());
+    if (++seen_faces[sorted] > 1) ++r.duplicate_triangles;
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t u = t[static_cast<std::size_t>(e)], v = t[static_cast<std::size_t>((e + 1) % 3)];
+      if (u == v) continue;
+      EdgeUse& use = edges[key(u, v)];
+      ++use.count;
+      use.forward += u < v ? 1 : 0;
+      components.unite(u, v);
+    }
+  }
+  UnionFind loops(mesh.vertex_count());
+  std::vector<char> on_boundary(mesh.vertex_count(), 0);
+  for (const auto& [k, use] : edges) {
+    if (use.count == 1) {
+      ++r.boundary_edges;
+      const auto u = static_cast<std::uint32_t>(k >> 32), v = static_cast<std::uint32_t>(k & 0xffffffffu);
+      loops.unite(u, v);
+      on_boundary[u] = on_boundary[v] = 1;
+    } else if (use.count > 2) {
+      ++r.non_manifold_edges;
+    } else if (use.forward != 1) {
+      ++r.inconsistent_edges;
+    }
+  }
+  std::vector<char> used(mesh.vertex_count(), 0);
+  for (const auto& t : mesh.triangles)
+    for (auto v : t) used[v] = 1;
+  for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    if (used[v] && components.find(v) == v) ++r.components;
+    if (on_boundary[v] && loops.find(v) == v) ++r.boundary_loops;
+  }
+
+  // A vertex is manifold when its triangles form one fan: link them through shared edges at v.
+  std::vector<std::vector<std::uint32_t>> around(mesh.vertex_count());
+  for (std::uint32_t f = 0; f < mesh.triangle_count(); ++f)
+    for (auto v : mesh.triangles[f]) around[v].push_back(f);
+  for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    const auto& faces = around[v];
+    if (faces.size() < 2) continue;
+    UnionFind fan(faces.size());
+    std::unordered_map<std::uint32_t, std::size_t> first_with_neighbour;
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      for (auto w : mesh.triangles[faces[i]]) {
+        if (w == v) continue;
+        auto [it, inserted] = first_with_neighbour.try_emplace(w, i);
+        if (!inserted) fan.unite(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(it->second));
+      }
+    }
+    std::size_t fans = 0;
+    for (std::size_t i = 0; i < faces.size(); ++i) fans += fan.find(static_cast<std::uint32_t>(i)) == i ? 1 : 0;
+    if (fans > 1) ++r.non_manifold_vertices;
+  }
+
+  if (r.closed() && r.manifold() && r.components == 1) {
+    const long long chi = static_cast<long long>(r.vertices) - static_cast<long long>(edges.size()) +
+                          static_cast<long long>(r.triangles);
+    r.genus = static_cast<int>((2 - chi) / 2);
+  }
+  if (options.self_intersections && r.non_finite_vertices == 0 && !mesh.empty()) {
+    r.self_intersecting_pairs = count_self_intersections(mesh, r.manifold() && r.boundary_edges == 0 &&
+                                                                   r.degenerate_triangles == 0,
+                                                         r.self_intersections_exact);
+  }
+  return r;
+}
+
+std::string closed_solid_problems(const MeshReport& r) {
+  std::vector<std::string> problems;
+  if (r.non_finite_vertices) problems.push_back(fmt::format("{} non-finite vertices", r.non_finite_vertices));
+  if (r.boundary_edges) problems.push_back(fmt::format("{} boundary edges in {} holes", r.boundary_edges, r.boundary_loops));
+  if (r.non_manifold_edges) problems.push_back(fmt::format("{} non-manifold edges", r.non_manifold_edges));
+  if (r.non_manifold_vertices) problems.push_back(fmt::format("{} non-manifold vertices", r.non_manifold_vertices));
+  if (r.inconsistent_edges) problems.push_back(fmt::format("{} inconsistently oriented edges", r.inconsistent_edges));
+  if (r.self_intersecting_pairs) problems.push_back(fmt::format("{} self-intersecting triangle pairs", r.self_intersecting_pairs));
+  if (r.closed() && r.signed_volume <= 0) problems.push_back("inside out (negative volume)");
+  std::string out;
+  for (const auto& p : problems) out += (out.empty() ? "" : ", ") + p;
+  return out;
+}
+
+std::string format_report(const MeshReport& r) {
+  auto flag = [](std::size_t n) { return n ? "  <-- problem" : ""; };
+  std::string s;
+  s += fmt::format("vertices              {}\n", r.vertices);
+  s += fmt::format("triangles             {}\n", r.triangles);
+  s += fmt::format("components            {}\n", r.components);
+  s += fmt::format("bounding box          [{:.6g}, {:.6g}, {:.6g}] .. [{:.6g}, {:.6g}, {:.6g}] m\n", r.box.min.x(),
+                   r.box.min.y(), r.box.min.z(), r.box.max.x(), r.box.max.y(), r.box.max.z());
+  s += fmt::format("area                  {:.9g} m^2\n", r.area);
+  s += fmt::format("signed volume         {:.9g} m^3{}\n", r.signed_volume,
+                   r.closed() && r.signed_volume <= 0 ? "  <-- inside out" : "");
+  s += fmt::format("non-finite vertices   {}{}\n", r.non_finite_vertices, flag(r.non_finite_vertices));
+  s += fmt::format("degenerate triangles  {}{}\n", r.degenerate_triangles, flag(r.degenerate_triangles));
+  s += fmt::format("duplicate triangles   {}{}\n", r.duplicate_triangles, flag(r.duplicate_triangles));
+  s += fmt::format("boundary edges        {} in {} holes{}\n", r.boundary_edges, r.boundary_loops, flag(r.boundary_edges));
+  s += fmt::format("non-manifold edges    {}{}\n", r.non_manifold_edges, flag(r.non_manifold_edges));
+  s += fmt::format("non-manifold vertices {}{}\n", r.non_manifold_vertices, flag(r.non_manifold_vertices));
+  s += fmt::format("inconsistent edges    {}{}\n", r.inconsistent_edges, flag(r.inconsistent_edges));
+  s += fmt::format("self-intersections    {}{}{}\n", r.self_intersecting_pairs,
+                   r.self_intersections_exact ? "" : " (pairs sharing a vertex not tested)", flag(r.self_intersecting_pairs));
+  if (r.genus >= 0) s += fmt::format("genus                 {}\n", r.genus);
+  s += fmt::format("watertight            {}\n", r.watertight() ? "yes" : "no: " + closed_solid_problems(r));
+  return s;
+}
+
+nlohmann::json to_json(const MeshReport& r) {
+  return nlohmann::json{
+      {"vertices", r.vertices},
+      {"triangles", r.triangles},
+      {"components", r.components},
+      {"bounding_box", {{"min", {r.box.min.x(), r.box.min.y(), r.box.min.z()}}, {"max", {r.box.max.x(), r.box.max.y(), r.box.max.z()}}}},
+      {"area", r.area},
+      {"signed_volume", r.signed_volume},
+      {"non_finite_vertices", r.non_finite_vertices},
+      {"degenerate_triangles", r.degenerate_triangles},
+      {"duplicate_triangles", r.duplicate_triangles},
+      {"boundary_edges", r.boundary_edges},
+      {"boundary_loops", r.boundary_loops},
+      {"non_manifold_edges", r.non_manifold_edges},
+      {"non_manifold_vertices", r.non_manifold_vertices},
+      {"inconsistent_edges", r.inconsistent_edges},
+      {"self_intersecting_pairs", r.self_intersecting_pairs},
+      {"self_intersections_exact", r.self_intersections_exact},
+      {"genus", r.genus >= 0 ? nlohmann::json(r.genus) : nlohmann::json(nullptr)},
+      {"closed", r.closed()},
+      {"manifold", r.manifold()},
+      {"watertight", r.watertight()},
+  };
+}
+
+}  // namespace ts

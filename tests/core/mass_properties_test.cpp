@@ -1,0 +1,87 @@
+#include "core/mass_properties.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/primitives.h"
+
+namespace ts {
+namespace {
+
+TEST(MassProperties, CubeMatchesAnalytic) {
+  const double a = 0.2, density = 2500.0;
+  const MassProperties m = compute_mass_properties(make_box({0, 0, 0}, {a, a, a}), density);
+  EXPECT_NEAR(m.volume, a * a * a, 1e-15);
+  EXPECT_NEAR(m.mass, density * a * a * a, 1e-12);
+  EXPECT_LT((m.center_of_mass - Eigen::Vector3d::Constant(a / 2)).norm(), 1e-15);
+  const double expected = m.mass * a * a / 6.0;
+  EXPECT_LT((m.inertia - expected * Eigen::Matrix3d::Identity()).norm(), 1e-12 * expected);
+}
+
+TEST(MassProperties, SphereMatchesAnalyticUpToTessellation) {
+  // The polyhedron is inscribed: compare with the analytic sphere within the volume deficit of the
+  // tessellation (computed from the polyhedron itself), which shrinks with subdivision.
+  const double r = 0.1;
+  double previous_error = 1e300;
+  for (int s : {3, 4, 5}) {
+    const MassProperties m = compute_mass_properties(make_icosphere(r, s), 1000.0);
+    const double sphere_volume = 4.0 / 3.0 * M_PI * r * r * r;
+    const double deficit = 1.0 - m.volume / sphere_volume;
+    EXPECT_GT(deficit, 0.0);
+    const double expected = 0.4 * m.mass * r * r;
+    const double error = std::abs(m.principal_moments.x() / expected - 1.0);
+    // Mass at radius r is what goes missing: the inertia deficit is within ~(5/3) of the volume's.
+    EXPECT_LT(error, 2.0 * deficit) << s;
+    EXPECT_LT(error, previous_error);
+    previous_error = error;
+    EXPECT_LT(m.center_of_mass.norm(), 1e-15);
+  }
+}
+
+TEST(MassProperties, TetrahedronMatchesAnalytic) {
+  // Unit right tetrahedron: V = 1/6, centroid (1/4, 1/4, 1/4); about the origin, with rho = 1,
+  // Ixx = 1/30 and products of inertia Ixy = -1/120 (Tonon 2004).
+  TriangleMesh tet;
+  tet.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  tet.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  const MassProperties m = compute_mass_properties(tet, 1.0);
+  EXPECT_NEAR(m.volume, 1.0 / 6.0, 1e-15);
+  EXPECT_LT((m.center_of_mass - Eigen::Vector3d::Constant(0.25)).norm(), 1e-15);
+  const Eigen::Vector3d c = m.center_of_mass;
+  // Parallel-axis theorem back to the origin.
+  const Eigen::Matrix3d about_origin = m.inertia + m.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+  EXPECT_NEAR(about_origin(0, 0), 1.0 / 30.0, 1e-15);
+  EXPECT_NEAR(about_origin(0, 1), -1.0 / 120.0, 1e-15);
+}
+
+TEST(MassProperties, RotatedAndTranslatedCopiesTransformCovariantly) {
+  const TriangleMesh base = make_torus(0.3, 0.1, 48, 16);
+  const MassProperties m0 = compute_mass_properties(base, 7800.0);
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (const Eigen::Vector3d& t : {Eigen::Vector3d(1, -2, 3), Eigen::Vector3d(1e4, -2e4, 5e3)}) {
+    TriangleMesh moved = base;
+    for (auto& v : moved.vertices) v = r * v + t;
+    const MassProperties m = compute_mass_properties(moved, 7800.0);
+    EXPECT_NEAR(m.mass / m0.mass, 1.0, 1e-9);
+    EXPECT_LT((m.center_of_mass - (r * m0.center_of_mass + t)).norm(), 1e-9 * (1.0 + t.norm()));
+    EXPECT_LT((m.inertia - r * m0.inertia * r.transpose()).norm(), 1e-9 * m0.inertia.norm()) << t.transpose();
+    EXPECT_LT((m.principal_moments - m0.principal_moments).norm(), 1e-9 * m0.principal_moments.norm());
+    EXPECT_GT(m.principal_axes.determinant(), 0.0);
+  }
+}
+
+TEST(MassProperties, InsideOutOrOpenMeshIsRejected) {
+  TriangleMesh inside_out = make_box({0, 0, 0}, {1, 1, 1});
+  for (auto& t : inside_out.triangles) std::swap(t[1], t[2]);
+  EXPECT_THROW(compute_mass_properties(inside_out, 1000.0), InputError);
+  TriangleMesh open = make_box({0, 0, 0}, {1, 1, 1});
+  open.triangles.resize(6);
+  EXPECT_THROW(compute_mass_properties(open, 1000.0), InputError);
+  EXPECT_THROW(compute_mass_properties(make_box({0, 0, 0}, {1, 1, 1}), -5.0), InputError);
+}
+
+}  // namespace
+}  // namespace ts

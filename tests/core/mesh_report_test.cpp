@@ -1,0 +1,102 @@
+#include "core/mesh_report.h"
+
+#include <gtest/gtest.h>
+
+#include "core/mesh_io.h"
+#include "core/primitives.h"
+#include "tests/test_support.h"
+
+namespace ts {
+namespace {
+
+TEST(MeshReport, GeneratedAssetsAreWatertightAndOutward) {
+  for (const char* name : {"sphere.obj", "cube.obj", "torus.obj", "trefoil.obj", "plate.obj", "bunny.obj"}) {
+    const MeshReport r = analyze_mesh(load_mesh(test::asset(name)));
+    EXPECT_TRUE(r.watertight()) << name << "\n" << format_report(r);
+    EXPECT_EQ(r.components, 1u) << name;
+  }
+  EXPECT_EQ(analyze_mesh(load_mesh(test::asset("torus.obj"))).genus, 1);
+  EXPECT_EQ(analyze_mesh(load_mesh(test::asset("trefoil.obj"))).genus, 1);
+  EXPECT_EQ(analyze_mesh(load_mesh(test::asset("bunny.obj"))).genus, 0);
+}
+
+TEST(MeshReport, OpenCubeHasOneHole) {
+  TriangleMesh m = make_box({0, 0, 0}, {1, 1, 1});
+  m.triangles.erase(m.triangles.begin(), m.triangles.begin() + 2);  // remove one face
+  const MeshReport r = analyze_mesh(m);
+  EXPECT_EQ(r.boundary_edges, 4u);
+  EXPECT_EQ(r.boundary_loops, 1u);
+  EXPECT_FALSE(r.closed());
+  EXPECT_FALSE(closed_solid_problems(r).empty());
+}
+
+TEST(MeshReport, CountsDuplicateFlippedAndNonManifold) {
+  TriangleMesh dup = make_box({0, 0, 0}, {1, 1, 1});
+  dup.triangles.push_back(dup.triangles[0]);
+  const MeshReport rd = analyze_mesh(dup);
+  EXPECT_EQ(rd.duplicate_triangles, 1u);
+  EXPECT_GT(rd.non_manifold_edges, 0u);
+
+  TriangleMesh flipped = make_box({0, 0, 0}, {1, 1, 1});
+  std::swap(flipped.triangles[3][1], flipped.triangles[3][2]);
+  EXPECT_EQ(analyze_mesh(flipped).inconsistent_edges, 3u);
+
+  TriangleMesh inside_out = make_box({0, 0, 0}, {1, 1, 1});
+  for (auto& t : inside_out.triangles) std::swap(t[1], t[2]);
+  const MeshReport ri = analyze_mesh(inside_out);
+  EXPECT_LT(ri.signed_volume, 0.0);
+  EXPECT_FALSE(ri.watertight());
+
+  // Two cubes sharing one corner vertex: a non-manifold vertex, two components joined at it.
+  TriangleMesh a = make_box({0, 0, 0}, {1, 1, 1}), b = make_box({1, 1, 1}, {2, 2, 2});
+  const auto offset = static_cast<std::uint32_t>(a.vertices.size());
+  for (auto& v : b.vertices) a.vertices.push_back(v);
+  for (auto t : b.triangles) {
+    for (auto& i : t) i = (b.vertices[i - 0] == Eigen::Vector3d(1, 1, 1)) ? 7u : i + offset;
+    a.triangles.push_back(t);
+  }
+  EXPECT_EQ(analyze_mesh(a).non_manifold_vertices, 1u);
+}
+
+TEST(MeshReport, CountsComponentsAndDegenerateTriangles) {
+  TriangleMesh two = make_box({0, 0, 0}, {1, 1, 1});
+  const TriangleMesh other = make_box({3, 0, 0}, {4, 1, 1});
+  const auto offset = static_cast<std::uint32_t>(two.vertices.size());
+  for (auto& v : other.vertices) two.vertices.push_back(v);
+  for (auto t : other.triangles) two.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  two.triangles.push_back({0, 0, 1});
+  const MeshReport r = analyze_mesh(two);
+  EXPECT_EQ(r.components, 2u);
+  EXPECT_EQ(r.degenerate_triangles, 1u);
+}
+
+TEST(MeshReport, FindsASelfIntersectingPair) {
+  TriangleMesh m = make_box({0, 0, 0}, {1, 1, 1});
+  const TriangleMesh inner = make_box({0.5, 0.5, 0.5}, {1.5, 1.5, 1.5});  // overlapping second box
+  const auto offset = static_cast<std::uint32_t>(m.vertices.size());
+  for (auto& v : inner.vertices) m.vertices.push_back(v);
+  for (auto t : inner.triangles) m.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  EXPECT_GT(analyze_mesh(m).self_intersecting_pairs, 0u);
+  EXPECT_EQ(analyze_mesh(make_box({0, 0, 0}, {1, 1, 1})).self_intersecting_pairs, 0u);
+}
+
+TEST(MeshReport, RealMeshesFromCgalMatchTheirKnownState) {
+  EXPECT_TRUE(analyze_mesh(load_mesh(test::cgal_mesh("elephant"))).watertight());
+  const MeshReport holes = analyze_mesh(load_mesh(test::cgal_mesh("elephant-with-holes")));
+  EXPECT_GT(holes.boundary_loops, 0u);
+  EXPECT_GT(analyze_mesh(load_mesh(test::cgal_mesh("cow"))).self_intersecting_pairs, 0u);
+  const MeshReport tet = analyze_mesh(load_mesh(test::cgal_mesh("tetrahedron")));
+  EXPECT_TRUE(tet.closed());
+  EXPECT_LT(tet.signed_volume, 0.0);
+  EXPECT_EQ(analyze_mesh(load_mesh(test::cgal_mesh("knot1"))).genus, 1);
+}
+
+TEST(MeshReport, JsonCarriesTheCounts) {
+  const auto json = to_json(analyze_mesh(make_box({0, 0, 0}, {1, 1, 1})));
+  EXPECT_EQ(json["triangles"], 12);
+  EXPECT_EQ(json["watertight"], true);
+  EXPECT_EQ(json["genus"], 0);
+}
+
+}  // namespace
+}  // namespace ts
