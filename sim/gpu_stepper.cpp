@@ -311,4 +311,26 @@ std::size_t GpuStepper::gpu_bytes() const {
   return total;
 }
 
+void GpuPipelineStepper::load(const World& world) {
+  if (!stepper_) {
+    stepper_ = std::make_unique<GpuStepper>(context_, world, settings_, precision_, timings_);
+  } else {
+    stepper_->upload(world);
+  }
+}
+
+StepStats GpuPipelineStepper::advance(World& world, std::int64_t steps) {
+  if (!stepper_) load(world);
+  stepper_->step(static_cast<int>(steps));
+  StepStats stats = stepper_->statistics();
+  stepper_->download(world);
+  return stats;
+}
+
+std::vector<ContactRecord> GpuPipelineStepper::contacts(const World& world) {
+  CpuReferenceStepper reference(settings_);
+  reference.load(world);
+  return reference.contacts(world);
+}
+
 }  // namespace ts::sim

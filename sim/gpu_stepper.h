@@ -4,6 +4,7 @@
 // gathered per particle (no float atomics) -> per-body sums and integration. Steps run with no CPU
 // round trip; statistics and state are read back only when asked.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "gpu/gl.h"
 #include "gpu/hash_grid.h"
 #include "sim/cpu_reference.h"
+#include "sim/scene_runner.h"
 #include "sim/world.h"
 
 namespace ts::sim {
@@ -60,6 +62,26 @@ class GpuStepper {
   double energy_reference_ = 0.0, energy_scale_ = 0.0;  // J, blow-up check as CpuStepper
   bool any_kinematic_ = false;                          // kinematic bodies do work: no energy check
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
+};
+
+// The GPU pipeline behind the scene runner's Stepper interface. Shaders are compiled once; load()
+// re-uploads the state (at the start and whenever an emitter has added grains).
+class GpuPipelineStepper : public Stepper {
+ public:
+  GpuPipelineStepper(gpu::Context& context, const StepSettings& settings, Precision precision, bool timings)
+      : context_(context), settings_(settings), precision_(precision), timings_(timings) {}
+  void load(const World& world) override;
+  StepStats advance(World& world, std::int64_t steps) override;
+  // Contact dumps are recomputed by the CPU reference on the downloaded state.
+  std::vector<ContactRecord> contacts(const World& world) override;
+  std::string timing_report() { return stepper_ ? stepper_->timing_report() : std::string(); }
+
+ private:
+  gpu::Context& context_;
+  StepSettings settings_;
+  Precision precision_;
+  bool timings_;
+  std::unique_ptr<GpuStepper> stepper_;
 };
 
 }  // namespace ts::sim

@@ -1,0 +1,86 @@
+// `tetrasand sim SCENE.toml`: run a sand scene on the GPU (or the CPU reference with --cpu).
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+
+#include "app/commands.h"
+#include "core/log.h"
+#include "gpu/context.h"
+#include "sim/gpu_stepper.h"
+#include "sim/scene.h"
+#include "sim/scene_runner.h"
+
+namespace ts::app {
+
+Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
+  auto* cmd = app.add_subcommand("sim", "Run a tetrahedral-grain DEM scene (TOML) on the GPU");
+  struct Options {
+    std::string scene;
+    std::string output = "sim-out";
+    double duration = 0;  // s; 0 = the scene's
+    bool cpu = false;
+    std::string precision = "float";
+    bool timings = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("SCENE", o->scene, "Scene file (TOML; see assets/scenes/README.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", o->output, "Output directory (metrics.csv, particle dumps, frames)")->capture_default_str();
+  cmd->add_option("--duration", o->duration, "Simulated time [s], overriding the scene's")->check(CLI::PositiveNumber);
+  cmd->add_flag("--cpu", o->cpu, "Use the double-precision CPU reference instead of the GPU pipeline");
+  cmd->add_option("--precision", o->precision, "GPU arithmetic: float or double (GLSL fp64)")
+      ->check(CLI::IsMember({"float", "double"}))
+      ->capture_default_str();
+  cmd->add_flag("--timings", o->timings, "Print per-kernel GPU times at the end");
+  return [o, &global] {
+    sim::Scene scene = sim::load_scene(o->scene);
+    if (o->duration > 0) scene.simulation.duration = o->duration;
+    std::unique_ptr<gpu::Context> context;
+    sim::GpuPipelineStepper* gpu_stepper = nullptr;
+    std::function<std::unique_ptr<sim::Stepper>(const sim::StepSettings&)> make_stepper;
+    if (!o->cpu) {
+      gpu::ContextOptions options;
+      options.device = global.device;
+      options.debug = global.gl_debug;
+      context = std::make_unique<gpu::Context>(options);
+      make_stepper = [&](const sim::StepSettings& settings) -> std::unique_ptr<sim::Stepper> {
+        auto stepper = std::make_unique<sim::GpuPipelineStepper>(
+            *context, settings, o->precision == "double" ? sim::Precision::Double : sim::Precision::Float, o->timings);
+        gpu_stepper = stepper.get();
+        return stepper;
+      };
+    }
+    const bool terminal = ::isatty(STDERR_FILENO) != 0;
+    const auto start = std::chrono::steady_clock::now();
+    sim::RunHooks hooks;
+    hooks.on_output = [&](const sim::World& world, const sim::StepStats& stats, std::int64_t step) {
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double rate = elapsed > 0 ? static_cast<double>(step) / elapsed : 0.0;
+      const double remaining = rate > 0 ? (scene.simulation.duration - world.time) / world.time * elapsed : 0.0;
+      const std::string line = fmt::format("t = {:.4f} / {:.4f} s  step {}  {:.0f} steps/s  contacts {}  ETA {:.0f} s",
+                                           world.time, scene.simulation.duration, step, rate, stats.contacts,
+                                           world.time > 0 ? remaining : 0.0);
+      if (terminal) {
+        std::fprintf(stderr, "\r%s   ", line.c_str());
+      } else {
+        log::info("{}", line);
+      }
+    };
+    const sim::RunResult result = sim::run_scene(scene, o->output, hooks, make_stepper);
+    if (terminal) std::fprintf(stderr, "\n");
+    if (!result.time_step_warning.empty()) log::warn("{}", result.time_step_warning);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    fmt::print("{}: {} steps of {:.3g} s, {} grains, {:.1f} s wall ({:.3g} grain-steps/s, {})\n", o->scene,
+               result.steps, result.dt, result.grains, seconds,
+               seconds > 0 ? static_cast<double>(result.steps) * static_cast<double>(result.grains) / seconds : 0.0,
+               o->cpu ? "CPU reference" : context->summary());
+    fmt::print("clamps: {} velocity, {} angular velocity, {} overlap (each clamp means a less accurate result)\n",
+               result.last.velocity_clamps, result.last.angular_velocity_clamps, result.last.overlap_clamps);
+    fmt::print("outputs: {}/metrics.csv ({} rows)\n", o->output, result.outputs);
+    if (o->timings && gpu_stepper) fmt::print("{}", gpu_stepper->timing_report());
+    return 0;
+  };
+}
+
+}  // namespace ts::app
