@@ -34,8 +34,9 @@ struct StepSettings {
   // than `angular_damping_speed` (m/s) has its angular velocity scaled by (1 - rate dt), rate 1/s.
   double angular_damping_rate = 0;
   double angular_damping_speed = 0;
-  // Blow-up detection: total mechanical energy may not exceed the reference by more than this
-  // fraction of (reference kinetic energy + M |g| d_max) while no work is done on the system.
+  // Blow-up detection: the mechanical energy (kinetic + potential + contact springs, at the start of
+  // each step) may not exceed its value at the first step by more than this fraction of (kinetic +
+  // spring energy then + M |g| d_max) while no work is done on the system.
   bool check_energy = true;
   double energy_growth_tolerance = 0.5;
 };
@@ -83,7 +84,7 @@ class CpuStepper {
   StepStats step(World& world);
 
   // Call after doing work on the system (adding grains, moving props by hand): the energy check
-  // restarts from the current state. Also rebuilds the pair table if materials were added.
+  // restarts from the next step's state. Also rebuilds the pair table if materials were added.
   void reset_energy_reference(const World& world);
 
   // Every contact of `world` as it stands (each particle pair once); off the stepping path.
@@ -99,7 +100,7 @@ class CpuStepper {
   void visit_contacts(const World& world, std::uint32_t i, Fn&& fn) const;
   void compute_forces(const World& world, StepStats& stats);
   void integrate(World& world, StepStats& stats) const;
-  void check_stability(const World& world, const StepStats& stats) const;
+  void check_stability(const World& world, double mechanical_energy) const;
 
   StepSettings settings_;
   std::size_t material_count_ = 0;
@@ -107,8 +108,11 @@ class CpuStepper {
   NeighbourGrid grid_;
   // Per-particle scratch, reused between steps.
   std::vector<Eigen::Vector3d> position_, velocity_, force_, torque_;
-  double energy_reference_ = 0;  // J
+  double energy_reference_ = 0;  // J: kinetic + potential + spring energy when the reference was taken
   double energy_scale_ = 0;      // J
+  double dynamic_mass_ = 0;      // kg
+  double max_diameter_ = 0;      // m
+  bool reference_pending_ = true;
 };
 
 }  // namespace ts::sim
