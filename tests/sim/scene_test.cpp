@@ -135,6 +135,46 @@ material = "sand"
   }
 }
 
+TEST(Scene, RoughCylinderLinesTheWallFromOutside) {
+  const Scene s = parse_scene(std::string(kMinimal) + R"(
+[[boundary]]
+type = "cylinder"
+rough = true
+centre = [0.1, 0.0]
+radius = 0.01
+z_min = 0.0
+z_max = 0.01
+particle_radius = 5.0e-4
+material = "sand"
+)",
+                              "scene.toml");
+  const World w = make_world(s);
+  ASSERT_EQ(w.bodies.size(), 1u);
+  for (const auto& p : particle_positions(w)) {
+    // Inner surface of the particle ring at the wall radius.
+    EXPECT_NEAR((p.head<2>() - Eigen::Vector2d(0.1, 0)).norm() - 5e-4, 0.01, 1e-12);
+    EXPECT_GE(p.z(), -1e-15);
+    EXPECT_LE(p.z(), 0.01 + 1e-15);
+  }
+}
+
+TEST(Scene, ColumnEmitterStacksGrainsInsideItsRadius) {
+  const Scene s = parse_scene(std::string(kMinimal) + R"(
+[[emitter]]
+type = "column"
+centre = [0.0, 0.0, 0.01]
+radius = 0.012
+count = 60
+)",
+                              "scene.toml");
+  const World w = make_world(s);
+  ASSERT_EQ(w.bodies.size(), 60u);
+  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+    EXPECT_LE(w.bodies.position[b].head<2>().norm() + w.bodies.bounding_radius[b], 0.012 + 1e-12);
+    EXPECT_GE(w.bodies.position[b].z() - w.bodies.bounding_radius[b], 0.01 - 1e-12);
+  }
+}
+
 TEST(Scene, SmoothBoxIsFiveInwardPlanes) {
   const Scene s = parse_scene(
       std::string(kMinimal) + "[[boundary]]\ntype = \"box\"\nmin = [0, 0, 0]\nmax = [1, 2, 3]\nmaterial = \"sand\"\n",
