@@ -77,8 +77,7 @@ TEST(SceneRunner, PourEmitterAddsGrainsOverTime) {
   scene.output = OutputSettings{};
   scene.output.every = 100;
   const RunResult r = run_scene(scene, test::temp_dir());
-  EXPECT_GE(r.grains, 10u);  // 4000 grains/s for 5 ms, where the sites are free
-  EXPECT_LE(r.grains, 21u);
+  EXPECT_EQ(r.grains, 10u);  // 2000 grains/s: one at t = 0, then one each 0.5 ms before 5 ms
 }
 
 TEST(SceneRunner, TooLargeTimeStepWarnsThenBlowsUpWithTheLastGoodState) {

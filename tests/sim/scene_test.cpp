@@ -204,7 +204,7 @@ TEST(Scene, PourEmitterReleasesGrainsAtItsRate) {
   PourEmitter pour(s, s.emitters.at(0));
   w.time = 0.0;
   EXPECT_EQ(pour.emit(w), 1u);
-  w.time = 2.0e-3;  // 4000 grains/s: 9 grains due by now
+  w.time = 4.0e-3;  // 2000 grains/s: 9 grains due by now
   EXPECT_EQ(pour.emit(w), 8u);
   EXPECT_EQ(w.bodies.size(), floor_bodies + 9);
   EXPECT_FALSE(pour.finished());
