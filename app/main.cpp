@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   auto add = [&](app::Runner runner) { runners[app.get_subcommands({}).back()] = std::move(runner); };
   add(app::add_devices_command(app, global));
   add(app::add_info_command(app, global));
+  add(app::add_sdf_command(app, global));
   add(app::add_sim_command(app, global));
 
   try {

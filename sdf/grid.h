@@ -6,6 +6,9 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "core/mesh.h"
+#include "sdf/settings.h"
+
 namespace ts::sdf {
 
 struct GridSpec {
@@ -31,5 +34,11 @@ struct GridSpec {
   // World point -> continuous voxel coordinates (voxel centres at integers).
   Eigen::Vector3d to_voxel(const Eigen::Vector3d& world) const { return (world - origin) / voxel_size; }
 };
+
+// The grid for a bounding box: voxel size from the settings, index_offset = floor(min / h) - padding,
+// dims covering max + padding. Throws ts::InputError for a non-finite or empty box, a non-positive
+// voxel size or resolution, a band below one voxel, or a grid above settings.max_voxels (the
+// message names the smallest voxel size that fits).
+GridSpec make_grid(const Aabb& box, const SdfSettings& settings);
 
 }  // namespace ts::sdf

@@ -1,0 +1,153 @@
+// `tetrasand sdf MESH -o OUT.vdb`: narrow-band SDF by GPU scan conversion, written as an OpenVDB level set.
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+
+#include <openvdb/tools/SignedFloodFill.h>
+
+#include "app/commands.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "core/mesh_io.h"
+#include "core/mesh_report.h"
+#include "sdf/exact_sdf.h"
+#include "sdf/grid.h"
+#include "sdf/openvdb_compare.h"
+#include "sdf/pseudonormals.h"
+#include "sdf/scan_convert.h"
+#include "sdf/vdb_io.h"
+
+namespace ts::app {
+namespace {
+
+// Re-signs the band voxels by the generalised winding number (robust where the mesh has holes),
+// then floods the signs outward again.
+void resign_by_winding_number(openvdb::FloatGrid& grid, const sdf::ExactDistance& exact) {
+  std::vector<std::pair<openvdb::Coord, float>> voxels;
+  for (auto it = grid.cbeginValueOn(); it; ++it) voxels.emplace_back(it.getCoord(), *it);
+  tbb::parallel_for(std::size_t{0}, voxels.size(), [&](std::size_t i) {
+    const openvdb::Vec3d p = grid.indexToWorld(voxels[i].first);
+    const bool inside = exact.winding_number({p.x(), p.y(), p.z()}) >= 0.5;
+    voxels[i].second = inside ? -std::abs(voxels[i].second) : std::abs(voxels[i].second);
+  });
+  auto accessor = grid.getAccessor();
+  for (const auto& [coord, value] : voxels) accessor.setValue(coord, value);
+  openvdb::tools::signedFloodFill(grid.tree());
+}
+
+}  // namespace
+
+Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
+  auto* cmd = app.add_subcommand("sdf", "Narrow-band signed distance field by GPU scan conversion (OpenVDB level set)");
+  struct Options {
+    std::string mesh, output;
+    double voxel = 0;
+    int resolution = 128;
+    double band = 3.0;
+    int padding = -1;
+    std::string sign = "pseudonormal";
+    double scale = 1.0;
+    double slab_mb = 1024;
+    bool timings = false, compare = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("MESH", o->mesh, "Closed triangle mesh (any format assimp reads)")->required();
+  cmd->add_option("-o,--output", o->output, "Output .vdb file")->required();
+  auto* voxel = cmd->add_option("--voxel", o->voxel, "Voxel size [world units, m]")->check(CLI::PositiveNumber);
+  cmd->add_option("--resolution", o->resolution, "Voxels along the longest side (instead of --voxel)")
+      ->check(CLI::PositiveNumber)
+      ->excludes(voxel)
+      ->capture_default_str();
+  cmd->add_option("--band", o->band, "Half-width of the narrow band [voxels], >= 1")->capture_default_str();
+  cmd->add_option("--padding", o->padding, "Voxels beyond the bounding box (default: band + 1)");
+  cmd->add_option("--sign", o->sign, "Sign method: pseudonormal (closed meshes) or winding (robust to holes)")
+      ->check(CLI::IsMember({"pseudonormal", "winding"}))
+      ->capture_default_str();
+  cmd->add_option("--scale", o->scale, "Multiply coordinates by this factor first (e.g. 1000: metres -> mm)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-slab-mb", o->slab_mb, "GPU memory for one z-slab of the grid [MiB]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_flag("--timings", o->timings, "Per-kernel GPU times and peak GPU memory");
+  cmd->add_flag("--compare-openvdb", o->compare,
+                "Also build OpenVDB's meshToLevelSet and the exact SDF; print how both compare with exact distance");
+  return [o, &global] {
+    const auto start = std::chrono::steady_clock::now();
+    TriangleMesh mesh = load_mesh(o->mesh);
+    if (o->scale != 1.0) scale_mesh(mesh, o->scale);
+    ReportOptions report_options;
+    report_options.self_intersections = false;  // signs only need closedness and orientation
+    const MeshReport report = analyze_mesh(mesh, report_options);
+    const bool winding = o->sign == "winding";
+    if (!report.closed() && !winding) {
+      log::warn("{}: the mesh is not closed ({}); pseudonormal signs may be wrong near the holes: use --sign winding",
+                o->mesh, closed_solid_problems(report));
+    }
+    if (report.closed() && report.signed_volume < 0) {
+      log::warn("{}: the mesh is inside out (negative volume): inside and outside are swapped", o->mesh);
+    }
+    sdf::SdfSettings settings;
+    settings.voxel_size = o->voxel;
+    settings.resolution = o->resolution;
+    settings.band = o->band;
+    settings.padding = o->padding;
+    const sdf::GridSpec spec = sdf::make_grid(bounding_box(mesh), settings);
+
+    gpu::ContextOptions context_options;
+    context_options.device = global.device;
+    context_options.debug = global.gl_debug;
+    gpu::Context context(context_options);
+    sdf::ScanConvertOptions scan;
+    scan.band = o->band;
+    scan.timings = o->timings;
+    scan.max_slab_bytes = static_cast<std::size_t>(o->slab_mb * 1048576.0);
+    const bool terminal = ::isatty(STDERR_FILENO) != 0;
+    scan.progress = [&](double done) {
+      if (terminal) std::fprintf(stderr, "\rscan conversion %5.1f %%", 100.0 * done);
+    };
+    const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
+    sdf::ScanConvertResult result = sdf::scan_convert(context, mesh, normals, spec, scan);
+    if (terminal) std::fprintf(stderr, "\n");
+    std::unique_ptr<sdf::ExactDistance> exact;
+    if (winding || o->compare) exact = std::make_unique<sdf::ExactDistance>(mesh);
+    if (winding) resign_by_winding_number(*result.grid, *exact);
+
+    const std::map<std::string, std::string> metadata{
+        {"tetrasand:source", o->mesh},
+        {"tetrasand:source_sha256", sha256_file(o->mesh)},
+        {"tetrasand:band_voxels", fmt::format("{}", o->band)},
+        {"tetrasand:sign", o->sign},
+        {"tetrasand:renderer", context.summary()}};
+    sdf::write_vdb(o->output, result.grid, metadata, {o->mesh});
+    const auto& st = result.stats;
+    fmt::print("{}: {} triangles -> {} ({} x {} x {} voxels of {:.6g}, band {} voxels, {} band voxels)\n", o->mesh,
+               mesh.triangle_count(), o->output, spec.dims.x(), spec.dims.y(), spec.dims.z(), spec.voxel_size, o->band,
+               st.band_voxels);
+    if (st.degenerate_triangles || st.needle_triangles) {
+      fmt::print("{} degenerate triangles skipped, {} needle triangles bounded by rectangles\n", st.degenerate_triangles,
+                 st.needle_triangles);
+    }
+    if (o->timings) {
+      fmt::print("{} slabs of {} layers, {} draws, peak GPU memory {:.1f} MiB, {:.3f} s\n{}", st.slabs,
+                 st.layers_per_slab, st.draws, st.peak_gpu_bytes / 1048576.0, st.seconds, st.timing_report);
+    }
+    if (o->compare) {
+      const auto exact_grid = sdf::exact_sdf_grid(mesh, spec, o->band, winding ? sdf::SignMethod::Winding
+                                                                               : sdf::SignMethod::Pseudonormal);
+      const auto vdb = sdf::openvdb_level_set(mesh, spec.voxel_size, o->band);
+      const double band_world = o->band * spec.voxel_size;
+      fmt::print("{}", sdf::format_comparison(sdf::compare_grids(*result.grid, *exact_grid, spec.voxel_size, band_world),
+                                              sdf::compare_grids(*vdb, *exact_grid, spec.voxel_size, band_world),
+                                              sdf::compare_grids(*result.grid, *vdb, spec.voxel_size, band_world)));
+    }
+    fmt::print("total {:.2f} s on {}\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+               context.summary());
+    return 0;
+  };
+}
+
+}  // namespace ts::app
