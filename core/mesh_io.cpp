@@ -5,12 +5,15 @@
 #include <assimp/scene.h>
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <unordered_map>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/mesh_file_checks.h"
 
 namespace ts {
 namespace fs = std::filesystem;
@@ -24,6 +27,25 @@ void check_readable_file(const fs::path& path) {
   if (fs::file_size(path, ec) == 0) throw InputError(path, "is empty");
   std::ifstream probe(path, std::ios::binary);
   if (!probe) throw InputError(path, "cannot be opened for reading (permission?)");
+}
+
+std::string lowercase_extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+// OFF and PLY get a strict pass first (core/mesh_file_checks.h): assimp's readers trust declared
+// counts for allocations and clamp out-of-range indices without an error.
+void check_before_assimp(const fs::path& path) {
+  const std::string ext = lowercase_extension(path);
+  if (ext != ".off" && ext != ".ply") return;
+  const std::string bytes = read_file(path);
+  if (bytes.starts_with("ply\n") || bytes.starts_with("ply\r\n") || ext == ".ply") {
+    detail::check_ply_file(path, bytes);
+  } else {
+    detail::check_off_file(path, bytes);
+  }
 }
 
 struct PositionHash {
@@ -87,6 +109,7 @@ struct Flattener {
 
 TriangleMesh load_mesh(const fs::path& path) {
   check_readable_file(path);
+  check_before_assimp(path);
   Assimp::Importer importer;
   // Triangulate polygons; keep positions as they are (no normal generation, no vertex merging that
   // depends on normals or texture coordinates: welding by position is done below).

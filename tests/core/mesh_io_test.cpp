@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <fstream>
+#include <utility>
 
 #include "core/error.h"
 #include "core/mesh_report.h"
@@ -33,12 +35,21 @@ TEST(MeshIo, ReadsEachCommonFormatAsAClosedCube) {
 }
 
 TEST(MeshIo, ReadsStlObjAndGlb) {
-  EXPECT_GT(load_mesh(test::assimp_model("STL/Spider_binary.stl")).triangle_count(), 100u);
-  EXPECT_GT(load_mesh(test::assimp_model("OBJ/box.obj")).triangle_count(), 0u);
+  // The spider in three encodings: the OBJ's 19 meshes share positions that are welded across meshes.
+  for (const char* file : {"STL/Spider_ascii.stl", "STL/Spider_binary.stl", "OBJ/spider.obj"}) {
+    const TriangleMesh spider = load_mesh(test::assimp_model(file));
+    EXPECT_EQ(spider.triangle_count(), 1368u) << file;
+    EXPECT_EQ(spider.vertex_count(), 722u) << file;
+  }
+  const TriangleMesh box = load_mesh(test::assimp_model("OBJ/box.obj"));
+  EXPECT_EQ(box.triangle_count(), 12u);
+  EXPECT_TRUE(analyze_mesh(box).watertight());
   EXPECT_GT(load_mesh(test::assimp_model("glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb")).triangle_count(),
             1000u);
-  const TriangleMesh holed = load_mesh(test::assimp_model("STL/sphereWithHole.stl"));
-  EXPECT_FALSE(analyze_mesh(holed).closed());
+  const MeshReport holed = analyze_mesh(load_mesh(test::assimp_model("STL/sphereWithHole.stl")));
+  EXPECT_FALSE(holed.closed());
+  EXPECT_EQ(holed.boundary_edges, 9u);
+  EXPECT_EQ(holed.boundary_loops, 1u);
 }
 
 TEST(MeshIo, FlattensNodeTransformsAndTriangulatesPolygons) {
@@ -67,6 +78,36 @@ TEST(MeshIo, FlattensNodeTransformsAndTriangulatesPolygons) {
   const TriangleMesh quad = load_mesh(dir / "quad.obj");
   EXPECT_EQ(quad.triangle_count(), 2u);
   EXPECT_EQ(quad.vertex_count(), 4u);
+}
+
+TEST(MeshIo, MirroringNodeTransformKeepsTrianglesOutward) {
+  const auto dir = test::temp_dir();
+  // A closed, outward tetrahedron instanced by a node that mirrors x: the winding must be restored.
+  const float positions[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const std::uint16_t indices[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+  {
+    std::ofstream bin(dir / "tet.bin", std::ios::binary);
+    bin.write(reinterpret_cast<const char*>(positions), sizeof positions);
+    bin.write(reinterpret_cast<const char*>(indices), sizeof indices);
+  }
+  write_text(dir / "mirrored.gltf", R"({
+    "asset": {"version": "2.0"},
+    "scene": 0,
+    "scenes": [{"nodes": [0]}],
+    "nodes": [{"mesh": 0, "scale": [-1, 1, 1], "translation": [5, 0, 0]}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+    "buffers": [{"uri": "tet.bin", "byteLength": 72}],
+    "bufferViews": [{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 24}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+                   "min": [0, 0, 0], "max": [1, 1, 1]},
+                  {"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR"}]
+  })");
+  const TriangleMesh mesh = load_mesh(dir / "mirrored.gltf");
+  ASSERT_EQ(mesh.triangle_count(), 4u);
+  const MeshReport report = analyze_mesh(mesh);
+  EXPECT_TRUE(report.watertight()) << format_report(report);
+  EXPECT_NEAR(report.signed_volume, 1.0 / 6.0, 1e-12);
+  EXPECT_DOUBLE_EQ(bounding_box(mesh).min.x(), 4.0);
 }
 
 TEST(MeshIo, MissingFileIsAClearError) {
@@ -111,6 +152,55 @@ TEST(MeshIo, RecoverableObjDamageLoadsAndIsReported) {
   EXPECT_EQ(analyze_mesh(mesh).boundary_loops, 1u);
 }
 
+TEST(MeshIo, HugeDeclaredCountsFailFastWithoutAllocating) {
+  // assimp's own regression file: an OFF header declaring 3.5e11 vertices. Assimp would reserve memory
+  // for all of them; the strict pre-check streams and stops where the data ends.
+  const std::string off = load_error(test::assimp_model("invalid/OutOfMemory.off"));
+  EXPECT_NE(off.find("declares 353535235358 vertices but the file ends after 14"), std::string::npos) << off;
+  const auto dir = test::temp_dir();
+  write_text(dir / "huge.ply",
+             "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
+             "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n");
+  const std::string ply = load_error(dir / "huge.ply");
+  EXPECT_NE(ply.find("declares 4000000000 'vertex' elements but the file ends in number 0"), std::string::npos) << ply;
+}
+
+TEST(MeshIo, OutOfRangeFaceIndicesAreErrorsNotClamped) {
+  // Assimp's OFF and PLY readers clamp or replace such indices and load a wrong mesh without an error.
+  const auto dir = test::temp_dir();
+  const std::string vertices = "0 0 0\n1 0 0\n0 1 0\n";
+  write_text(dir / "index.off", "OFF\n3 1 0\n" + vertices + "3 0 1 7\n");
+  write_text(dir / "negative.off", "OFF\n# a comment line\n3 1 0\n" + vertices + "3 0 -2 1\n");
+  write_text(dir / "short.off", "OFF\n3 1 0\n" + vertices + "3 0 1\n");
+  write_text(dir / "truncated.off", "OFF\n3 2 0\n" + vertices + "3 0 1 2\n");
+  write_text(dir / "index.ply",
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n" + vertices + "3 0 1 9\n");
+  const std::pair<const char*, const char*> cases[] = {
+      {"index.off", "line 6: face 0 refers to vertex '7', outside 0..2"},
+      {"negative.off", "line 7: face 0 refers to vertex '-2', outside 0..2"},
+      {"short.off", "line 6: face 0 declares 3 corners but lists 2"},
+      {"truncated.off", "the header declares 2 faces but the file ends after 1"},
+      {"index.ply", "line 13: face 0 refers to vertex 9, outside 0..2"},
+  };
+  for (const auto& [file, expected] : cases) {
+    const std::string error = load_error(dir / file);
+    EXPECT_NE(error.find(std::string(file) + ": " + expected), std::string::npos) << error;
+  }
+}
+
+TEST(MeshIo, BinaryPlyWithOutOfRangeIndexIsAnError) {
+  const auto dir = test::temp_dir();
+  std::string bytes =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  bytes += std::string(36, '\0');                  // three vertices at the origin (zero is zero in either order)
+  bytes += std::string("\x03\0\0\0\0\0\0\0\x01\0\0\x01\0", 13);  // 3 corners: 0, 1, 256 (big-endian)
+  write_text(dir / "big.ply", bytes);
+  const std::string error = load_error(dir / "big.ply");
+  EXPECT_NE(error.find("face 0 refers to vertex 256, outside 0..2"), std::string::npos) << error;
+}
+
 TEST(MeshIo, NonFiniteCoordinatesAreRejected) {
   const auto dir = test::temp_dir();
   write_text(dir / "nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
@@ -125,6 +215,9 @@ TEST(MeshIo, PointCloudIsRejected) {
              "end_header\n0 0 0\n1 0 0\n0 1 0\n");
   const std::string error = load_error(dir / "points.ply");
   EXPECT_NE(error.find("no triangles"), std::string::npos) << error;
+  for (const char* file : {"OBJ/point_cloud.obj", "OBJ/testpoints.obj", "OBJ/testline.obj"}) {
+    EXPECT_NE(load_error(test::assimp_model(file)).find("has no triangles"), std::string::npos) << file;
+  }
 }
 
 TEST(MeshIo, ObjRoundTripKeepsFullPrecision) {

@@ -1,0 +1,19 @@
+#pragma once
+// Strict checks of OFF and PLY files before assimp reads them. Assimp's readers are lenient where it
+// hurts: an OFF or PLY header that declares billions of elements makes them reserve memory for all
+// of them (the machine swaps or the process is killed), and face indices out of range are silently
+// clamped or replaced, so a broken file loads as a plausible but wrong mesh. These checks stream
+// through the file, never trusting a declared count for an allocation, and throw ts::InputError
+// naming the file, the line (text files) and the problem.
+#include <filesystem>
+#include <string_view>
+
+namespace ts::detail {
+
+// `text` is the whole file. Accepts OFF, COFF, NOFF, CNOFF (extra per-vertex values are ignored).
+void check_off_file(const std::filesystem::path& path, std::string_view text);
+
+// `bytes` is the whole file: ascii, binary_little_endian or binary_big_endian.
+void check_ply_file(const std::filesystem::path& path, std::string_view bytes);
+
+}  // namespace ts::detail
