@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <unordered_map>
 
 #include "core/error.h"
 
@@ -53,6 +55,25 @@ std::array<double, 10> volume_integrals(const TriangleMesh& mesh, const Eigen::V
   return integral;
 }
 
+// Edges not cancelled by an edge running the other way. The divergence theorem needs the surface to
+// bound a region: every directed edge matched by its reverse (holes and flipped faces break this;
+// two solids sharing an edge do not).
+std::size_t unmatched_edges(const TriangleMesh& mesh) {
+  std::unordered_map<std::uint64_t, int> balance;
+  balance.reserve(3 * mesh.triangle_count());
+  for (const auto& t : mesh.triangles) {
+    for (std::size_t e = 0; e < 3; ++e) {
+      const std::uint32_t u = t[e], v = t[(e + 1) % 3];
+      if (u == v) continue;
+      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(u, v)) << 32) | std::max(u, v);
+      balance[key] += u < v ? 1 : -1;
+    }
+  }
+  std::size_t unmatched = 0;
+  for (const auto& [key, b] : balance) unmatched += b != 0 ? 1 : 0;
+  return unmatched;
+}
+
 Eigen::Vector3d reference_point(const TriangleMesh& mesh) { return bounding_box(mesh).center(); }
 
 }  // namespace
@@ -67,13 +88,20 @@ MassProperties compute_mass_properties(const TriangleMesh& mesh, double density)
     throw InputError(fmt::format("density must be positive (got {} kg/m^3)", density));
   }
   if (mesh.empty()) throw InputError("mass properties of an empty mesh");
+  if (const std::size_t open = unmatched_edges(mesh); open > 0) {
+    throw InputError(fmt::format("mass properties need a closed, consistently oriented mesh: {} edges are open or "
+                                 "traversed the same way by their two triangles (holes or flipped faces)",
+                                 open));
+  }
   const Eigen::Vector3d origin = reference_point(mesh);
   const auto integral = volume_integrals(mesh, origin);
   const double volume = integral[0];
   const double size = bounding_box(mesh).size().maxCoeff();
+  if (volume < 0.0) {
+    throw InputError(fmt::format("the mesh is inside out (signed volume {:.6g} m^3): its triangles face inward", volume));
+  }
   if (!(volume > 1e-12 * size * size * size)) {
-    throw InputError(fmt::format("the mesh encloses no positive volume ({:.6g} m^3): it is open, inside out or flat",
-                                 volume));
+    throw InputError(fmt::format("the mesh encloses no volume ({:.6g} m^3): it is flat or degenerate", volume));
   }
   MassProperties out;
   out.density = density;

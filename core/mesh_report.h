@@ -41,6 +41,9 @@ struct ReportOptions {
   bool self_intersections = true;  // the costly check (seconds on ~100k triangles)
 };
 
+inline bool is_closed_manifold(const MeshReport& r) { return r.closed() && r.manifold(); }
+inline bool is_watertight(const MeshReport& r) { return r.watertight(); }
+
 MeshReport analyze_mesh(const TriangleMesh& mesh, const ReportOptions& options = {});
 // Human-readable, several lines; problems are flagged.
 std::string format_report(const MeshReport& report);

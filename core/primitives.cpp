@@ -45,6 +45,8 @@ TriangleMesh make_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   return m;
 }
 
+TriangleMesh make_box(const Eigen::Vector3d& size) { return make_box(-0.5 * size, 0.5 * size); }
+
 TriangleMesh make_icosphere(double radius, int subdivisions) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   TriangleMesh m;

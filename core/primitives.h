@@ -8,6 +8,8 @@ namespace ts {
 
 // Axis-aligned box from lo to hi [m]: 8 vertices, 12 triangles.
 TriangleMesh make_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+// Box of edge lengths `size` [m] centred at the origin.
+TriangleMesh make_box(const Eigen::Vector3d& size);
 // Icosahedron subdivided `subdivisions` times (20 * 4^s triangles), vertices on the sphere [m].
 TriangleMesh make_icosphere(double radius, int subdivisions);
 // Torus about the z axis: major radius R, minor radius r [m], nu x nv quads split in two.

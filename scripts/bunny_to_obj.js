@@ -1,6 +1,6 @@
 #!/usr/bin/env node
 // Converts the Stanford bunny of the npm package `bunny` 1.0.1 (public domain; {positions, cells})
-// into assets/bunny.obj, scaled by 0.01 so the model is about 15 cm long, in metres.
+// into assets/bunny.obj, scaled by 0.01 so the model is about 10 cm long, in metres.
 //   cd /tmp && npm pack bunny@1.0.1 && tar xzf bunny-1.0.1.tgz && node scripts/bunny_to_obj.js /tmp/package assets/bunny.obj
 const fs = require('fs');
 const [pkg, out] = process.argv.slice(2);

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/error.h"
 #include "core/primitives.h"
@@ -73,14 +75,63 @@ TEST(MassProperties, RotatedAndTranslatedCopiesTransformCovariantly) {
   }
 }
 
+TEST(MassProperties, PrincipalAxesAreSortedAscendingAndRightHanded) {
+  // Box 1 x 2 x 3 m: I = m/12 (b^2 + c^2, ...) = m/12 (13, 10, 5): ascending means z, y, x.
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(-1.1, Eigen::Vector3d(3, -1, 2).normalized()).toRotationMatrix();
+  TriangleMesh box = make_box(Eigen::Vector3d(1, 2, 3));
+  for (auto& v : box.vertices) v = r * v;
+  const MassProperties m = compute_mass_properties(box, 1000.0);
+  EXPECT_NEAR(m.mass, 6000.0, 1e-9);
+  const Eigen::Vector3d expected = m.mass / 12.0 * Eigen::Vector3d(5, 10, 13);
+  EXPECT_LT((m.principal_moments - expected).norm(), 1e-9 * expected.norm());
+  EXPECT_NEAR(std::abs(m.principal_axes.col(0).dot(r.col(2))), 1.0, 1e-12);
+  EXPECT_NEAR(std::abs(m.principal_axes.col(1).dot(r.col(1))), 1.0, 1e-12);
+  EXPECT_NEAR(std::abs(m.principal_axes.col(2).dot(r.col(0))), 1.0, 1e-12);
+  EXPECT_NEAR(m.principal_axes.determinant(), 1.0, 1e-12);
+  // The axes diagonalise the inertia tensor.
+  const Eigen::Matrix3d diagonal = m.principal_axes.transpose() * m.inertia * m.principal_axes;
+  EXPECT_LT((diagonal - Eigen::Matrix3d(expected.asDiagonal())).norm(), 1e-9 * expected.norm());
+}
+
+std::string mass_error(const TriangleMesh& mesh, double density = 1000.0) {
+  try {
+    compute_mass_properties(mesh, density);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(MassProperties, InsideOutOrOpenMeshIsRejected) {
   TriangleMesh inside_out = make_box({0, 0, 0}, {1, 1, 1});
   for (auto& t : inside_out.triangles) std::swap(t[1], t[2]);
-  EXPECT_THROW(compute_mass_properties(inside_out, 1000.0), InputError);
+  EXPECT_NE(mass_error(inside_out).find("inside out"), std::string::npos) << mass_error(inside_out);
+  // Without its -x face the divergence sum is still positive (0.5 m^3): only the edge check sees it.
   TriangleMesh open = make_box({0, 0, 0}, {1, 1, 1});
-  open.triangles.resize(6);
-  EXPECT_THROW(compute_mass_properties(open, 1000.0), InputError);
-  EXPECT_THROW(compute_mass_properties(make_box({0, 0, 0}, {1, 1, 1}), -5.0), InputError);
+  open.triangles.erase(open.triangles.begin() + 8, open.triangles.begin() + 10);
+  EXPECT_NE(mass_error(open).find("closed"), std::string::npos) << mass_error(open);
+  TriangleMesh flipped = make_box({0, 0, 0}, {1, 1, 1});
+  std::swap(flipped.triangles[0][1], flipped.triangles[0][2]);
+  EXPECT_NE(mass_error(flipped).find("flipped"), std::string::npos) << mass_error(flipped);
+  EXPECT_NE(mass_error(make_box({0, 0, 0}, {1, 1, 1}), -5.0).find("density"), std::string::npos);
+}
+
+TEST(MassProperties, TwoBoxesSharingAnEdgeAddUp) {
+  // A non-manifold edge still bounds a region: the divergence theorem holds, so this is accepted.
+  TriangleMesh two = make_box({0, 0, 0}, {1, 1, 1});
+  const TriangleMesh other = make_box({1, 1, 0}, {2, 2, 1});
+  // Weld the two shared corners so that the edge between them belongs to four triangles.
+  std::vector<std::uint32_t> index(other.vertices.size());
+  for (std::size_t i = 0; i < other.vertices.size(); ++i) {
+    const auto same = std::find(two.vertices.begin(), two.vertices.end(), other.vertices[i]);
+    index[i] = static_cast<std::uint32_t>(same - two.vertices.begin());
+    if (same == two.vertices.end()) two.vertices.push_back(other.vertices[i]);
+  }
+  for (const auto& t : other.triangles) two.triangles.push_back({index[t[0]], index[t[1]], index[t[2]]});
+  ASSERT_EQ(two.vertices.size(), 14u);
+  const MassProperties m = compute_mass_properties(two, 1.0);
+  EXPECT_NEAR(m.volume, 2.0, 1e-12);
+  EXPECT_LT((m.center_of_mass - Eigen::Vector3d(1, 1, 0.5)).norm(), 1e-12);
 }
 
 }  // namespace

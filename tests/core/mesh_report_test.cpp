@@ -80,11 +80,49 @@ TEST(MeshReport, FindsASelfIntersectingPair) {
   EXPECT_EQ(analyze_mesh(make_box({0, 0, 0}, {1, 1, 1})).self_intersecting_pairs, 0u);
 }
 
+TEST(MeshReport, CountsExactlyOneCrossingPair) {
+  // Two triangles, one piercing the other: one pair, found on the soup path (the mesh is open).
+  TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {0.5, 0.5, -1}, {0.5, 0.5, 1}, {1.5, 0.5, 0.5}};
+  m.triangles = {{0, 1, 2}, {3, 4, 5}};
+  const MeshReport r = analyze_mesh(m);
+  EXPECT_EQ(r.self_intersecting_pairs, 1u);
+  EXPECT_EQ(r.components, 2u);
+  EXPECT_EQ(r.boundary_edges, 6u);
+  EXPECT_EQ(r.boundary_loops, 2u);
+  // Moved apart, the pair no longer crosses; touching at a shared vertex is not an intersection.
+  for (std::size_t i = 3; i < 6; ++i) m.vertices[i].z() += 3.0;
+  EXPECT_EQ(analyze_mesh(m).self_intersecting_pairs, 0u);
+  m.triangles[1] = {0, 4, 5};
+  EXPECT_EQ(analyze_mesh(m).self_intersecting_pairs, 0u);
+}
+
+TEST(MeshReport, ClosedManifoldPredicates) {
+  const MeshReport cube = analyze_mesh(make_box(Eigen::Vector3d(1, 1, 1)));
+  EXPECT_TRUE(is_closed_manifold(cube));
+  EXPECT_TRUE(is_watertight(cube));
+  EXPECT_EQ(closed_solid_problems(cube), "");
+  EXPECT_NE(format_report(cube).find("watertight            yes"), std::string::npos) << format_report(cube);
+  TriangleMesh open = make_box(Eigen::Vector3d(1, 1, 1));
+  open.triangles.pop_back();
+  const MeshReport r = analyze_mesh(open);
+  EXPECT_FALSE(is_closed_manifold(r));
+  EXPECT_NE(closed_solid_problems(r).find("3 boundary edges in 1 holes"), std::string::npos) << closed_solid_problems(r);
+  EXPECT_NE(format_report(r).find("<-- problem"), std::string::npos);
+}
+
 TEST(MeshReport, RealMeshesFromCgalMatchTheirKnownState) {
-  EXPECT_TRUE(analyze_mesh(load_mesh(test::cgal_mesh("elephant"))).watertight());
+  const MeshReport elephant = analyze_mesh(load_mesh(test::cgal_mesh("elephant")));
+  EXPECT_TRUE(elephant.watertight()) << format_report(elephant);
+  EXPECT_EQ(elephant.triangles, 5558u);
+  EXPECT_EQ(elephant.genus, 3);
   const MeshReport holes = analyze_mesh(load_mesh(test::cgal_mesh("elephant-with-holes")));
   EXPECT_GT(holes.boundary_loops, 0u);
-  EXPECT_GT(analyze_mesh(load_mesh(test::cgal_mesh("cow"))).self_intersecting_pairs, 0u);
+  EXPECT_FALSE(holes.closed());
+  const MeshReport cow = analyze_mesh(load_mesh(test::cgal_mesh("cow")));
+  EXPECT_TRUE(cow.closed());
+  EXPECT_GT(cow.self_intersecting_pairs, 0u);
+  EXPECT_FALSE(cow.watertight());
   const MeshReport tet = analyze_mesh(load_mesh(test::cgal_mesh("tetrahedron")));
   EXPECT_TRUE(tet.closed());
   EXPECT_LT(tet.signed_volume, 0.0);
