@@ -112,8 +112,10 @@ TriangleMesh load_mesh(const fs::path& path) {
   check_before_assimp(path);
   Assimp::Importer importer;
   // Triangulate polygons; keep positions as they are (no normal generation, no vertex merging that
-  // depends on normals or texture coordinates: welding by position is done below).
-  const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_SortByPType);
+  // depends on normals or texture coordinates: welding by position is done below). No SortByPType:
+  // points and lines are skipped face by face below, and that step turns an STL solid without
+  // facets into the baffling "Mesh with invalid primitive type" instead of an empty mesh.
+  const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate);
   if (!scene) {
     const std::string reason = importer.GetErrorString();
     if (reason.find("No suitable reader") != std::string::npos) {

@@ -157,10 +157,11 @@ MeshReport analyze_mesh(const TriangleMesh& mesh, const ReportOptions& options) 
     if (fans > 1) ++r.non_manifold_vertices;
   }
 
-  if (r.closed() && r.manifold() && r.components == 1) {
-    const long long chi = static_cast<long long>(r.vertices) - static_cast<long long>(edges.size()) +
-                          static_cast<long long>(r.triangles);
-    r.genus = static_cast<int>((2 - chi) / 2);
+  // Euler: chi = V - E + F = sum over components of (2 - 2 g). Unused vertices are not part of it.
+  if (r.closed() && r.manifold() && r.components > 0) {
+    const auto used_vertices = static_cast<long long>(std::count(used.begin(), used.end(), 1));
+    const long long chi = used_vertices - static_cast<long long>(edges.size()) + static_cast<long long>(r.triangles);
+    r.genus = static_cast<int>((2 * static_cast<long long>(r.components) - chi) / 2);
   }
   if (options.self_intersections && r.non_finite_vertices == 0 && !mesh.empty()) {
     r.self_intersecting_pairs = count_self_intersections(mesh, r.manifold() && r.boundary_edges == 0 &&

@@ -25,7 +25,7 @@ struct MeshReport {
   double area = 0;                         // m^2
   double signed_volume = 0;                // m^3; negative: inside out
   Aabb box;
-  int genus = -1;                          // for a closed manifold with one component, else -1
+  int genus = -1;                          // closed manifold: summed over components; else -1
 
   bool closed() const { return boundary_edges == 0 && non_manifold_edges == 0; }
   bool manifold() const { return non_manifold_edges == 0 && non_manifold_vertices == 0; }

@@ -206,6 +206,8 @@ TEST(MeshIo, NonFiniteCoordinatesAreRejected) {
   write_text(dir / "nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
   const std::string error = load_error(dir / "nan.obj");
   EXPECT_NE(error.find("non-finite"), std::string::npos) << error;
+  const std::string glb = load_error(test::assimp_model("glTF2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb"));
+  EXPECT_NE(glb.find("24 vertices have non-finite coordinates"), std::string::npos) << glb;
 }
 
 TEST(MeshIo, PointCloudIsRejected) {
@@ -215,6 +217,9 @@ TEST(MeshIo, PointCloudIsRejected) {
              "end_header\n0 0 0\n1 0 0\n0 1 0\n");
   const std::string error = load_error(dir / "points.ply");
   EXPECT_NE(error.find("no triangles"), std::string::npos) << error;
+  write_text(dir / "no_facets.stl", "solid nothing\nendsolid nothing\n");
+  EXPECT_NE(load_error(dir / "no_facets.stl").find("no_facets.stl: holds no geometry"), std::string::npos)
+      << load_error(dir / "no_facets.stl");
   for (const char* file : {"OBJ/point_cloud.obj", "OBJ/testpoints.obj", "OBJ/testline.obj"}) {
     EXPECT_NE(load_error(test::assimp_model(file)).find("has no triangles"), std::string::npos) << file;
   }

@@ -80,6 +80,19 @@ TEST(MeshReport, FindsASelfIntersectingPair) {
   EXPECT_EQ(analyze_mesh(make_box({0, 0, 0}, {1, 1, 1})).self_intersecting_pairs, 0u);
 }
 
+TEST(MeshReport, GenusIsSummedOverClosedComponents) {
+  TriangleMesh two = make_torus(1.0, 0.3, 24, 8);
+  const TriangleMesh sphere = make_icosphere(0.5, 1);
+  const auto offset = static_cast<std::uint32_t>(two.vertices.size());
+  for (const auto& v : sphere.vertices) two.vertices.push_back(v + Eigen::Vector3d(5, 0, 0));
+  for (const auto& t : sphere.triangles) two.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  two.vertices.push_back(Eigen::Vector3d(9, 9, 9));  // unused: must not change the Euler characteristic
+  const MeshReport r = analyze_mesh(two);
+  EXPECT_EQ(r.components, 2u);
+  EXPECT_EQ(r.genus, 1);
+  EXPECT_TRUE(r.watertight());
+}
+
 TEST(MeshReport, CountsExactlyOneCrossingPair) {
   // Two triangles, one piercing the other: one pair, found on the soup path (the mesh is open).
   TriangleMesh m;
