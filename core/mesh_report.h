@@ -43,6 +43,13 @@ struct ReportOptions {
 
 inline bool is_closed_manifold(const MeshReport& r) { return r.closed() && r.manifold(); }
 inline bool is_watertight(const MeshReport& r) { return r.watertight(); }
+// True exactly when compute_mass_properties (core/mass_properties.h) accepts the mesh: closed,
+// consistently oriented, finite, enclosing a positive volume. Self-intersections are allowed there.
+inline bool encloses_volume(const MeshReport& r) {
+  const double size = r.box.valid() ? r.box.size().maxCoeff() : 0.0;
+  return r.closed() && r.inconsistent_edges == 0 && r.non_finite_vertices == 0 &&
+         r.signed_volume > 1e-12 * size * size * size;
+}
 
 MeshReport analyze_mesh(const TriangleMesh& mesh, const ReportOptions& options = {});
 // Human-readable, several lines; problems are flagged.

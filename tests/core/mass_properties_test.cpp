@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
+#include "core/mesh_report.h"
 #include "core/primitives.h"
 
 namespace ts {
@@ -114,6 +116,19 @@ TEST(MassProperties, InsideOutOrOpenMeshIsRejected) {
   std::swap(flipped.triangles[0][1], flipped.triangles[0][2]);
   EXPECT_NE(mass_error(flipped).find("flipped"), std::string::npos) << mass_error(flipped);
   EXPECT_NE(mass_error(make_box({0, 0, 0}, {1, 1, 1}), -5.0).find("density"), std::string::npos);
+}
+
+TEST(MassProperties, ReportPredictsWhetherMassPropertiesAreAccepted) {
+  std::vector<TriangleMesh> meshes(5, make_box({0, 0, 0}, {1, 1, 1}));
+  for (auto& t : meshes[1].triangles) std::swap(t[1], t[2]);  // inside out
+  meshes[2].triangles.pop_back();                              // open
+  std::swap(meshes[3].triangles[0][1], meshes[3].triangles[0][2]);  // one flipped face
+  for (auto& v : meshes[4].vertices) v.z() = 0.0;              // flat: closed but no volume
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    const bool accepted = mass_error(meshes[i]).empty();
+    EXPECT_EQ(encloses_volume(analyze_mesh(meshes[i])), accepted) << i << ": " << mass_error(meshes[i]);
+    EXPECT_EQ(accepted, i == 0) << i;
+  }
 }
 
 TEST(MassProperties, TwoBoxesSharingAnEdgeAddUp) {
