@@ -21,7 +21,7 @@ struct MeshReport {
   std::size_t inconsistent_edges = 0;      // two triangles traverse a shared edge the same way
   std::size_t components = 0;              // connected through shared vertices
   std::size_t self_intersecting_pairs = 0;  // triangle pairs that cross (CGAL exact predicates)
-  bool self_intersections_exact = true;    // false: non-manifold input, adjacent pairs not tested
+  bool self_intersections_exact = true;    // false: degenerate triangles of non-manifold input not tested
   double area = 0;                         // m^2
   double signed_volume = 0;                // m^3; negative: inside out
   Aabb box;

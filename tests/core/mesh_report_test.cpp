@@ -110,6 +110,25 @@ TEST(MeshReport, CountsExactlyOneCrossingPair) {
   EXPECT_EQ(analyze_mesh(m).self_intersecting_pairs, 0u);
 }
 
+TEST(MeshReport, AdjacentTrianglesOfNonManifoldMeshesAreTestedToo) {
+  // A fan of three triangles on one edge (non-manifold, so the soup path) plus folds.
+  TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, -1, 0}, {0.5, 0, 1}, {0.3, 0.5, 0}};
+  m.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  EXPECT_EQ(analyze_mesh(m).non_manifold_edges, 1u);
+  EXPECT_EQ(analyze_mesh(m).self_intersecting_pairs, 0u);  // meeting only along the shared edge
+  m.triangles.push_back({0, 5, 1});  // folded back onto triangle 0: coplanar, same side of edge 01
+  EXPECT_EQ(analyze_mesh(m).self_intersecting_pairs, 1u);
+  // Sharing one corner: triangle (2, a, b) whose far edge pierces triangle 2 (0 1 4).
+  TriangleMesh corner;
+  corner.vertices = {{0, 0, 0}, {1, 0, 0}, {0.5, 0, 1}, {0.5, -0.5, 0.3}, {0.5, 0.5, 0.3}, {0.5, 0, -1}, {0.6, 0, -1.2}};
+  corner.triangles = {{0, 1, 2}, {2, 3, 4}, {0, 5, 6}, {0, 6, 5}};  // the last two make an edge shared 2x
+  corner.triangles.push_back({0, 5, 6});                            // ... 3x: non-manifold, soup path
+  const MeshReport r = analyze_mesh(corner);
+  EXPECT_GT(r.non_manifold_edges, 0u);
+  EXPECT_EQ(r.self_intersecting_pairs, 1u) << format_report(r);
+}
+
 TEST(MeshReport, ClosedManifoldPredicates) {
   const MeshReport cube = analyze_mesh(make_box(Eigen::Vector3d(1, 1, 1)));
   EXPECT_TRUE(is_closed_manifold(cube));
