@@ -57,14 +57,6 @@ void classify(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::V
   }
 }
 
-// Signed solid angle of triangle (a, b, c) seen from p (van Oosterom & Strackee 1983).
-double solid_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const double la = a.norm(), lb = b.norm(), lc = c.norm();
-  const double numerator = a.dot(b.cross(c));
-  const double denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-  return 2.0 * std::atan2(numerator, denominator);
-}
-
 }  // namespace
 
 struct ExactDistance::Tree {
@@ -74,7 +66,7 @@ struct ExactDistance::Tree {
 };
 
 ExactDistance::ExactDistance(const TriangleMesh& mesh)
-    : mesh_(mesh), normals_(compute_pseudonormals(mesh)), tree_(std::make_unique<Tree>()) {
+    : mesh_(mesh), normals_(compute_pseudonormals(mesh)), winding_(mesh), tree_(std::make_unique<Tree>()) {
   tree_->triangles.reserve(mesh.triangle_count());
   for (const auto& t : mesh.triangles) {
     auto point = [&](std::uint32_t v) { return Point(mesh.vertices[v].x(), mesh.vertices[v].y(), mesh.vertices[v].z()); };
@@ -105,55 +97,112 @@ const Eigen::Vector3d& ExactDistance::feature_normal(const ClosestPoint& c) cons
   }
 }
 
-double ExactDistance::winding_number(const Eigen::Vector3d& p) const {
-  // Direct sum over all triangles: exact, O(triangles) per query.
-  double total = 0.0;
-  for (const auto& t : mesh_.triangles)
-    total += solid_angle(mesh_.vertices[t[0]] - p, mesh_.vertices[t[1]] - p, mesh_.vertices[t[2]] - p);
-  return total / (4.0 * M_PI);
-}
+double ExactDistance::winding_number(const Eigen::Vector3d& p) const { return winding_(p); }
 
 double ExactDistance::signed_distance(const Eigen::Vector3d& p, SignMethod method) const {
-  const ClosestPoint c = closest(p);
-  bool inside;
-  if (method == SignMethod::Winding) {
-    inside = winding_number(p) >= 0.5;
-  } else {
-    inside = (p - c.point).dot(feature_normal(c)) < 0.0;
-  }
+  return signed_distance(p, closest(p), method);
+}
+
+double ExactDistance::signed_distance(const Eigen::Vector3d& p, const ClosestPoint& c, SignMethod method) const {
+  const bool inside = method == SignMethod::Winding ? std::abs(winding_number(p)) >= 0.5
+                                                    : (p - c.point).dot(feature_normal(c)) < 0.0;
   return inside ? -c.distance : c.distance;
 }
 
+namespace {
+
+// Triangles whose bounding box, grown by the band, reaches z slice k: only they can put a voxel of
+// that slice inside the band, so only that slice's voxels under their boxes are queried.
+std::vector<std::vector<std::uint32_t>> triangles_per_slice(const TriangleMesh& mesh, const GridSpec& spec,
+                                                            double band) {
+  std::vector<std::vector<std::uint32_t>> slices(static_cast<std::size_t>(spec.dims.z()));
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (auto v : mesh.triangles[t]) {
+      lo = std::min(lo, mesh.vertices[v].z());
+      hi = std::max(hi, mesh.vertices[v].z());
+    }
+    const double k_lo = std::ceil((lo - band - spec.origin.z()) / spec.voxel_size);
+    const double k_hi = std::floor((hi + band - spec.origin.z()) / spec.voxel_size);
+    for (int k = std::max(0, static_cast<int>(k_lo)); k <= std::min(spec.dims.z() - 1, static_cast<int>(k_hi)); ++k)
+      slices[static_cast<std::size_t>(k)].push_back(t);
+  }
+  return slices;
+}
+
+struct BandVoxel {
+  openvdb::Coord coord;
+  float value;
+};
+
+// The band voxels of slice k: candidates are the voxels under the grown xy boxes of the slice's
+// triangles; each gets one closest-point query.
+std::vector<BandVoxel> slice_band(const ExactDistance& exact, const TriangleMesh& mesh, const GridSpec& spec,
+                                  const std::vector<std::uint32_t>& triangles, int k, double band, SignMethod sign) {
+  const int nx = spec.dims.x(), ny = spec.dims.y();
+  std::vector<std::uint8_t> candidate(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), 0);
+  for (std::uint32_t t : triangles) {
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = Eigen::Vector3d::Constant(-INFINITY);
+    for (auto v : mesh.triangles[t]) {
+      lo = lo.cwiseMin(mesh.vertices[v]);
+      hi = hi.cwiseMax(mesh.vertices[v]);
+    }
+    const Eigen::Vector3d a = spec.to_voxel(lo - Eigen::Vector3d::Constant(band));
+    const Eigen::Vector3d b = spec.to_voxel(hi + Eigen::Vector3d::Constant(band));
+    const int i0 = std::max(0, static_cast<int>(std::ceil(a.x()))), i1 = std::min(nx - 1, static_cast<int>(std::floor(b.x())));
+    const int j0 = std::max(0, static_cast<int>(std::ceil(a.y()))), j1 = std::min(ny - 1, static_cast<int>(std::floor(b.y())));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) candidate[static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * static_cast<std::size_t>(j)] = 1;
+  }
+  std::vector<BandVoxel> out;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      if (!candidate[static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * static_cast<std::size_t>(j)]) continue;
+      const Eigen::Vector3d p = spec.voxel_center(i, j, k);
+      const ClosestPoint c = exact.closest(p);
+      if (!(c.distance < band)) continue;
+      out.push_back({openvdb::Coord(spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k),
+                     static_cast<float>(exact.signed_distance(p, c, sign))});
+    }
+  return out;
+}
+
+}  // namespace
+
 openvdb::FloatGrid::Ptr exact_sdf_grid(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels,
                                        SignMethod sign) {
-  const ExactDistance exact(mesh);
   const double band = band_voxels * spec.voxel_size;
-  std::vector<float> values(spec.voxel_count(), std::numeric_limits<float>::infinity());
-  tbb::parallel_for(0, spec.dims.z(), [&](int k) {
-    for (int j = 0; j < spec.dims.y(); ++j)
-      for (int i = 0; i < spec.dims.x(); ++i) {
-        const Eigen::Vector3d p = spec.voxel_center(i, j, k);
-        // Cheap rejection first: only voxels within the band need a sign.
-        const ClosestPoint c = exact.closest(p);
-        if (c.distance >= band) continue;
-        values[spec.linear_index(i, j, k)] = static_cast<float>(exact.signed_distance(p, sign));
-      }
-  });
   auto grid = openvdb::FloatGrid::create(static_cast<float>(band));
   grid->setTransform(openvdb::math::Transform::createLinearTransform(spec.voxel_size));
   grid->setGridClass(openvdb::GRID_LEVEL_SET);
   grid->setName("surface");
+  if (mesh.empty()) return grid;
+  const ExactDistance exact(mesh);
+  const auto slices = triangles_per_slice(mesh, spec, band);
+  std::vector<std::vector<BandVoxel>> voxels(slices.size());
+  tbb::parallel_for(0, spec.dims.z(), [&](int k) {
+    const auto slice = static_cast<std::size_t>(k);
+    voxels[slice] = slice_band(exact, mesh, spec, slices[slice], k, band, sign);
+  });
+  // OpenVDB trees are not safe to write from several threads: the slices go in one after another.
   auto accessor = grid->getAccessor();
-  for (int k = 0; k < spec.dims.z(); ++k)
-    for (int j = 0; j < spec.dims.y(); ++j)
-      for (int i = 0; i < spec.dims.x(); ++i) {
-        const float v = values[spec.linear_index(i, j, k)];
-        if (std::isfinite(v))
-          accessor.setValue(openvdb::Coord(spec.index_offset.x() + i, spec.index_offset.y() + j,
-                                           spec.index_offset.z() + k), v);
-      }
+  for (const auto& slice : voxels)
+    for (const BandVoxel& v : slice) accessor.setValue(v.coord, v.value);
   openvdb::tools::signedFloodFill(grid->tree());
   return grid;
+}
+
+std::vector<float> exact_sdf_dense(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels,
+                                   SignMethod sign) {
+  const auto grid = exact_sdf_grid(mesh, spec, band_voxels, sign);
+  std::vector<float> dense(spec.voxel_count());
+  auto accessor = grid->getConstAccessor();
+  for (int k = 0; k < spec.dims.z(); ++k)
+    for (int j = 0; j < spec.dims.y(); ++j)
+      for (int i = 0; i < spec.dims.x(); ++i)
+        dense[spec.linear_index(i, j, k)] = accessor.getValue(
+            openvdb::Coord(spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k));
+  return dense;
 }
 
 }  // namespace ts::sdf

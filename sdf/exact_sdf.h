@@ -12,6 +12,7 @@
 #include "sdf/grid.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/settings.h"
+#include "sdf/winding_number.h"
 
 namespace ts::sdf {
 
@@ -34,7 +35,10 @@ class ExactDistance {
 
   ClosestPoint closest(const Eigen::Vector3d& p) const;
   double signed_distance(const Eigen::Vector3d& p, SignMethod method) const;
-  // Generalised winding number (Jacobson et al. 2013): about 1 inside, 0 outside, fractional near holes.
+  // The same, reusing a closest point already found for p.
+  double signed_distance(const Eigen::Vector3d& p, const ClosestPoint& c, SignMethod method) const;
+  // Generalised winding number (sdf/winding_number.h, hierarchical): about 1 inside, 0 outside,
+  // fractional near holes; |w| >= 1/2 counts as inside (an inward-oriented closed mesh gives -1).
   double winding_number(const Eigen::Vector3d& p) const;
   // The outward pseudonormal of the feature holding a closest point.
   const Eigen::Vector3d& feature_normal(const ClosestPoint& c) const;
@@ -42,15 +46,21 @@ class ExactDistance {
 
  private:
   struct Tree;
-  const TriangleMesh& mesh_;
+  TriangleMesh mesh_;  // a copy: callers may pass a temporary
   Pseudonormals normals_;
+  FastWindingNumber winding_;
   std::unique_ptr<Tree> tree_;
 };
 
 // Every voxel with |d| < band * h, in world units, as an OpenVDB level set (background band * h,
-// transform createLinearTransform(h), name "surface"); voxels outside the band get +-band by a
-// signed flood fill.
+// transform createLinearTransform(h), coordinates index_offset + (i, j, k), name "surface"); voxels
+// outside the band get +-band by a signed flood fill. TBB-parallel over z slices.
 openvdb::FloatGrid::Ptr exact_sdf_grid(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels,
                                        SignMethod sign);
+
+// The same field, every voxel of `spec` (spec.linear_index order), clamped to +-band * h [m]: the
+// flood-filled level set read back densely, for comparisons with sdf::DenseSdf.
+std::vector<float> exact_sdf_dense(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels,
+                                   SignMethod sign);
 
 }  // namespace ts::sdf

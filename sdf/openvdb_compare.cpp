@@ -27,14 +27,22 @@ GridComparison compare_grids(const openvdb::FloatGrid& a, const openvdb::FloatGr
                              double band_world) {
   GridComparison out;
   std::vector<double> diffs;
-  auto other = a.getConstAccessor();
-  for (auto it = reference.cbeginValueOn(); it; ++it) {
-    const float r = *it;
-    if (std::abs(r) >= band_world) continue;
-    const float v = other.getValue(it.getCoord());
+  auto add = [&](float v, float r) {
     diffs.push_back(std::abs(static_cast<double>(v) - r) / voxel_size);
     // On the surface itself (|d| below 1e-4 voxel) the sign is a matter of rounding, not an error.
     if (std::abs(r) > 1e-4 * voxel_size) out.sign_disagreements += (v < 0) != (r < 0) ? 1 : 0;
+  };
+  auto in_band = [&](float value) { return std::abs(value) < band_world; };
+  auto other = a.getConstAccessor();
+  for (auto it = reference.cbeginValueOn(); it; ++it)
+    if (in_band(*it)) add(other.getValue(it.getCoord()), *it);
+  // Band voxels of `a` the reference has outside its band (or not at all): a's band is too wide there.
+  auto ref = reference.getConstAccessor();
+  for (auto it = a.cbeginValueOn(); it; ++it) {
+    if (!in_band(*it)) continue;
+    float r = 0.0f;
+    if (ref.probeValue(it.getCoord(), r) && in_band(r)) continue;  // counted above
+    add(*it, ref.getValue(it.getCoord()));
   }
   if (diffs.empty()) return out;
   std::sort(diffs.begin(), diffs.end());
@@ -44,6 +52,16 @@ GridComparison compare_grids(const openvdb::FloatGrid& a, const openvdb::FloatGr
   out.p99 = diffs[static_cast<std::size_t>(0.99 * static_cast<double>(diffs.size() - 1))];
   out.max = diffs.back();
   return out;
+}
+
+ThreeWayComparison compare_with_exact(const openvdb::FloatGrid& gpu, const openvdb::FloatGrid& openvdb,
+                                      const openvdb::FloatGrid& exact, double voxel_size, double band_world) {
+  return {compare_grids(gpu, exact, voxel_size, band_world), compare_grids(openvdb, exact, voxel_size, band_world),
+          compare_grids(gpu, openvdb, voxel_size, band_world)};
+}
+
+std::string format_comparison(const ThreeWayComparison& c) {
+  return format_comparison(c.gpu_vs_exact, c.openvdb_vs_exact, c.gpu_vs_openvdb);
 }
 
 std::string format_comparison(const GridComparison& gpu, const GridComparison& vdb, const GridComparison& both) {

@@ -14,17 +14,27 @@ namespace ts::sdf {
 openvdb::FloatGrid::Ptr openvdb_level_set(const TriangleMesh& mesh, double h, double band);
 
 struct GridComparison {
-  std::size_t voxels = 0;              // compared: |value| < band in the reference
+  std::size_t voxels = 0;              // compared: |value| < band in either grid
   std::size_t sign_disagreements = 0;
   double mean = 0, p99 = 0, max = 0;   // |a - reference| [voxels]
 };
 
-// Compares `a` with `reference` over the reference's band voxels (|value| < band_world).
+// Compares `a` with `reference` over the voxels active with |value| < band_world [m] in either grid
+// (where one grid has no active voxel its value is its background, +-band). Sign disagreements skip
+// voxels the reference puts on the surface (|value| < 1e-4 voxel).
 GridComparison compare_grids(const openvdb::FloatGrid& a, const openvdb::FloatGrid& reference, double voxel_size,
                              double band_world);
+
+// tetrasand's GPU grid and OpenVDB's, each against the exact one, and against each other.
+struct ThreeWayComparison {
+  GridComparison gpu_vs_exact, openvdb_vs_exact, gpu_vs_openvdb;
+};
+ThreeWayComparison compare_with_exact(const openvdb::FloatGrid& gpu, const openvdb::FloatGrid& openvdb,
+                                      const openvdb::FloatGrid& exact, double voxel_size, double band_world);
 
 // The report `tetrasand sdf --compare-openvdb` prints.
 std::string format_comparison(const GridComparison& gpu_vs_exact, const GridComparison& openvdb_vs_exact,
                               const GridComparison& gpu_vs_openvdb);
+std::string format_comparison(const ThreeWayComparison& comparison);
 
 }  // namespace ts::sdf
