@@ -17,6 +17,7 @@ using Runner = std::function<int()>;
 
 Runner add_devices_command(CLI::App& app, const GlobalOptions& global);
 Runner add_info_command(CLI::App& app, const GlobalOptions& global);
+Runner add_sample_command(CLI::App& app, const GlobalOptions& global);
 Runner add_sdf_command(CLI::App& app, const GlobalOptions& global);
 Runner add_sim_command(CLI::App& app, const GlobalOptions& global);
 

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   add(app::add_devices_command(app, global));
   add(app::add_info_command(app, global));
   add(app::add_sdf_command(app, global));
+  add(app::add_sample_command(app, global));
   add(app::add_sim_command(app, global));
 
   try {

@@ -1,0 +1,236 @@
+#include "sampler/sample_mesh.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <span>
+
+#include <tbb/parallel_for.h>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "core/mass_properties.h"
+#include "sampler/sampling_quality.h"
+#include "sampler/surface_points.h"
+#include "sdf/exact_sdf.h"
+#include "sdf/grid.h"
+#include "sdf/pseudonormals.h"
+#include "sdf/scan_convert.h"
+#include "sdf/settings.h"
+
+namespace ts::sampler {
+namespace {
+
+constexpr std::size_t kDefaultCount = 4000;
+constexpr double kBandVoxels = 4.0;  // SDF half-width: 2 r at the default voxel, room for every move
+
+// The radius and spacing the coverage target asks for. A hexagonal arrangement of spacing s has
+// covering radius s / sqrt(3); a relaxed arrangement is not quite hexagonal and its covering radius
+// comes out about kRelaxedCovering times larger (measured on the sphere and the bunny: 1.05-1.12),
+// so covering radius c_t = coverage * r needs s = sqrt(3) c_t / kRelaxedCovering. The hole-closing
+// rounds then mend what is left.
+constexpr double kRelaxedCovering = 1.1;
+struct Sizing {
+  double radius = 0.0, spacing = 0.0;
+  std::size_t count = 0;
+};
+
+Sizing size_particles(double area, const SampleSettings& s) {
+  Sizing out;
+  if (s.radius > 0.0) {
+    out.radius = s.radius;
+  } else {
+    const std::size_t n = s.count > 0 ? s.count : kDefaultCount;
+    // Invert count_for_coverage: N = 2A / (sqrt(3) s^2) with s = sqrt(3) coverage r.
+    const double spacing = std::sqrt(2.0 * area / (std::sqrt(3.0) * static_cast<double>(n)));
+    out.radius = spacing * kRelaxedCovering / (std::sqrt(3.0) * s.coverage);
+  }
+  out.spacing = std::sqrt(3.0) * s.coverage * out.radius / kRelaxedCovering;
+  out.count = static_cast<std::size_t>(
+      std::ceil(particles_for_covering_radius(area, s.coverage * out.radius / kRelaxedCovering)));
+  return out;
+}
+
+void check_sizes(const Sizing& z, const SampleSettings& s, double area) {
+  if (!(s.coverage > 0.0)) throw InputError(fmt::format("--coverage must be positive (got {})", s.coverage));
+  if (z.count < 8) {
+    throw InputError(fmt::format("particle radius {:.4g} m is too large for this mesh (area {:.4g} m^2): it would "
+                                 "hold only {} particles; use a radius below {:.4g} m",
+                                 z.radius, area, z.count, z.radius * std::sqrt(static_cast<double>(z.count) / 8.0)));
+  }
+  if (z.count > s.max_particles) {
+    const double smallest = z.radius * std::sqrt(static_cast<double>(z.count) / static_cast<double>(s.max_particles));
+    throw InputError(fmt::format("particle radius {:.4g} m needs about {} particles, above the cap of {}; the "
+                                 "smallest radius that fits is {:.4g} m",
+                                 z.radius, z.count, s.max_particles, smallest));
+  }
+}
+
+// The SDF grid: voxel r / 2 unless the user set one; grown while the dense texture would exceed the
+// budget (then the trilinear error grows too, so say so).
+sdf::GridSpec choose_grid(const TriangleMesh& mesh, double radius, const SampleSettings& s,
+                          std::vector<std::string>& warnings) {
+  sdf::SdfSettings grid;
+  grid.voxel_size = s.voxel_size > 0.0 ? s.voxel_size : 0.5 * radius;
+  grid.band = kBandVoxels;
+  for (;;) {
+    const sdf::GridSpec spec = sdf::make_grid(bounding_box(mesh), grid);
+    if (spec.voxel_count() * 16 <= s.max_sdf_bytes) {
+      if (grid.voxel_size > 0.5 * radius && s.voxel_size <= 0.0) {
+        warnings.push_back(fmt::format("the SDF voxel was enlarged to {:.4g} m (r / {:.2f}) to fit the {} MiB texture "
+                                       "budget; relaxation is coarser, the exact projection keeps particles on the surface",
+                                       grid.voxel_size, radius / grid.voxel_size, s.max_sdf_bytes >> 20));
+      }
+      return spec;
+    }
+    if (s.voxel_size > 0.0) {
+      throw InputError(fmt::format("SDF voxel {:.4g} m needs {} MiB of GPU texture, above the budget of {} MiB",
+                                   s.voxel_size, spec.voxel_count() * 16 >> 20, s.max_sdf_bytes >> 20));
+    }
+    grid.voxel_size *= 1.25;
+  }
+}
+
+std::vector<Eigen::Vector3f> to_local(const std::vector<Eigen::Vector3d>& world, const Eigen::Vector3d& origin) {
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(world.size());
+  for (const auto& p : world) out.push_back((p - origin).cast<float>());
+  return out;
+}
+
+// Moves each particle to its exact closest point on the mesh and returns the outward normal there
+// (the pseudonormal of the feature holding it).
+void project_exactly(const sdf::ExactDistance& exact, std::vector<Eigen::Vector3d>& points,
+                     std::vector<Eigen::Vector3d>& normals) {
+  normals.resize(points.size());
+  tbb::parallel_for(std::size_t{0}, points.size(), [&](std::size_t i) {
+    const sdf::ClosestPoint c = exact.closest(points[i]);
+    points[i] = c.point;
+    normals[i] = exact.feature_normal(c);
+  });
+}
+
+ThinFeatures find_thin_features(const TriangleMesh& mesh, const sdf::ExactDistance& exact, double spacing) {
+  const sdf::Pseudonormals& pn = exact.pseudonormals();
+  // A triangle whose solid is thinner than the spacing: half a spacing inward from its centroid,
+  // the point is already outside again or barely inside.
+  ThinFeatures thin;
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    const Eigen::Vector3d centroid = (mesh.vertices[tri[0]] + mesh.vertices[tri[1]] + mesh.vertices[tri[2]]) / 3.0;
+    const Eigen::Vector3d probe = centroid - 0.5 * spacing * pn.face[t];
+    if (exact.signed_distance(probe, sdf::SignMethod::Pseudonormal) > -0.25 * spacing) {
+      ++thin.triangles;
+      thin.where.extend(centroid);
+    }
+  }
+  return thin;
+}
+
+}  // namespace
+
+SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const SampleSettings& settings,
+                         const std::function<void(const SampleProgress&)>& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  SampleResult result;
+  const double area = surface_area(mesh);
+  if (!(area > 0.0)) throw InputError("the mesh has no surface area");
+  const MassProperties mass = compute_mass_properties(mesh, settings.density);
+  const Sizing z = size_particles(area, settings);
+  check_sizes(z, settings, area);
+  result.estimated_count = z.count;
+
+  // 1. SDF, kept on the GPU as a dense texture.
+  const sdf::GridSpec spec = choose_grid(mesh, z.radius, settings, result.warnings);
+  const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
+  sdf::ScanConvertOptions scan;
+  scan.band = kBandVoxels;
+  scan.keep_dense = true;
+  scan.build_grid = false;
+  scan.timings = settings.timings;
+  const sdf::ScanConvertResult field = sdf::scan_convert(context, mesh, normals, spec, scan);
+  const sdf::ExactDistance exact(mesh);
+
+  // 2. Seeds.
+  std::mt19937_64 rng(settings.seed);
+  std::vector<Eigen::Vector3d> particles = sample_surface_points(mesh, z.count, rng).positions;
+
+  // 3-4. Relax, project, measure coverage, inject, repeat.
+  GpuRelaxer relaxer(context, field.dense, settings.timings);
+  RelaxSettings relax = settings.relax;
+  relax.spacing = z.spacing;
+  relax.band_limit = 0.95 * kBandVoxels * spec.voxel_size;
+  const double target = settings.coverage * z.radius;
+  int iterations = 0, rounds = 0;
+  bool converged = true;
+  std::vector<Eigen::Vector3d> particle_normals;
+  CoverageResult coverage;
+  for (;;) {
+    std::vector<Eigen::Vector3f> local = to_local(particles, spec.origin);
+    const RelaxStats stats = relaxer.relax(local, relax, [&](int it, std::size_t n, double residual) {
+      if (progress) progress({rounds, iterations + it, n, residual});
+    });
+    iterations += stats.iterations;
+    converged = stats.converged;
+    // After the first relaxation only the injected particles and their neighbours need to settle.
+    relax.max_iterations = std::min(relax.max_iterations, 300);
+    particles.clear();
+    for (const auto& p : local) particles.push_back(p.cast<double>() + spec.origin);
+    project_exactly(exact, particles, particle_normals);
+    CoverageSettings probe;
+    probe.probes = settings.probes;
+    probe.seed = settings.seed + 1000u * static_cast<unsigned>(rounds + 1);
+    probe.worst_k = std::max<std::size_t>(1, particles.size() / 50);
+    probe.min_depth = target;  // only real holes
+    coverage = measure_coverage(mesh, std::span<const Eigen::Vector3d>(particles), probe);
+    if (coverage.covering_radius <= target || rounds >= settings.max_rounds) break;
+    // Inject at the worst uncovered surface points (already on the surface), then relax again.
+    for (const auto& hole : coverage.worst) particles.push_back(hole.position);
+    ++rounds;
+  }
+  if (coverage.covering_radius > target) {
+    result.warnings.push_back(fmt::format("coverage target not reached after {} rounds: covering radius {:.4g} m = {:.3f} r "
+                                          "(target {:.3f} r)",
+                                          rounds, coverage.covering_radius, coverage.covering_radius / z.radius,
+                                          settings.coverage));
+  }
+
+  // 5. Quality and the body.
+  const SpacingStatistics spacing = spacing_statistics(area, std::span<const Eigen::Vector3d>(particles));
+  const double max_phi = max_distance_to_surface(mesh, std::span<const Eigen::Vector3d>(particles));
+  result.thin = find_thin_features(mesh, exact, z.spacing);
+  if (result.thin.triangles > 0) {
+    result.warnings.push_back(fmt::format("{} triangles belong to features thinner than the particle spacing {:.4g} m "
+                                          "(within [{:.4g}, {:.4g}, {:.4g}] .. [{:.4g}, {:.4g}, {:.4g}] m): particles of "
+                                          "both sides overlap there",
+                                          result.thin.triangles, z.spacing, result.thin.where.min.x(),
+                                          result.thin.where.min.y(), result.thin.where.min.z(), result.thin.where.max.x(),
+                                          result.thin.where.max.y(), result.thin.where.max.z()));
+  }
+  ParticleBody& body = result.body;
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    body.positions.push_back(particles[i].cast<float>());
+    body.normals.push_back(particle_normals[i].cast<float>());
+  }
+  body.particle_radius = z.radius;
+  set_mass_properties(body, mass);
+  body.sdf_voxel_size = spec.voxel_size;
+  body.quality.relative_radius = spacing.relative_radius;
+  body.quality.cv = spacing.cv_nn;
+  body.quality.covering_radius = coverage.covering_radius;
+  body.quality.covering_over_r = coverage.covering_radius / z.radius;
+  if (settings.grain_radius > 0.0) {
+    body.quality.covering_over_r_plus_grain = coverage.covering_radius / (z.radius + settings.grain_radius);
+  }
+  body.quality.max_abs_phi_over_r = max_phi / z.radius;
+  body.quality.iterations = iterations;
+  body.quality.injection_rounds = rounds;
+  body.quality.converged = converged;
+  body.quality.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (settings.timings) result.timing_report = field.stats.timing_report + relaxer.timing_report();
+  return result;
+}
+
+}  // namespace ts::sampler

@@ -1,0 +1,60 @@
+#pragma once
+// The main job: a closed mesh becomes a particle rigid body (thesis 6.3; Bell, Yu & Mucha 2005).
+//   1. SDF by GPU scan conversion, voxel = r / 2 unless set (see SampleSettings::voxel_size);
+//   2. seeds spread area-uniformly with the injected seed, as many as the coverage target needs;
+//   3. GPU relaxation (attraction to the zero level set + Gaussian repulsion);
+//   4. exact projection onto the mesh, coverage measured on many surface points, particles
+//      injected at the worst uncovered points and relaxed again, until the covering radius meets
+//      the target or the round limit;
+//   5. quality figures and mass properties (from the closed mesh, never from the particles).
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/mesh.h"
+#include "gpu/context.h"
+#include "sampler/gpu_relaxer.h"
+#include "sampler/particle_body.h"
+
+namespace ts::sampler {
+
+struct SampleSettings {
+  double radius = 0.0;         // particle radius r [m]; 0: from `count`, else about 4000 particles
+  std::size_t count = 0;       // particle count instead of a radius
+  double coverage = 1.0;       // target covering radius / r: 1 = the spheres cover the whole surface
+  double grain_radius = 0.0;   // grain radius [m] for the leak figure c / (r + r_grain); 0: not reported
+  double voxel_size = 0.0;     // SDF voxel [m]; 0: r / 2, so trilinear interpolation error stays far below r
+  double density = 1000.0;     // kg/m^3
+  std::uint64_t seed = 1;
+  int max_rounds = 8;                  // coverage repair rounds
+  std::size_t probes = 1'000'000;      // surface points the covering radius is measured on
+  std::size_t max_particles = 20'000'000;
+  std::size_t max_sdf_bytes = 1ull << 30;  // dense SDF texture budget; the voxel grows (with a warning) past it
+  bool timings = false;
+  RelaxSettings relax;                 // spacing and band are filled in from the radius
+};
+
+struct SampleProgress {
+  int round = 0;               // 0: first relaxation; k: after the k-th injection
+  int iteration = 0;
+  std::size_t particles = 0;
+  double residual = 0.0;       // mean displacement per step / spacing
+};
+
+struct ThinFeatures {
+  std::size_t triangles = 0;   // triangles whose solid is thinner than the particle spacing there
+  Aabb where;                  // their bounding box
+};
+
+struct SampleResult {
+  ParticleBody body;
+  ThinFeatures thin;
+  std::size_t estimated_count = 0;  // from the area and the coverage target
+  std::vector<std::string> warnings;
+  std::string timing_report;
+};
+
+SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const SampleSettings& settings,
+                         const std::function<void(const SampleProgress&)>& progress = {});
+
+}  // namespace ts::sampler

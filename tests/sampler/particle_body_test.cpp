@@ -1,0 +1,284 @@
+#include "sampler/particle_body.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/mass_properties.h"
+#include "sampler/surface_points.h"
+#include "sim/scene.h"
+#include "tests/test_meshes.h"
+#include "tests/test_support.h"
+
+namespace ts::sampler {
+namespace {
+
+namespace fs = std::filesystem;
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+// The message of the InputError `f` throws ("" and a test failure when it throws none).
+template <typename F>
+std::string input_error(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError";
+  return "";
+}
+
+std::vector<Eigen::Vector3f> random_vectors(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<float> u(-10.0f, 10.0f);
+  std::vector<Eigen::Vector3f> v(n);
+  for (auto& p : v) p = {u(rng), u(rng), u(rng)};
+  return v;
+}
+
+// A complete body: a 2 x 1 x 0.5 m box of density 1500 kg/m^3 with area-uniform surface particles.
+ParticleBody box_body() {
+  const TriangleMesh box = test::box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d(2.0, 1.0, 0.5));
+  ParticleBody body;
+  set_mass_properties(body, compute_mass_properties(box, 1500.0));
+  std::mt19937_64 rng(1);
+  const SurfacePoints points = sample_surface_points(box, 300, rng);
+  for (std::size_t i = 0; i < points.positions.size(); ++i) {
+    body.positions.push_back(points.positions[i].cast<float>());
+    body.normals.push_back(points.normals[i].cast<float>());
+  }
+  body.particle_radius = 0.05;
+  body.sdf_voxel_size = 0.0125;
+  body.source_path = "meshes/box.obj";
+  body.source_sha256 = std::string(64, 'a');
+  body.quality = {0.81, 0.035, 0.047, 0.94, 0.47 / 1.5, 0.02, 1234, 1.75, true, 2};
+  return body;
+}
+
+TEST(ParticlesPly, BinaryRoundTripIsBitExact) {
+  const fs::path file = test::temp_dir() / "p.ply";
+  const auto positions = random_vectors(1000, 1);
+  const auto normals = random_vectors(1000, 2);
+  write_particles_ply(file, positions, normals);
+  const ParticlesPly back = read_particles_ply(file);
+  EXPECT_EQ(back.positions, positions);
+  EXPECT_EQ(back.normals, normals);
+  // 6 floats per particle after the header.
+  const std::string bytes = read_file(file);
+  EXPECT_EQ(bytes.size() - (bytes.find("end_header\n") + 11), 1000u * 24u);
+  EXPECT_TRUE(bytes.starts_with("ply\nformat binary_little_endian 1.0\n"));
+
+  write_particles_ply(file, positions, {});
+  const ParticlesPly plain = read_particles_ply(file);
+  EXPECT_EQ(plain.positions, positions);
+  EXPECT_TRUE(plain.normals.empty());
+}
+
+TEST(ParticlesPly, AsciiFilesWithOtherPropertiesAndElementsAreRead) {
+  const fs::path file = test::temp_dir() / "hand.ply";
+  write_text(file,
+             "ply\r\nformat ascii 1.0\r\ncomment made by hand\r\nelement camera 1\r\nproperty list uchar int ids\r\n"
+             "element vertex 3\r\nproperty double z\r\nproperty uchar red\r\nproperty float x\r\nproperty int y\r\n"
+             "element face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n"
+             "3 7 8 9\r\n"
+             "0.5 255 1 2\r\n-1e-3 0 -4.25 7\r\n3 1 0 0\r\n"
+             "3 0 1 2\r\n");
+  const ParticlesPly p = read_particles_ply(file);
+  ASSERT_EQ(p.positions.size(), 3u);
+  EXPECT_EQ(p.positions[0], Eigen::Vector3f(1.0f, 2.0f, 0.5f));
+  EXPECT_EQ(p.positions[1], Eigen::Vector3f(-4.25f, 7.0f, -1e-3f));
+  EXPECT_EQ(p.positions[2], Eigen::Vector3f(0.0f, 0.0f, 3.0f));
+  EXPECT_TRUE(p.normals.empty());
+}
+
+TEST(ParticlesPly, BinaryFilesWithDoublesAndAListElementFirstAreRead) {
+  const fs::path file = test::temp_dir() / "mixed.ply";
+  std::string bytes =
+      "ply\nformat binary_little_endian 1.0\nelement tag 2\nproperty list uchar short values\n"
+      "element vertex 2\nproperty double x\nproperty double y\nproperty double z\nproperty float nx\n"
+      "property float ny\nproperty float nz\nend_header\n";
+  auto put = [&](const auto& value) { bytes.append(reinterpret_cast<const char*>(&value), sizeof value); };
+  put(std::uint8_t{1});
+  put(std::int16_t{-5});
+  put(std::uint8_t{2});
+  put(std::int16_t{3});
+  put(std::int16_t{4});
+  for (int i = 0; i < 2; ++i) {
+    put(0.25 + i);
+    put(-1.5);
+    put(1e-5 * i);
+    put(0.0f);
+    put(0.0f);
+    put(1.0f);
+  }
+  write_text(file, bytes);
+  const ParticlesPly p = read_particles_ply(file);
+  ASSERT_EQ(p.positions.size(), 2u);
+  EXPECT_EQ(p.positions[1], Eigen::Vector3f(1.25f, -1.5f, 1e-5f));
+  EXPECT_EQ(p.normals[1], Eigen::Vector3f(0.0f, 0.0f, 1.0f));
+}
+
+TEST(ParticlesPly, BadFilesAreInputErrorsNamingFileAndProblem) {
+  const fs::path dir = test::temp_dir();
+  const std::string xyz = "element vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"solid cube\nendsolid\n", "not a PLY file"},
+      {"ply\nformat binary_big_endian 1.0\n" + xyz + std::string(24, '\0'), "binary_big_endian is not supported"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n", "no end_header"},
+      {"ply\n" + xyz + "1 2 3 4 5 6\n", "no format line"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n1 2\n",
+       "no scalar property z"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+       "property float nx\nend_header\n1 2 3 4\n",
+       "only some of nx, ny, nz"},
+      {"ply\nformat binary_little_endian 1.0\n" + xyz + std::string(20, '\0'), "truncated"},
+      {"ply\nformat ascii 1.0\n" + xyz + "1 2 3\n4 5\n", "truncated"},
+      {"ply\nformat ascii 1.0\n" + xyz + "1 2 3\n4 five 6\n", "\"five\" in the PLY data is not a number"},
+      {"ply\nformat ascii 1.0\n" + xyz + "1 2 3\n4 nan 6\n", "vertex 1: y is not a finite float"},
+      {"ply\nformat ascii 1.0\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n",
+       "no vertex element"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty quaternion x\nend_header\n", "unknown type"},
+      {"ply\nformat binary_little_endian 1.0\nelement vertex 99999999999\nproperty float x\nproperty float y\n"
+       "property float z\nend_header\n" + std::string(12, '\0'),
+       "truncated"},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const fs::path file = dir / ("bad" + std::to_string(i) + ".ply");
+    write_text(file, cases[i].first);
+    const std::string message = input_error([&] { read_particles_ply(file); });
+    EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+    EXPECT_NE(message.find(cases[i].second), std::string::npos) << "case " << i << ": " << message;
+  }
+  EXPECT_NE(input_error([&] { read_particles_ply(dir / "missing.ply"); }).find("no such file"), std::string::npos);
+}
+
+TEST(ParticleBody, JsonRoundTripKeepsEveryField) {
+  const fs::path dir = test::temp_dir();
+  const ParticleBody body = box_body();
+  const fs::path json = write_body(dir / "out", "box", body);
+  EXPECT_EQ(json, dir / "out" / "box.body.json");
+  EXPECT_TRUE(fs::exists(dir / "out" / "box.particles.ply"));
+  const ParticleBody back = read_body(json);
+  EXPECT_EQ(back.positions, body.positions);
+  EXPECT_EQ(back.normals, body.normals);
+  EXPECT_EQ(back.particle_radius, body.particle_radius);
+  EXPECT_EQ(back.density, body.density);
+  EXPECT_EQ(back.mass, body.mass);
+  EXPECT_EQ(back.volume, body.volume);
+  EXPECT_EQ(back.center_of_mass, body.center_of_mass);
+  EXPECT_EQ(back.inertia, body.inertia);
+  EXPECT_EQ(back.principal_axes, body.principal_axes);
+  EXPECT_EQ(back.principal_moments, body.principal_moments);
+  EXPECT_EQ(back.sdf_voxel_size, body.sdf_voxel_size);
+  EXPECT_EQ(back.source_path, body.source_path);
+  EXPECT_EQ(back.source_sha256, body.source_sha256);
+  EXPECT_EQ(back.quality.relative_radius, body.quality.relative_radius);
+  EXPECT_EQ(back.quality.cv, body.quality.cv);
+  EXPECT_EQ(back.quality.covering_radius, body.quality.covering_radius);
+  EXPECT_EQ(back.quality.covering_over_r, body.quality.covering_over_r);
+  EXPECT_EQ(back.quality.covering_over_r_plus_grain, body.quality.covering_over_r_plus_grain);
+  EXPECT_EQ(back.quality.max_abs_phi_over_r, body.quality.max_abs_phi_over_r);
+  EXPECT_EQ(back.quality.iterations, body.quality.iterations);
+  EXPECT_EQ(back.quality.seconds, body.quality.seconds);
+  EXPECT_EQ(back.quality.converged, body.quality.converged);
+  EXPECT_EQ(back.quality.injection_rounds, body.quality.injection_rounds);
+
+  // Without a grain radius the grain-relative covering ratio is null, and reads back as absent.
+  ParticleBody no_grain = body;
+  no_grain.quality.covering_over_r_plus_grain.reset();
+  const fs::path json2 = write_body(dir, "plain", no_grain);
+  EXPECT_TRUE(nlohmann::json::parse(read_file(json2))["quality"]["covering_over_r_plus_grain"].is_null());
+  EXPECT_FALSE(read_body(json2).quality.covering_over_r_plus_grain.has_value());
+}
+
+TEST(ParticleBody, JsonHasExactlyTheDocumentedKeys) {
+  const fs::path json = write_body(test::temp_dir(), "box", box_body());
+  const auto j = nlohmann::ordered_json::parse(read_file(json));
+  std::vector<std::string> keys, quality_keys;
+  for (const auto& item : j.items()) keys.push_back(item.key());
+  for (const auto& item : j["quality"].items()) quality_keys.push_back(item.key());
+  EXPECT_EQ(keys, (std::vector<std::string>{"format_version", "units", "source", "particle_radius", "particle_count",
+                                            "particles", "density", "mass", "volume", "center_of_mass", "inertia",
+                                            "principal_moments", "principal_axes", "sdf_voxel_size", "quality"}));
+  EXPECT_EQ(quality_keys, (std::vector<std::string>{"relative_radius", "cv", "covering_radius", "covering_over_r",
+                                                    "covering_over_r_plus_grain", "max_abs_phi_over_r", "iterations",
+                                                    "seconds", "converged", "injection_rounds"}));
+  EXPECT_EQ(j["particles"], "box.particles.ply");
+  EXPECT_EQ(j["particle_count"], 300);
+  EXPECT_EQ(j["format_version"], kBodyFormatVersion);
+  EXPECT_EQ(j["units"]["length"], "m");
+  // The box's mass: 2 x 1 x 0.5 m at 1500 kg/m^3.
+  EXPECT_NEAR(j["mass"].get<double>(), 1500.0, 1e-9);
+}
+
+TEST(ParticleBody, ValidationErrorsNameTheFileAndTheKey) {
+  const fs::path dir = test::temp_dir();
+  const fs::path json = write_body(dir, "box", box_body());
+  const auto original = nlohmann::ordered_json::parse(read_file(json));
+  auto error_after = [&](const std::function<void(nlohmann::ordered_json&)>& edit) {
+    auto j = original;
+    edit(j);
+    write_text(json, j.dump(2));
+    return input_error([&] { read_body(json); });
+  };
+  const std::string prefix = json.string() + ": ";
+  EXPECT_EQ(error_after([](auto& j) { j.erase("mass"); }), prefix + "mass: missing");
+  EXPECT_EQ(error_after([](auto& j) { j["quality"].erase("cv"); }), prefix + "quality.cv: missing");
+  EXPECT_EQ(error_after([](auto& j) { j["source"].erase("sha256"); }), prefix + "source.sha256: missing");
+  EXPECT_EQ(error_after([](auto& j) { j["particle_radius"] = -0.1; }), prefix + "particle_radius: must be > 0, not -0.1");
+  EXPECT_EQ(error_after([](auto& j) { j["quality"]["converged"] = 1; }), prefix + "quality.converged: must be true or false");
+  EXPECT_NE(error_after([](auto& j) { j["quality"]["colour"] = "red"; }).find(prefix + "quality.colour: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["format_version"] = 2; }).find(prefix + "format_version: 2 is not supported"),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["units"]["length"] = "mm"; }).find(prefix + "units.length: must be \"m\""),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["mass"] = 1.0; }).find(prefix + "mass: 1 kg differs from density * volume"),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["inertia"][0][1] = 3.0; }).find(prefix + "inertia: must be symmetric"),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["principal_axes"][0] = {2.0, 0.0, 0.0}; }).find(prefix + "principal_axes:"),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["center_of_mass"] = {1.0, 2.0}; }).find(prefix + "center_of_mass: must be an array"),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["particle_count"] = 299; }).find(prefix + "particle_count: 299 but box.particles.ply holds 300"),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["particles"] = "gone.ply"; }).find("gone.ply: no such file"), std::string::npos);
+  write_text(json, "{ not json");
+  EXPECT_NE(input_error([&] { read_body(json); }).find(prefix + "not valid JSON"), std::string::npos);
+}
+
+TEST(ParticleBody, InvalidBodiesAreNotWritten) {
+  const fs::path dir = test::temp_dir();
+  ParticleBody body = box_body();
+  body.mass = 0.0;
+  EXPECT_NE(input_error([&] { write_body(dir, "box", body); }).find("mass: must be finite and > 0"), std::string::npos);
+  body = box_body();
+  body.normals.pop_back();
+  EXPECT_NE(input_error([&] { write_body(dir, "box", body); }).find("299 normals for 300 particles"), std::string::npos);
+  EXPECT_THROW(write_body(dir, "a/b", box_body()), InputError);
+  EXPECT_TRUE(fs::is_empty(dir)) << "neither the PLY nor the JSON of a refused body is written";
+}
+
+TEST(ParticleBody, SimulatorLoadsWhatTheSamplerWrites) {
+  const ParticleBody body = box_body();
+  const sim::ParticleBody loaded = sim::load_particle_body(write_body(test::temp_dir(), "box", body));
+  ASSERT_EQ(loaded.particles.size(), body.positions.size());
+  for (std::size_t i = 0; i < body.positions.size(); ++i) {
+    EXPECT_EQ(loaded.particles[i], body.positions[i].cast<double>());
+  }
+  EXPECT_EQ(loaded.particle_radius, body.particle_radius);
+  EXPECT_EQ(loaded.mass, body.mass);
+  EXPECT_EQ(loaded.center_of_mass, body.center_of_mass);
+  EXPECT_EQ(loaded.inertia, body.inertia);
+}
+
+}  // namespace
+}  // namespace ts::sampler
