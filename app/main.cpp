@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   add(app::add_sdf_command(app, global));
   add(app::add_sample_command(app, global));
   add(app::add_sim_command(app, global));
+  add(app::add_export_command(app, global));
 
   try {
     app.parse(argc, argv);
