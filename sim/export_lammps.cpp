@@ -97,11 +97,24 @@ std::string data_file(const World& w, const std::vector<std::int64_t>& mol, cons
   out += fmt::format("{} atoms\n{} atom types\n\n", x.size(), w.materials.size());
   out += fmt::format("{} {} xlo xhi\n{} {} ylo yhi\n{} {} zlo zhi\n\n", num(box.lo.x()), num(box.hi.x()),
                      num(box.lo.y()), num(box.hi.y()), num(box.lo.z()), num(box.hi.z()));
+  // fix gravity pulls on atom masses: a dynamic body's atom densities are scaled so that its atoms
+  // weigh the body's mass (grains: already so, four full spheres; sampled props overlap).
+  std::vector<double> density_scale(w.bodies.size(), 1.0);
+  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+    if (!is_dynamic(w, b)) continue;
+    double atoms = 0;  // kg
+    for (std::uint32_t k = 0; k < w.bodies.particle_count[b]; ++k) {
+      const std::uint32_t i = w.bodies.first_particle[b] + k;
+      atoms += w.materials[w.particles.material[i]].density * 4.0 / 3.0 * std::numbers::pi *
+               std::pow(w.particles.radius[i], 3);
+    }
+    density_scale[b] = 1.0 / (w.bodies.inverse_mass[b] * atoms);
+  }
   out += "Atoms # sphere: id type diameter density x y z\n\n";
   for (std::size_t i = 0; i < x.size(); ++i) {
     const std::uint16_t m = w.particles.material[i];
-    out += fmt::format("{} {} {} {} {}\n", i + 1, m + 1, num(2 * w.particles.radius[i]), num(w.materials[m].density),
-                       vec(x[i]));
+    const double density = w.materials[m].density * density_scale[w.particles.body[i]];  // kg/m^3
+    out += fmt::format("{} {} {} {} {}\n", i + 1, m + 1, num(2 * w.particles.radius[i]), num(density), vec(x[i]));
   }
   out += "\nMolecules\n\n";
   for (std::size_t i = 0; i < x.size(); ++i) out += fmt::format("{} {}\n", i + 1, mol[w.particles.body[i]]);
@@ -267,6 +280,11 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
     deck.approximations.push_back(
         "cylinder walls: LAMMPS uses the wall's curvature in the effective radius (R* = r R/(R - r) inside a "
         "cylinder of radius R); tetrasand treats walls as flat (R* = r)");
+  }
+  if (std::any_of(scene.props.begin(), scene.props.end(), [](const Prop& p) { return p.motion == MotionType::Dynamic; })) {
+    deck.approximations.push_back(
+        "dynamic props: gravity acts on the atoms (weighted to the body's mass), whose centroid may sit slightly off "
+        "the mesh's centre of mass: a small gravity torque tetrasand does not have");
   }
   if (!pours.empty()) {
     deck.approximations.push_back(
