@@ -1,9 +1,11 @@
 #include "sdf/scan_convert.h"
 
+#include <fmt/format.h>
 #include <openvdb/tools/SignedFloodFill.h>
 
 #include <algorithm>
 #include <chrono>
+#include <iterator>
 #include <optional>
 #include <cmath>
 
@@ -125,36 +127,47 @@ GpuGeometry build_geometry(const TriangleMesh& mesh, const Pseudonormals& normal
   return g;
 }
 
-// Indices (4 per prism, GL_LINES_ADJACENCY) grouped by the block of `block` z-layers they touch.
+// Geometry-shader variants by invocation count (4 layers each): a prism goes to the first variant
+// that covers its layer span, so small triangles (most of a fine mesh, spanning ~2 * margin layers)
+// do not pay for 32 mostly idle invocations. The last is the full draw block (kLayersPerDraw).
+constexpr int kVariantInvocations[] = {4, 32};
+constexpr std::size_t kVariants = std::size(kVariantInvocations);
+static_assert(4 * kVariantInvocations[kVariants - 1] == kLayersPerDraw, "the last variant covers a draw block");
+
+// Indices (4 per prism, GL_LINES_ADJACENCY) grouped by the block of `block` z-layers they touch and,
+// within a block, by variant: list kVariants * b + v holds the block's prisms for variant v.
 struct DrawLists {
   std::vector<std::uint32_t> indices;
-  std::vector<std::size_t> begin;  // block b uses indices[begin[b] .. begin[b+1])
+  std::vector<std::size_t> begin;  // list l uses indices[begin[l] .. begin[l+1])
 };
 
 DrawLists bucket_by_block(const GpuGeometry& g, int dims_z, int block) {
   const int blocks = (dims_z + block - 1) / block;
-  std::vector<std::size_t> counts(static_cast<std::size_t>(blocks) + 1, 0);
+  std::vector<std::size_t> counts(kVariants * static_cast<std::size_t>(blocks) + 1, 0);
   auto block_range = [&](std::uint32_t t) {
     const int lo = std::clamp(static_cast<int>(std::ceil(g.zmin[t])), 0, dims_z - 1);
     const int hi = std::clamp(static_cast<int>(std::floor(g.zmax[t])), 0, dims_z - 1);
     const bool empty = std::floor(g.zmax[t]) < 0 || std::ceil(g.zmin[t]) > dims_z - 1 || hi < lo;
-    return std::tuple{lo / block, hi / block, empty};
+    std::size_t variant = 0;
+    while (variant + 1 < kVariants && hi - lo + 1 > 4 * kVariantInvocations[variant]) ++variant;
+    return std::tuple{lo / block, hi / block, empty, variant};
   };
   for (std::uint32_t t : g.drawn) {
-    auto [b0, b1, empty] = block_range(t);
+    auto [b0, b1, empty, variant] = block_range(t);
     if (!empty)
-      for (int b = b0; b <= b1; ++b) counts[static_cast<std::size_t>(b) + 1] += 4;
+      for (int b = b0; b <= b1; ++b) counts[kVariants * static_cast<std::size_t>(b) + variant + 1] += 4;
   }
   DrawLists lists;
   lists.begin.resize(counts.size());
-  for (std::size_t b = 1; b < counts.size(); ++b) lists.begin[b] = lists.begin[b - 1] + counts[b];
+  for (std::size_t l = 1; l < counts.size(); ++l) lists.begin[l] = lists.begin[l - 1] + counts[l];
   lists.indices.resize(lists.begin.back());
   std::vector<std::size_t> cursor(lists.begin.begin(), lists.begin.end() - 1);
   for (std::uint32_t t : g.drawn) {
-    auto [b0, b1, empty] = block_range(t);
+    auto [b0, b1, empty, variant] = block_range(t);
     if (empty) continue;
     for (int b = b0; b <= b1; ++b)
-      for (std::uint32_t k = 0; k < 4; ++k) lists.indices[cursor[static_cast<std::size_t>(b)]++] = 4 * t + k;
+      for (std::uint32_t k = 0; k < 4; ++k)
+        lists.indices[cursor[kVariants * static_cast<std::size_t>(b) + variant]++] = 4 * t + k;
   }
   return lists;
 }
@@ -262,17 +275,25 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
     throw GpuError("SDF grid " + std::to_string(spec.dims.x()) + " x " + std::to_string(spec.dims.y()) +
                    " exceeds this GPU's largest render target side (" + std::to_string(max_size) + ")");
   }
-  // The prism reaches past the band by one voxel so rounding never loses a band voxel; the fragment
-  // shader drops what lies beyond depth_range.
-  const double margin = options.band + 1.0;
+  // Every voxel with |d| < band lies inside the triangle's prism grown by the band; a quarter voxel
+  // more keeps rounding of the cross-sections (~1e-6 voxel) from losing one, and costs far fewer
+  // fragments than a whole voxel ((4.25/5)^3 for tiny triangles). The fragment shader drops what
+  // lies beyond depth_range.
+  const double margin = options.band + 0.25;
   const GpuGeometry geometry = build_geometry(mesh, normals, spec, margin);
   const int slab_layers = choose_slab_layers(spec, options.max_slab_bytes);
   const int block = std::min(kLayersPerDraw, slab_layers);
   const DrawLists lists = bucket_by_block(geometry, spec.dims.z(), block);
 
   gpu::ShaderLibrary library;
-  gpu::Program program = gpu::Program::graphics(library, "sdf/scan_convert.vert", "sdf/scan_convert.geom",
-                                                "sdf/scan_convert.frag");
+  std::vector<gpu::Program> programs;
+  for (int invocations : kVariantInvocations) {
+    programs.push_back(gpu::Program::graphics(library, "sdf/scan_convert.vert", "sdf/scan_convert.geom",
+                                              "sdf/scan_convert.frag", {"INVOCATIONS " + std::to_string(invocations)}));
+  }
+  std::vector<std::string> timer_names;
+  for (int invocations : kVariantInvocations)
+    timer_names.push_back(fmt::format("sdf/scan_convert ({} GS invocations)", invocations));
   gpu::Buffer triangles = gpu::Buffer::from<SdfTriangle>(geometry.triangles);
   gpu::Buffer prisms = gpu::Buffer::from<SdfPrism>(geometry.prisms);
   gpu::Buffer indices = gpu::Buffer::from<std::uint32_t>(lists.indices);
@@ -310,10 +331,13 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
   glDepthMask(GL_TRUE);
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
-  program.use();
-  program.set("grid_xy", static_cast<float>(spec.dims.x()), static_cast<float>(spec.dims.y()));
-  program.set("slab_layers", slab_layers);
-  program.set("depth_range", static_cast<float>(margin));
+  for (gpu::Program& program : programs) {
+    program.use();
+    program.set("grid_xy", static_cast<float>(spec.dims.x()), static_cast<float>(spec.dims.y()));
+    program.set("slab_layers", slab_layers);
+    program.set("depth_range", static_cast<float>(margin));
+    program.set("draw_layers", block);
+  }
   glBindVertexArray(vao);
 
   const std::size_t layer_voxels = static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y());
@@ -324,17 +348,21 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
     const float clear_depth = 1.0f;
     glClearNamedFramebufferfv(target.framebuffer(), GL_COLOR, 0, clear_value);
     glClearNamedFramebufferfv(target.framebuffer(), GL_DEPTH, 0, &clear_depth);
-    program.set("slab_first_z", z0);
     for (int first = 0; first < layers; first += block) {
-      const std::size_t b = static_cast<std::size_t>((z0 + first) / block);
-      const std::size_t begin = lists.begin[b], end = lists.begin[b + 1];
-      if (begin == end) continue;
-      program.set("draw_first_layer", first);
-      queue.timed("sdf/scan_convert (draw)", [&] {
-        glDrawElements(GL_LINES_ADJACENCY, static_cast<GLsizei>(end - begin), GL_UNSIGNED_INT,
-                       reinterpret_cast<const void*>(begin * sizeof(std::uint32_t)));
-      });
-      ++stats.draws;
+      for (std::size_t variant = 0; variant < kVariants; ++variant) {
+        const std::size_t list = kVariants * static_cast<std::size_t>((z0 + first) / block) + variant;
+        const std::size_t begin = lists.begin[list], end = lists.begin[list + 1];
+        if (begin == end) continue;
+        gpu::Program& program = programs[variant];
+        program.use();
+        program.set("slab_first_z", z0);
+        program.set("draw_first_layer", first);
+        queue.timed(timer_names[variant], [&] {
+          glDrawElements(GL_LINES_ADJACENCY, static_cast<GLsizei>(end - begin), GL_UNSIGNED_INT,
+                         reinterpret_cast<const void*>(begin * sizeof(std::uint32_t)));
+        });
+        ++stats.draws;
+      }
     }
     queue.timed("sdf/readback", [&] {
       glGetTextureSubImage(target.color(), 0, 0, 0, 0, spec.dims.x(), spec.dims.y(), layers, GL_RGBA, GL_FLOAT,

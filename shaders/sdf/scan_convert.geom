@@ -10,7 +10,11 @@
 // draws per slab as the slab has layers. Worst case per layer: a box prism = 6 tetrahedra x 4 vertices.
 #include "common/layouts.h"
 
+// The host compiles two variants: INVOCATIONS 32 for triangles whose prism spans many layers, and
+// INVOCATIONS 4 for the common small ones, so a small triangle does not pay for 28 idle invocations.
+#ifndef INVOCATIONS
 #define INVOCATIONS 32
+#endif
 #define LAYERS_PER_INVOCATION 4
 layout(lines_adjacency, invocations = INVOCATIONS) in;
 layout(triangle_strip, max_vertices = 96) out;
@@ -20,6 +24,7 @@ layout(std430, binding = TS_BINDING_SDF_PRISMS) readonly buffer Prisms { SdfPris
 uniform int slab_first_z;      // grid z index of render-target layer 0
 uniform int slab_layers;       // layers in the render target
 uniform int draw_first_layer;  // first render-target layer this draw covers
+uniform int draw_layers;       // layers this draw covers (at most INVOCATIONS * LAYERS_PER_INVOCATION)
 uniform vec2 grid_xy;          // grid dims along x and y = viewport size
 
 flat in uint v_triangle[];
@@ -87,9 +92,13 @@ void main() {
       zmax = max(zmax, max(lo[i].z, hi[i].z));
     }
   }
-  int first = draw_first_layer + gl_InvocationID * LAYERS_PER_INVOCATION;
-  int layer_lo = max(first, int(ceil(zmin)) - slab_first_z);
-  int layer_hi = min(min(first + LAYERS_PER_INVOCATION - 1, slab_layers - 1), int(floor(zmax)) - slab_first_z);
+  // Invocations start at the prism's own first layer in this draw (not at the draw's first layer):
+  // the host sends a triangle to the variant whose INVOCATIONS cover its span.
+  int start = max(draw_first_layer, int(ceil(zmin)) - slab_first_z);
+  int first = start + gl_InvocationID * LAYERS_PER_INVOCATION;
+  int last = min(min(first + LAYERS_PER_INVOCATION - 1, slab_layers - 1), draw_first_layer + draw_layers - 1);
+  int layer_lo = first;
+  int layer_hi = min(last, int(floor(zmax)) - slab_first_z);
   for (int layer = layer_lo; layer <= layer_hi; ++layer) {
     float z = float(slab_first_z + layer);
     slice_triangular_prism(lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], z, layer);
