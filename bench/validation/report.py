@@ -1,0 +1,232 @@
+#!/usr/bin/python3
+"""docs/validation.md from the CSV files of tetrasand_validation_runs, with PNG plots (matplotlib).
+
+Usage: bench/validation/report.py RUN_DIR DOCS_DIR
+Each section states what the literature expects and whether tetrasand meets it, from the numbers of
+this run (nothing is hard-coded but the literature's values and the tolerances).
+"""
+import os
+import sys
+import time
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+RADIUS = 1e-3  # m, grain sphere radius of every run
+DENSITY = 2600.0  # kg/m^3
+GRAIN_MASS = DENSITY * 4 * 4.0 / 3.0 * np.pi * RADIUS**3  # kg, four full spheres
+D_EQ = 2 * RADIUS * 4 ** (1 / 3)  # m, volume-equivalent sphere diameter of a touching tetrahedral grain
+
+
+def save(fig, docs, name):
+    os.makedirs(os.path.join(docs, "validation"), exist_ok=True)
+    path = os.path.join(docs, "validation", name)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return f"![{name}](validation/{name})"
+
+
+def restitution(run, docs):
+    d = np.genfromtxt(os.path.join(run, "restitution.csv"), delimiter=",", names=True)
+    v, et, eh = d["impact_speed_m_s"], d["e_tsuji"], d["e_thesis"]
+    tsuji_spread = float(np.max(np.abs(et - 0.65)))
+    # Kuwabara & Kono 1987 / Brilliantov 1996: 1 - e ~ v^(1/5) for viscoelastic Hertz (thesis damping).
+    slope = np.polyfit(np.log(v), np.log(1 - eh), 1)[0]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.semilogx(v, et, "o-", label="Tsuji damping")
+    ax.semilogx(v, eh, "s-", label="thesis damping (eq. 3.27)")
+    ax.axhline(0.65, color="grey", ls=":", label="requested e = 0.65")
+    ax.set_xlabel("impact speed (m/s)")
+    ax.set_ylabel("coefficient of restitution")
+    ax.legend()
+    img = save(fig, docs, "restitution.png")
+    ok_t, ok_h = tsuji_spread < 0.005, abs(slope - 0.2) < 0.05
+    return f"""## Restitution against impact speed
+
+One solid sphere (r = 1 mm, E = 10 MPa, requested e = 0.65) hits a smooth wall head on, no gravity,
+200 steps per contact (CPU reference, semi-implicit Euler).
+
+{img}
+
+- Expected: Tsuji damping gives a restitution independent of impact speed (Tsuji et al. 1992);
+  the thesis's viscoelastic damping gives 1 - e growing as v^(1/5) (Kuwabara & Kono 1987;
+  Brilliantov et al. 1996), equal to e at the reference speed 1 m/s.
+- Measured: Tsuji e within {tsuji_spread:.4f} of 0.65 from {v.min():g} to {v.max():g} m/s
+  (**{'meets' if ok_t else 'does not meet'}** it, tolerance 0.005); thesis damping 1 - e ~ v^{slope:.3f}
+  (**{'meets' if ok_h else 'does not meet'}** 0.2 within 0.05).
+"""
+
+
+def repose(run, docs):
+    d = np.genfromtxt(os.path.join(run, "repose.csv"), delimiter=",", names=True)
+    mu, angle = d["mu"], d["angle_deg"]
+    rising = bool(np.all(np.diff(angle[:2]) > 0))
+    saturates = bool(abs(angle[-1] - angle[-2]) < max(3.0, 0.5 * (angle[1] - angle[0])))
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(mu, angle, "o-", label="tetrasand (CPU reference, 400 grains)")
+    ax.set_xlabel("friction coefficient mu")
+    ax.set_ylabel("angle of repose (deg)")
+    ax.legend()
+    img = save(fig, docs, "repose.png")
+    table = "\n".join(f"| {m:g} | {a:.1f} |" for m, a in zip(mu, angle))
+    return f"""## Angle of repose against friction
+
+400 grains poured at 1000 grains/s from a 1.6 cm box 3-6 cm above a rough floor (fixed spheres of the
+grains' size), no side walls, 0.8 s; angle = slope of the heap's surface (highest grain per 2 mm
+ring, fitted between 20 % and 80 % of the heap's height).
+
+{img}
+
+| mu | angle (deg) |
+|---|---|
+{table}
+
+- Expected: the angle rises with sliding friction and levels off above mu ~ 0.5 (Zhou et al. 2002,
+  spheres; non-spherical grains stand steeper through interlocking); thesis ch. 7 reports 30-40 deg
+  for its tetrahedral grains with thousands of grains.
+- Measured: rising from mu = {mu[0]:g} to {mu[1]:g}: **{'yes' if rising else 'no'}**; levelling off
+  at the top: **{'yes' if saturates else 'no'}**. A heap of 400 grains is only a few grains high, so
+  each angle carries several degrees of noise (one run per point); a meaningful curve needs
+  10^4-10^5 grains per heap, a GPU run.
+"""
+
+
+def silo(run, docs):
+    d = np.genfromtxt(os.path.join(run, "silo.csv"), delimiter=",", names=True)
+    rows = []
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
+    for D in np.unique(d["orifice_m"]):
+        s = d[d["orifice_m"] == D]
+        t, n = s["time_s"], s["discharged"]
+        total = n.max()
+        sel = (t >= 0.2) & (n <= 0.7 * 600)  # after the column's first fall, before the silo runs low
+        if sel.sum() < 3:
+            continue
+        rate = np.polyfit(t[sel], n[sel], 1)[0]  # grains/s
+        rows.append((D, rate * GRAIN_MASS, total))
+        ax1.plot(t, n, label=f"D = {D * 1e3:g} mm")
+    ax1.set_xlabel("time (s)")
+    ax1.set_ylabel("grains discharged")
+    ax1.legend()
+    D = np.array([r[0] for r in rows])
+    W = np.array([r[1] for r in rows])
+    # Beverloo W = C rho_b sqrt(g) (D - k d)^(5/2): W^(2/5) is linear in D.
+    a, b = np.polyfit(D, W ** 0.4, 1)
+    k = -b / a / D_EQ
+    rho_b = 0.6 * DENSITY
+    C = a ** 2.5 / (rho_b * np.sqrt(9.81))
+    # Free exponent with k fixed at the fitted value.
+    n_exp = np.polyfit(np.log(D - k * D_EQ), np.log(W), 1)[0] if np.all(D > k * D_EQ) else float("nan")
+    Dfit = np.linspace(D.min() * 0.9, D.max() * 1.1, 50)
+    ax2.plot(D * 1e3, W * 1e3, "o", label="tetrasand")
+    ax2.plot(Dfit * 1e3, np.clip(a * Dfit + b, 0, None) ** 2.5 * 1e3, "-", label=f"Beverloo fit, k = {k:.2f}")
+    ax2.set_xlabel("orifice diameter D (mm)")
+    ax2.set_ylabel("discharge rate W (g/s)")
+    ax2.legend()
+    img = save(fig, docs, "silo.png")
+    width = 0.040
+    cond1 = width > 2.5 * D.max()
+    cond2 = width > D.max() + 30 * D_EQ
+    table = "\n".join(f"| {x * 1e3:g} | {w * 1e3:.2f} | {int(t)} |" for x, w, t in rows)
+    return f"""## Silo discharge against orifice diameter (Beverloo)
+
+A flat-bottomed silo: smooth cylinder of 40 mm diameter, rough plate with a round orifice, 600
+grains (d = {D_EQ * 1e3:.2f} mm volume-equivalent) released as a column at t = 0, 0.6 s; rate fitted
+from t = 0.2 s (after the column's first fall) while fewer than 70 % of the grains had left.
+
+{img}
+
+| D (mm) | W (g/s) | grains out |
+|---|---|---|
+{table}
+
+- Expected: W = C rho_b sqrt(g) (D - k d)^(5/2) with C ~ 0.58 and k ~ 1.5 for spheres (Beverloo et al.
+  1961); Mankoc et al. 2007 show the 5/2 law holds only when the silo is wider than 2.5 D and D + 30 d
+  and filled above 1.2 widths.
+- Measured: with the exponent fixed at 5/2, k = {k:.2f} and C = {C:.2f} (taking rho_b = 0.6 rho);
+  with k fixed there, the free exponent is {n_exp:.2f}.
+- Honestly: this silo does **not** meet Mankoc's conditions (width > 2.5 D: {'yes' if cond1 else 'no'};
+  width > D + 30 d = {(D.max() + 30 * D_EQ) * 1e3:.0f} mm: {'yes' if cond2 else 'no'}; the 600 grains
+  fill it about 2 widths at the start and drain below 1.2 widths while the rate is measured), and
+  three orifices at 4-6 grain diameters cannot test an exponent. The rate does grow with D as the
+  law says; testing 5/2 needs a silo of 10^5 grains (width 10 cm, D from 5 to 20 d), a GPU run.
+"""
+
+
+def forces(run, docs):
+    f = np.loadtxt(os.path.join(run, "contact_forces.csv"), skiprows=1)
+    f = f[f > 0]
+    fn = f / f.mean()
+    bins = np.linspace(0, fn.max(), 30)
+    hist, edges = np.histogram(fn, bins=bins, density=True)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    tail = (centres > 1) & (hist > 0)
+    beta = -np.polyfit(centres[tail], np.log(hist[tail]), 1)[0]
+    # exp(-c f^alpha): log(-log(P/P0)) is linear in log f; P0 from the fit of the exponential.
+    def sse(alpha):
+        x = centres[tail] ** alpha
+        p = np.polyfit(x, np.log(hist[tail]), 1)
+        return np.sum((np.polyval(p, x) - np.log(hist[tail])) ** 2), p
+    alphas = np.linspace(0.5, 3.0, 51)
+    errors = [sse(a)[0] for a in alphas]
+    alpha = alphas[int(np.argmin(errors))]
+    e_exp, p_exp = sse(1.0)
+    e_gauss, p_gauss = sse(2.0)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.semilogy(centres[hist > 0], hist[hist > 0], "o", label=f"tetrasand, {len(f)} contacts")
+    x = np.linspace(1, fn.max(), 50)
+    ax.semilogy(x, np.exp(np.polyval(p_exp, x)), "-", label=f"exponential tail, beta = {beta:.2f}")
+    ax.semilogy(x, np.exp(np.polyval(p_gauss, x ** 2)), "--", label="Gaussian tail")
+    ax.set_xlabel("f = F_n / <F_n>")
+    ax.set_ylabel("P(f)")
+    ax.legend()
+    img = save(fig, docs, "contact_forces.png")
+    faster = alpha > 1.0
+    return f"""## Normal contact forces in a resting pile (thesis 7.2)
+
+The grain-grain and grain-floor particle contacts of the mu = 0.5 heap at rest, normal force
+magnitudes over their mean.
+
+{img}
+
+- Expected: a plateau or peak near f = 1 and a tail for f > 1 that is exponential, P ~ exp(-beta f) with
+  beta ~ 1.5 (Mueth, Jaeger & Nagel 1998), or falls faster, Gaussian-like exp(-c f^2) (van Eerd et al.
+  2007, thesis table 7.2) once there are enough contacts.
+- Measured: exponential tail beta = {beta:.2f}; best tail exponent alpha = {alpha:.2f} in exp(-c f^alpha)
+  (squared log residuals: exponential {e_exp:.2f}, Gaussian {e_gauss:.2f}). Tail falls at least as fast as
+  an exponential: **{'yes' if faster else 'no'}**. With {len(f)} contacts the tail holds few forces above
+  f = 3; the thesis's distributions came from 10^4-10^5 grains.
+"""
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    run, docs = sys.argv[1], sys.argv[2]
+    parts = [restitution(run, docs), repose(run, docs), silo(run, docs), forces(run, docs)]
+    header = f"""# Physical validation
+
+Produced by `scripts/bench.sh validation` ({time.strftime('%Y-%m-%d')}, {os.cpu_count()} CPU cores, CPU
+reference in double precision; no GPU was used). Each run is sized to finish in about a minute on two
+shared cores, which is far below the grain counts the literature's laws are stated for; each section says
+what the small run can and cannot show. Tetrahedral grains of four touching spheres, r = 1 mm, quartz
+density; E = 1 MPa in the scene runs (a soft sand keeps the time step near 40 us).
+
+Not run here: column-collapse runout against aspect ratio (Lube et al. 2004, Lajeunesse et al. 2004:
+runout ~ a for a < 3, ~ a^(2/3) above) needs tens of thousands of grains per column and a real GPU
+(`tetrasand sim` on the GPU pipeline); at a few hundred grains the column is a few grains wide and the
+exponents are not there to find.
+"""
+    text = header + "\n" + "\n".join(parts)
+    path = os.path.join(docs, "validation.md")
+    open(path + ".tmp", "w").write(text)
+    os.replace(path + ".tmp", path)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
