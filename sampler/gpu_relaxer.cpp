@@ -56,22 +56,28 @@ void GpuRelaxer::project(std::uint32_t count, int steps) {
 }
 
 RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const RelaxSettings& settings,
-                             const std::function<void(int, std::size_t, double)>& progress) {
+                             const std::function<void(int, std::size_t, double)>& progress,
+                             std::vector<std::uint8_t>* mobile) {
   if (!(settings.spacing > 0.0)) throw InputError("sampler spacing must be positive");
+  if (mobile && mobile->size() != positions.size()) throw Error(ExitCode::Internal, "relax: mobile mask size");
   const double sigma = settings.sigma_over_spacing * settings.spacing;
   const double cutoff = sigma * std::sqrt(2.0 * std::log(1.0 / settings.kernel_epsilon));
   RelaxStats stats;
   auto upload = [&] {
     const std::size_t n = std::max<std::size_t>(positions.size(), 1);
     std::vector<Eigen::Vector4f> packed(n, Eigen::Vector4f::Zero());
-    for (std::size_t i = 0; i < positions.size(); ++i) packed[i] << positions[i], 0.0f;
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+      packed[i] << positions[i], (mobile == nullptr || (*mobile)[i]) ? 1.0f : 0.0f;
+    }
     if (positions_[0].bytes() < n * 16) {
       positions_[0] = gpu::Buffer(n * 16);
       positions_[1] = gpu::Buffer(n * 16);
+      velocities_ = gpu::Buffer(n * 16);
       step_info_ = gpu::Buffer(n * 16);
       partials_ = gpu::Buffer(((n + 255) / 256) * 16);
     }
     positions_[0].upload(packed.data(), n * 16);
+    velocities_.fill_zero();
   };
   auto download = [&](std::uint32_t count) {
     const auto packed = positions_[0].read<Eigen::Vector4f>(count);
@@ -84,6 +90,7 @@ RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const Rela
   relax_.set("cell_size", static_cast<float>(cutoff));
   relax_.set("inv_two_sigma2", static_cast<float>(1.0 / (2.0 * sigma * sigma)));
   relax_.set("repulsion_gain", static_cast<float>(settings.repulsion_gain));
+  relax_.set("momentum", static_cast<float>(settings.momentum));
   relax_.set("max_move", static_cast<float>(settings.max_move_over_cell * cutoff));
   relax_.set("band_limit", static_cast<float>(settings.band_limit));
   while (stats.iterations < settings.max_iterations && count > 0) {
@@ -91,6 +98,7 @@ RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const Rela
     positions_[0].bind(0);
     positions_[1].bind(1);
     grid_.bind();
+    velocities_.bind(3);
     step_info_.bind(6);
     bind_sdf(relax_);
     relax_.set("count", count);
@@ -105,19 +113,23 @@ RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const Rela
     reduce_.set("count", count);
     queue_.dispatch_items(reduce_, count);
     const auto partials = partials_.read<Eigen::Vector4f>((count + 255) / 256);
-    double moved = 0.0, outside = 0.0;
-    for (const auto& p : partials) moved += p.x(), outside += p.z();
-    stats.mean_move_over_spacing = moved / count / settings.spacing;
+    double moved = 0.0, outside = 0.0, moving = 0.0;
+    for (const auto& p : partials) moved += p.x(), outside += p.z(), moving += p.w();
+    stats.mean_move_over_spacing = moving > 0.0 ? moved / moving / settings.spacing : 0.0;
     if (progress) progress(stats.iterations, count, stats.mean_move_over_spacing);
     if (outside > 0.0) {
       // Drop particles that left the band (rare: seeds start on the surface), on the CPU.
       const auto info = step_info_.read<Eigen::Vector4f>(count);
       download(count);
       std::size_t kept = 0;
-      for (std::uint32_t i = 0; i < count; ++i)
-        if (info[i].z() == 0.0f) positions[kept++] = positions[i];
+      for (std::uint32_t i = 0; i < count; ++i) {
+        if (info[i].z() != 0.0f) continue;
+        if (mobile) (*mobile)[kept] = (*mobile)[i];
+        positions[kept++] = positions[i];
+      }
       stats.removed += count - kept;
       positions.resize(kept);
+      if (mobile) mobile->resize(kept);
       upload();
       count = static_cast<std::uint32_t>(kept);
     }

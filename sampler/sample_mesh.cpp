@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -12,6 +13,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mass_properties.h"
+#include "sampler/point_grid.h"
 #include "sampler/sampling_quality.h"
 #include "sampler/surface_points.h"
 #include "sdf/exact_sdf.h"
@@ -93,6 +95,56 @@ sdf::GridSpec choose_grid(const TriangleMesh& mesh, double radius, const SampleS
   }
 }
 
+// After an injection, the particles within `radius` of a new one move, the others are frozen; the new
+// ones (appended after `particles`) move too.
+constexpr double kMobileRadiusOverSpacing = 2.5;
+constexpr int kLocalIterations = 200;
+std::vector<std::uint8_t> mobile_near_injections(const std::vector<Eigen::Vector3d>& particles,
+                                                 const std::vector<UncoveredPoint>& holes, double radius) {
+  std::vector<Eigen::Vector3d> injected;
+  for (const auto& h : holes) injected.push_back(h.position);
+  const PointGrid grid(injected, radius);
+  std::vector<std::uint8_t> mobile(particles.size() + holes.size(), 1);
+  tbb::parallel_for(std::size_t{0}, particles.size(), [&](std::size_t i) {
+    mobile[i] = grid.nearest(particles[i]).distance <= radius ? 1 : 0;
+  });
+  return mobile;
+}
+
+// Redundant particles: where a feature is thinner than a voxel (an ear tip, a blade) the smoothed
+// field has no zero level set and relaxed particles collect in its sink, and the exact projection can
+// put two onto one vertex. Of each pair closer than `min_distance` [m] the later one is dropped
+// (greedy, in index order: deterministic); the coverage measurement that follows re-injects a particle
+// wherever that opened a hole, at least r from every other one.
+constexpr double kCrowdedOverSpacing = 0.6;
+std::size_t drop_crowded(std::vector<Eigen::Vector3d>& particles, std::vector<Eigen::Vector3d>& normals,
+                         double min_distance) {
+  if (particles.size() < 2) return 0;
+  const PointGrid grid(particles, min_distance);
+  std::vector<std::uint8_t> crowded(particles.size(), 0);
+  tbb::parallel_for(std::size_t{0}, particles.size(), [&](std::size_t i) {
+    crowded[i] = grid.nearest(particles[i], i).distance < min_distance ? 1 : 0;
+  });
+  // Only crowded particles can be dropped; a crowded one survives when no kept particle is too close.
+  std::vector<std::size_t> kept_crowded;
+  std::size_t out = 0;
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    if (crowded[i]) {
+      bool clash = false;
+      for (const std::size_t k : kept_crowded) clash = clash || (particles[k] - particles[i]).norm() < min_distance;
+      if (clash) continue;
+      kept_crowded.push_back(out);
+    }
+    particles[out] = particles[i];
+    normals[out] = normals[i];
+    ++out;
+  }
+  const std::size_t dropped = particles.size() - out;
+  particles.resize(out);
+  normals.resize(out);
+  return dropped;
+}
+
 std::vector<Eigen::Vector3f> to_local(const std::vector<Eigen::Vector3d>& world, const Eigen::Vector3d& origin) {
   std::vector<Eigen::Vector3f> out;
   out.reserve(world.size());
@@ -157,7 +209,7 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   std::mt19937_64 rng(settings.seed);
   std::vector<Eigen::Vector3d> particles = sample_surface_points(mesh, z.count, rng).positions;
 
-  // 3-4. Relax, project, measure coverage, inject, repeat.
+  // 3-4. Relax, project, measure coverage, inject, relax locally, repeat.
   GpuRelaxer relaxer(context, field.dense, settings.timings);
   RelaxSettings relax = settings.relax;
   relax.spacing = z.spacing;
@@ -166,28 +218,37 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   int iterations = 0, rounds = 0;
   bool converged = true;
   std::vector<Eigen::Vector3d> particle_normals;
+  std::vector<std::uint8_t> mobile(particles.size(), 1);
   CoverageResult coverage;
   for (;;) {
     std::vector<Eigen::Vector3f> local = to_local(particles, spec.origin);
     const RelaxStats stats = relaxer.relax(local, relax, [&](int it, std::size_t n, double residual) {
       if (progress) progress({rounds, iterations + it, n, residual});
-    });
+    }, &mobile);
     iterations += stats.iterations;
-    converged = stats.converged;
-    // After the first relaxation only the injected particles and their neighbours need to settle.
-    relax.max_iterations = std::min(relax.max_iterations, 300);
+    converged = converged && stats.converged;
+    log::debug("sampler round {}: {} iterations, residual {:.3g}, {} of {} particles mobile", rounds, stats.iterations,
+               stats.mean_move_over_spacing, std::count(mobile.begin(), mobile.end(), 1), mobile.size());
     particles.clear();
     for (const auto& p : local) particles.push_back(p.cast<double>() + spec.origin);
     project_exactly(exact, particles, particle_normals);
+    const std::size_t dropped = drop_crowded(particles, particle_normals, kCrowdedOverSpacing * z.spacing);
+    if (dropped > 0) log::debug("sampler round {}: dropped {} crowded particles", rounds, dropped);
     CoverageSettings probe;
     probe.probes = settings.probes;
     probe.seed = settings.seed + 1000u * static_cast<unsigned>(rounds + 1);
-    probe.worst_k = std::max<std::size_t>(1, particles.size() / 50);
+    probe.worst_k = std::max<std::size_t>(1, particles.size() / 10);
     probe.min_depth = target;  // only real holes
     coverage = measure_coverage(mesh, std::span<const Eigen::Vector3d>(particles), probe);
+    log::debug("sampler round {}: covering radius {:.4f} r, {} holes deeper than the target", rounds,
+               coverage.covering_radius / z.radius, coverage.worst.size());
     if (coverage.covering_radius <= target || rounds >= settings.max_rounds) break;
-    // Inject at the worst uncovered surface points (already on the surface), then relax again.
+    // Inject at the worst uncovered surface points (already on the surface); only they and the
+    // particles near them relax again, so the rest of the arrangement (and its holes, already
+    // measured) stays as it is.
+    mobile = mobile_near_injections(particles, coverage.worst, kMobileRadiusOverSpacing * z.spacing);
     for (const auto& hole : coverage.worst) particles.push_back(hole.position);
+    relax.max_iterations = std::min(relax.max_iterations, kLocalIterations);
     ++rounds;
   }
   if (coverage.covering_radius > target) {

@@ -1,6 +1,7 @@
 #version 450
-// Convergence reduction: per work group, the sum of |move|, the largest |phi| and the count of
-// particles outside the band. The host adds the partials in order (deterministic, no float atomics).
+// Convergence reduction: per work group, the sum of the gradient steps of the mobile particles, the
+// largest |phi|, the count of particles outside the band and the count of mobile particles. The host
+// adds the partials in order (deterministic, no float atomics).
 layout(local_size_x = 256) in;
 layout(std430, binding = 6) readonly buffer StepInfo { vec4 step_info[]; };
 layout(std430, binding = 7) writeonly buffer Partials { vec4 partials[]; };
@@ -8,13 +9,12 @@ uniform uint count;
 shared vec4 scratch[256];
 void main() {
   uint i = gl_GlobalInvocationID.x, t = gl_LocalInvocationID.x;
-  vec4 v = i < count ? step_info[i] : vec4(0.0);
-  scratch[t] = vec4(v.x, v.y, v.z, 0.0);
+  scratch[t] = i < count ? step_info[i] : vec4(0.0);
   for (uint stride = 128u; stride > 0u; stride >>= 1u) {
     barrier();
     if (t < stride) {
       vec4 a = scratch[t], b = scratch[t + stride];
-      scratch[t] = vec4(a.x + b.x, max(a.y, b.y), a.z + b.z, 0.0);
+      scratch[t] = vec4(a.x + b.x, max(a.y, b.y), a.z + b.z, a.w + b.w);
     }
   }
   if (t == 0u) partials[gl_WorkGroupID.x] = scratch[0];

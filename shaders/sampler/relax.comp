@@ -3,7 +3,16 @@
 // One relaxation step of the repulsion sampler (thesis 6.3; Witkin & Heckbert 1994; Bell et al. 2005):
 // each particle moves by -phi grad(phi) (to the zero level set) plus Gaussian repulsion from the
 // neighbours in the 27 surrounding cells, projected onto the tangent plane so that repulsion spreads
-// particles over the surface instead of pushing them off it. Positions ping-pong between two buffers.
+// particles over the surface instead of pushing them off it.
+//
+// The tangential part is gradient descent on the repulsion energy with heavy-ball momentum (Polyak
+// 1964): v <- beta v + gain F_t, kept tangential. Plain descent crawls on the long-wavelength modes of
+// a large arrangement (their stiffness falls like (spacing / wavelength)^2); momentum speeds them up by
+// 1 / (1 - beta) while the stiff short modes stay stable (gain * stiffness < 2 (1 + beta)). The
+// attraction -phi n is not accumulated, so nothing overshoots across the surface.
+//
+// positions.w = 1 marks a mobile particle; 0 a frozen one, which still repels but does not move (the
+// local re-relaxation after an injection moves only the particles near the new ones).
 #include "common/hash_grid.glsl"
 #include "sampler/sdf_sample.glsl"
 
@@ -11,26 +20,24 @@ layout(local_size_x = 128) in;
 layout(std430, binding = 0) readonly buffer PositionsIn { vec4 p_in[]; };
 layout(std430, binding = 1) writeonly buffer PositionsOut { vec4 p_out[]; };
 layout(std430, binding = 2) readonly buffer CellCount { uint cell_count[]; };
+layout(std430, binding = 3) buffer Velocities { vec4 velocity[]; };  // xyz: momentum step [m], own entry only
 layout(std430, binding = 4) readonly buffer CellStart { uint cell_start[]; };
 layout(std430, binding = 5) readonly buffer Sorted { uint sorted_ids[]; };
-layout(std430, binding = 6) writeonly buffer StepInfo { vec4 step_info[]; };  // x: |move| [m], y: |phi| [m], z: 1 if outside the band
+// x: |tangential gradient step| [m] (the residual; 0 if frozen; the normal term is left out because
+// hardware trilinear filtering quantises phi to a fraction of a voxel, a floor that says nothing about
+// the arrangement, and the exact projection fixes the normal position afterwards), y: |phi| [m], z: 1 if outside the band, w: 1 if mobile
+layout(std430, binding = 6) writeonly buffer StepInfo { vec4 step_info[]; };
 
 uniform uint count;
 uniform float cell_size;       // = repulsion cutoff [m]
 uniform uint table_size;
 uniform float inv_two_sigma2;  // 1 / (2 sigma^2) [1/m^2]
 uniform float repulsion_gain;  // dimensionless step on the kernel sum
+uniform float momentum;        // beta in [0, 1)
 uniform float max_move;        // CFL guard: at most this far per step [m]
 uniform float band_limit;      // |phi| beyond which a particle has left the band [m]
 
-void main() {
-  uint i = gl_GlobalInvocationID.x;
-  if (i >= count) return;
-  vec3 p = p_in[i].xyz;
-  vec4 s = sample_sdf(p);
-  vec3 n = s.xyz;
-  float phi = s.w;
-
+vec3 repulsion_at(uint i, vec3 p) {
   ivec3 c = cell_of_position(p, cell_size);
   float cutoff2 = cell_size * cell_size;
   vec3 repulsion = vec3(0.0);
@@ -51,13 +58,45 @@ void main() {
           if (j == i) continue;
           vec3 x = p - p_in[j].xyz;
           float d2 = dot(x, x);
+          // Coincident particles feel no Gaussian force (x = 0): part them along a fixed axis, the
+          // lower id one way and the higher the other; the tangential projection below keeps it on the surface.
+          if (d2 == 0.0) x = (i < j ? 1e-3 : -1e-3) * cell_size * vec3(0.6, 0.48, 0.64);
           if (d2 < cutoff2) repulsion += exp(-d2 * inv_two_sigma2) * x;
         }
       }
-  repulsion -= dot(repulsion, n) * n;
-  vec3 move = repulsion_gain * repulsion - phi * n;
+  return repulsion;
+}
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  vec4 pw = p_in[i];
+  vec3 p = pw.xyz;
+  vec4 s = sample_sdf(p);
+  vec3 n = s.xyz;
+  float phi = s.w;
+  bool outside = abs(phi) >= band_limit;
+  if (pw.w == 0.0) {
+    p_out[i] = pw;
+    step_info[i] = vec4(0.0, abs(phi), outside ? 1.0 : 0.0, 0.0);
+    return;
+  }
+  vec3 f = repulsion_at(i, p);
+  f = repulsion_gain * (f - dot(f, n) * n);
+  // Adaptive restart (O'Donoghue & Candes 2015, per particle): momentum that points against the
+  // force is dropped. Without it a particle that flips sides of a feature thinner than a voxel (the
+  // tangent plane turning over from step to step) or one squeezed against frozen neighbours rings
+  // instead of settling.
+  vec3 v_old = velocity[i].xyz;
+  vec3 v = (dot(v_old, f) > 0.0 ? momentum * v_old : vec3(0.0)) + f;
+  v -= dot(v, n) * n;
+  vec3 move = v - phi * n;
   float length_move = length(move);
-  if (length_move > max_move) move *= max_move / length_move;
-  p_out[i] = vec4(p + move, 0.0);
-  step_info[i] = vec4(min(length_move, max_move), abs(phi), abs(phi) >= band_limit ? 1.0 : 0.0, 0.0);
+  if (length_move > max_move) {
+    move *= max_move / length_move;
+    v *= max_move / length_move;
+  }
+  velocity[i] = vec4(v, 0.0);
+  p_out[i] = vec4(p + move, 1.0);
+  step_info[i] = vec4(length(f), abs(phi), outside ? 1.0 : 0.0, 1.0);
 }
