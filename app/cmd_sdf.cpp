@@ -24,21 +24,6 @@
 namespace ts::app {
 namespace {
 
-// Re-signs the band voxels by the generalised winding number (robust where the mesh has holes),
-// then floods the signs outward again.
-void resign_by_winding_number(openvdb::FloatGrid& grid, const sdf::ExactDistance& exact) {
-  std::vector<std::pair<openvdb::Coord, float>> voxels;
-  for (auto it = grid.cbeginValueOn(); it; ++it) voxels.emplace_back(it.getCoord(), *it);
-  tbb::parallel_for(std::size_t{0}, voxels.size(), [&](std::size_t i) {
-    const openvdb::Vec3d p = grid.indexToWorld(voxels[i].first);
-    const bool inside = exact.winding_number({p.x(), p.y(), p.z()}) >= 0.5;
-    voxels[i].second = inside ? -std::abs(voxels[i].second) : std::abs(voxels[i].second);
-  });
-  auto accessor = grid.getAccessor();
-  for (const auto& [coord, value] : voxels) accessor.setValue(coord, value);
-  openvdb::tools::signedFloodFill(grid.tree());
-}
-
 }  // namespace
 
 Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
@@ -114,7 +99,7 @@ Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
     if (terminal) std::fprintf(stderr, "\n");
     std::unique_ptr<sdf::ExactDistance> exact;
     if (winding || o->compare) exact = std::make_unique<sdf::ExactDistance>(mesh);
-    if (winding) resign_by_winding_number(*result.grid, *exact);
+    if (winding) sdf::resign_by_winding_number(*result.grid, *exact);
 
     const std::map<std::string, std::string> metadata{
         {"tetrasand:source", o->mesh},

@@ -192,6 +192,21 @@ openvdb::FloatGrid::Ptr exact_sdf_grid(const TriangleMesh& mesh, const GridSpec&
   return grid;
 }
 
+void resign_by_winding_number(openvdb::FloatGrid& grid, const ExactDistance& exact) {
+  std::vector<std::pair<openvdb::Coord, float>> voxels;
+  voxels.reserve(grid.activeVoxelCount());
+  for (auto it = grid.cbeginValueOn(); it; ++it) voxels.emplace_back(it.getCoord(), *it);
+  tbb::parallel_for(std::size_t{0}, voxels.size(), [&](std::size_t i) {
+    const openvdb::Vec3d p = grid.indexToWorld(voxels[i].first);
+    const bool inside = std::abs(exact.winding_number({p.x(), p.y(), p.z()})) >= 0.5;
+    voxels[i].second = inside ? -std::abs(voxels[i].second) : std::abs(voxels[i].second);
+  });
+  // OpenVDB trees are not safe to write from several threads.
+  auto accessor = grid.getAccessor();
+  for (const auto& [coord, value] : voxels) accessor.setValue(coord, value);
+  openvdb::tools::signedFloodFill(grid.tree());
+}
+
 std::vector<float> exact_sdf_dense(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels,
                                    SignMethod sign) {
   const auto grid = exact_sdf_grid(mesh, spec, band_voxels, sign);

@@ -58,6 +58,12 @@ class ExactDistance {
 openvdb::FloatGrid::Ptr exact_sdf_grid(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels,
                                        SignMethod sign);
 
+// Re-signs every active voxel of a level set (world units) by the generalised winding number of
+// `exact`'s mesh, |w| >= 1/2 inside, and floods the signs outward again (OpenVDB signedFloodFill):
+// the sign method for open meshes, where pseudonormals are wrong next to the holes. Distances are
+// kept. TBB-parallel over the voxels.
+void resign_by_winding_number(openvdb::FloatGrid& grid, const ExactDistance& exact);
+
 // The same field, every voxel of `spec` (spec.linear_index order), clamped to +-band * h [m]: the
 // flood-filled level set read back densely, for comparisons with sdf::DenseSdf.
 std::vector<float> exact_sdf_dense(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels,

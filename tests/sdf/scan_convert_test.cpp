@@ -8,6 +8,7 @@
 #include <map>
 
 #include "gpu/context.h"
+#include "sdf/grid.h"
 #include "sdf/pseudonormals.h"
 #include "tests/test_meshes.h"
 
@@ -119,6 +120,53 @@ TEST_F(ScanConvert, CubeBandIsCompleteAndExactToAThousandthVoxel) {
   EXPECT_EQ(a.sign_errors, 0u);
   EXPECT_LE(a.max_error_voxels, 1e-3);
   EXPECT_EQ(result.stats.band_voxels, a.band_voxels);
+}
+
+// Signed distance to the axis-aligned box [-r, r]^3 (exact, closed form) [same units as p].
+double box_distance(const Eigen::Vector3d& p, double r) {
+  const Eigen::Vector3d q = p.cwiseAbs() - Eigen::Vector3d::Constant(r);
+  return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+}
+
+TEST_F(ScanConvert, TwelveTriangleCubeAt512CubedIsExact) {
+  // Each triangle spans ~520 layers of a 523^3 grid: many draws and slabs per triangle. Small slabs
+  // (~12 layers) keep host memory for the readback low; every voxel is checked in closed form.
+  const TriangleMesh cube = box_mesh({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
+  ASSERT_EQ(cube.triangle_count(), 12u);
+  SdfSettings settings;
+  settings.resolution = 512;
+  const GridSpec spec = make_grid(bounding_box(cube), settings);
+  ASSERT_GE(spec.dims.minCoeff(), 512);
+  ScanConvertOptions options;
+  options.max_slab_bytes = std::size_t{64} << 20;
+  const auto result = run(cube, spec, options);
+  EXPECT_GT(result.stats.slabs, 20);
+  const double band = options.band;
+  auto acc = result.grid->getConstAccessor();
+  std::size_t band_voxels = 0, holes = 0, sign_errors = 0;
+  double worst = 0.0;
+  for (int k = 0; k < spec.dims.z(); ++k)
+    for (int j = 0; j < spec.dims.y(); ++j)
+      for (int i = 0; i < spec.dims.x(); ++i) {
+        const double exact = box_distance(spec.voxel_center(i, j, k), 0.5) / spec.voxel_size;
+        const openvdb::Coord c(spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k);
+        float value = 0.0f;
+        const bool on = acc.probeValue(c, value);
+        const double gpu = value / spec.voxel_size;
+        if (std::abs(exact) < band - 1e-3) {
+          ++band_voxels;
+          if (!on) {
+            ++holes;
+            continue;
+          }
+          worst = std::max(worst, std::abs(gpu - exact));
+        }
+        if (std::abs(exact) > 1e-3 && (gpu < 0) != (exact < 0)) ++sign_errors;
+      }
+  EXPECT_GT(band_voxels, 6u * 512u * 512u * 5u);
+  EXPECT_EQ(holes, 0u);
+  EXPECT_EQ(sign_errors, 0u);
+  EXPECT_LE(worst, 1e-3);
 }
 
 TEST_F(ScanConvert, LongTrianglesSpanningHundredsOfLayersComeOutExact) {
