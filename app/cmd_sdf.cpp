@@ -22,9 +22,6 @@
 #include "sdf/vdb_io.h"
 
 namespace ts::app {
-namespace {
-
-}  // namespace
 
 Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
   auto* cmd = app.add_subcommand("sdf", "Narrow-band signed distance field by GPU scan conversion (OpenVDB level set)");
@@ -81,6 +78,11 @@ Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
     settings.band = o->band;
     settings.padding = o->padding;
     const sdf::GridSpec spec = sdf::make_grid(bounding_box(mesh), settings);
+    if (o->padding >= 0 && o->padding < o->band) {
+      log::warn("{}: --padding {} is below the band half-width {}: the band is cut where the mesh comes within {} "
+                "voxels of the grid border",
+                o->mesh, o->padding, o->band, o->band);
+    }
 
     gpu::ContextOptions context_options;
     context_options.device = global.device;
@@ -90,9 +92,17 @@ Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
     scan.band = o->band;
     scan.timings = o->timings;
     scan.max_slab_bytes = static_cast<std::size_t>(o->slab_mb * 1048576.0);
+    // Progress: a live line on a terminal; otherwise (logs, CI) a line per tenth of a grid that takes
+    // several slabs, so a long run shows it is alive.
     const bool terminal = ::isatty(STDERR_FILENO) != 0;
+    int reported_tenths = 0;
     scan.progress = [&](double done) {
-      if (terminal) std::fprintf(stderr, "\rscan conversion %5.1f %%", 100.0 * done);
+      if (terminal) {
+        std::fprintf(stderr, "\rscan conversion %5.1f %%", 100.0 * done);
+      } else if (done < 1.0 && static_cast<int>(10.0 * done) > reported_tenths) {
+        reported_tenths = static_cast<int>(10.0 * done);
+        log::info("scan conversion {:.0f} %", 100.0 * done);
+      }
     };
     const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
     sdf::ScanConvertResult result = sdf::scan_convert(context, mesh, normals, spec, scan);
@@ -121,9 +131,15 @@ Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
                  st.layers_per_slab, st.draws, st.peak_gpu_bytes / 1048576.0, st.seconds, st.timing_report);
     }
     if (o->compare) {
+      auto lap = std::chrono::steady_clock::now();
       const auto exact_grid = sdf::exact_sdf_grid(mesh, spec, o->band, winding ? sdf::SignMethod::Winding
                                                                                : sdf::SignMethod::Pseudonormal);
+      const double exact_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lap).count();
+      lap = std::chrono::steady_clock::now();
       const auto vdb = sdf::openvdb_level_set(mesh, spec.voxel_size, o->band);
+      const double vdb_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lap).count();
+      fmt::print("times: tetrasand GPU {:.3f} s, CPU exact {:.3f} s, OpenVDB meshToLevelSet {:.3f} s\n", st.seconds,
+                 exact_seconds, vdb_seconds);
       const double band_world = o->band * spec.voxel_size;
       fmt::print("{}", sdf::format_comparison(sdf::compare_grids(*result.grid, *exact_grid, spec.voxel_size, band_world),
                                               sdf::compare_grids(*vdb, *exact_grid, spec.voxel_size, band_world),

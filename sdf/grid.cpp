@@ -41,9 +41,12 @@ GridSpec make_grid(const Aabb& box, const SdfSettings& s) {
   if (voxels > static_cast<double>(s.max_voxels) || dims.maxCoeff() > 2e9) {
     // dims scale as 1/h: the smallest h that fits makes the product equal to the cap.
     const double smallest = h * std::cbrt(voxels / static_cast<double>(s.max_voxels)) * 1.01;
+    const Eigen::Vector3d fits = (dims * (h / smallest)).array().floor();
     throw InputError(fmt::format("a {:.0f} x {:.0f} x {:.0f} grid ({:.3g} voxels) exceeds the cap of {} voxels; the "
-                                 "smallest voxel size that fits is about {:.4g} (resolution {:.0f})",
-                                 dims.x(), dims.y(), dims.z(), voxels, s.max_voxels, smallest, longest / smallest));
+                                 "largest grid that fits is about {:.0f} x {:.0f} x {:.0f}: the smallest voxel size "
+                                 "that fits is about {:.4g} (resolution {:.0f})",
+                                 dims.x(), dims.y(), dims.z(), voxels, s.max_voxels, fits.x(), fits.y(), fits.z(),
+                                 smallest, std::floor(longest / smallest)));
   }
   spec.dims = dims.cast<int>();
   spec.origin = h * spec.index_offset.cast<double>();

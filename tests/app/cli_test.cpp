@@ -81,3 +81,95 @@ TEST(CliInfo, ReportsHolesAndMassPropertiesAsJson) {
 
 }  // namespace
 }  // namespace ts
+
+namespace ts {
+namespace {
+
+std::string quoted(const std::filesystem::path& p) {
+  std::string out(1, '\'');  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + s + "'"
+  out += p.string();
+  out += '\'';
+  return out;
+}
+
+TEST(CliSdf, CompareOpenVdbPrintsTheThreeWayStatisticsOnARealMesh) {
+  const auto dir = test::temp_dir();
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sdf " + quoted(test::cgal_mesh("knot1")) + " -o " + quoted(dir / "knot.vdb") +
+                                    " --resolution 32 --compare-openvdb",
+                                &out),
+            0)
+      << out;
+  for (const char* line : {"tetrasand GPU vs exact", "OpenVDB vs exact", "tetrasand GPU vs OpenVDB", "mean", "p99",
+                           "signs", "closer to exact: tetrasand GPU", "CPU exact", "OpenVDB meshToLevelSet"})
+    EXPECT_NE(out.find(line), std::string::npos) << line << "\n" << out;
+}
+
+TEST(CliSdf, OpenVdbsOwnToolReadsTheOutputAsALevelSet) {
+  const auto dir = test::temp_dir();
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sdf " + quoted(test::asset("cube.obj")) + " -o " + quoted(dir / "cube.vdb") +
+                                    " --voxel 0.01 --band 2",
+                                &out),
+            0)
+      << out;
+  // vdb_print from Debian's libopenvdb-tools.
+  FILE* pipe = ::popen(("vdb_print -l " + quoted(dir / "cube.vdb") + " 2>&1").c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string text;
+  char buffer[4096];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;) text.append(buffer, n);
+  ASSERT_EQ(::pclose(pipe), 0) << text;
+  EXPECT_NE(text.find("class: level set"), std::string::npos) << text;
+  EXPECT_NE(text.find("voxel size: 0.01"), std::string::npos) << text;
+  EXPECT_NE(text.find("Background value: 0.02"), std::string::npos) << text;
+  EXPECT_NE(text.find("Name: surface"), std::string::npos) << text;
+}
+
+TEST(CliSdf, OpenMeshWarnsUnlessSignedByWindingNumber) {
+  const auto dir = test::temp_dir();
+  const std::string holed = quoted(test::cgal_mesh("elephant-with-holes"));
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sdf " + holed + " -o " + quoted(dir / "a.vdb") + " --resolution 24", &out), 0) << out;
+  EXPECT_NE(out.find("not closed"), std::string::npos) << out;
+  EXPECT_NE(out.find("--sign winding"), std::string::npos) << out;
+  ASSERT_EQ(test::run_tetrasand("sdf " + holed + " -o " + quoted(dir / "b.vdb") + " --resolution 24 --sign winding",
+                                &out),
+            0)
+      << out;
+  EXPECT_EQ(out.find("not closed"), std::string::npos) << out;
+}
+
+TEST(CliSdf, PaddingBelowTheBandWarnsThatTheBandIsCut) {
+  const auto dir = test::temp_dir();
+  const std::string cube = quoted(test::asset("cube.obj"));
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sdf " + cube + " -o " + quoted(dir / "a.vdb") + " --resolution 16", &out), 0) << out;
+  EXPECT_EQ(out.find("band is cut"), std::string::npos) << out;
+  // 16 voxels + 2 * (ceil(3) + 1) automatic padding.
+  EXPECT_NE(out.find("25 x 25 x 25"), std::string::npos) << out;
+  ASSERT_EQ(test::run_tetrasand("sdf " + cube + " -o " + quoted(dir / "b.vdb") + " --resolution 16 --padding 1", &out), 0)
+      << out;
+  EXPECT_NE(out.find("band is cut"), std::string::npos) << out;
+  EXPECT_NE(out.find("19 x 19 x 19"), std::string::npos) << out;
+}
+
+TEST(CliSdf, GridOverTheCapNamesTheLargestGridThatFits) {
+  const auto dir = test::temp_dir();
+  std::string out;
+  EXPECT_EQ(test::run_tetrasand("sdf " + quoted(test::asset("cube.obj")) + " -o " + quoted(dir / "a.vdb") +
+                                    " --resolution 2000",
+                                &out),
+            1)
+      << out;
+  EXPECT_NE(out.find("largest grid that fits"), std::string::npos) << out;
+  EXPECT_NE(out.find("exceeds the cap"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "a.vdb"));
+  EXPECT_EQ(test::run_tetrasand("sdf " + quoted(test::asset("cube.obj")) + " -o " + quoted(dir / "a.vdb") + " --voxel 0",
+                                &out),
+            2)
+      << out;
+}
+
+}  // namespace
+}  // namespace ts
