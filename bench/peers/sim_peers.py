@@ -203,17 +203,21 @@ def rebound_apex(z, radius=1e-3):
 
 
 def repose_angle(xyz):
-    """Slope of the heap's surface (highest grain per 2 mm ring) between 20 % and 80 % of its height."""
+    """Slope of a heap's flank: the highest grain centre per 2 mm ring, fitted from the last ring above
+    80 % of the heap's height outwards to the first ring below 20 % (not the flat top, not the
+    scattered grains around it)."""
     r = np.hypot(xyz[:, 0], xyz[:, 1])
     ring = (r / 2e-3).astype(int)
     top = np.zeros(ring.max() + 1)
     np.maximum.at(top, ring, xyz[:, 2])
     h = top.max()
-    sel = (top >= 0.2 * h) & (top <= 0.8 * h)
+    first = int(np.nonzero(top > 0.8 * h)[0].max())
+    below = np.nonzero(top[first:] < 0.2 * h)[0]
+    last = first + (int(below[0]) if len(below) else len(top) - first)
     x = (np.arange(len(top)) + 0.5) * 2e-3
-    if sel.sum() < 2:
+    if last - first < 2:
         return float("nan")
-    slope = np.polyfit(x[sel], top[sel], 1)[0]
+    slope = np.polyfit(x[first:last], top[first:last], 1)[0]
     return float(np.degrees(np.arctan(-slope)))
 
 
@@ -266,8 +270,11 @@ def main():
         r = tetrasand(bin_dir, scenes[scene], os.path.join(work, scene + "_cpu"), gpu=False)
         z = np.array([read_ply_bodies(p)[1][0, 2] for p in r["plys"]])
         apex, _ = rebound_apex(z)
+        # Forward Euler is shown for information: it is not the integrator LAMMPS has.
+        symplectic = scene == "bounce"
         physics.append(("bounce: rebound apex", name, f"{apex * 1e3:.4f} mm (e = {np.sqrt(apex / drop):.4f})",
-                        f"{(apex / apex_l - 1) * 100:+.2f} %", "2 %", abs(apex / apex_l - 1) <= 0.02))
+                        f"{(apex / apex_l - 1) * 100:+.2f} %", "2 %" if symplectic else "(informative)",
+                        abs(apex / apex_l - 1) <= 0.02 if symplectic else None))
 
     # Heap: angle of repose, CPU reference and LAMMPS.
     hc = tetrasand(bin_dir, scenes["heap"], os.path.join(work, "heap_cpu"), gpu=False)
@@ -287,14 +294,16 @@ def main():
              f"Same scene, same material (E = 1 MPa, nu = 0.3, e = 0.5, mu = 0.5, gamma_s = 0.1 N s/m), same dt "
              f"({bed['CPU reference']['steps']} steps over 0.4 s), {grains} grains settling in a smooth 2 cm box. "
              "LAMMPS runs the deck written by `tetrasand export lammps`. Rates are process wall time (start-up "
-             "included) for all codes; the machine is shared, so read the ratios, not the absolute figures.", "",
+             "included) for all codes; the CPU reference uses TBB on every core, LAMMPS serial one core and "
+             "`mpirun -np 2` two. The machine is shared with other jobs, so read the ratios, not the absolute "
+             "figures.", "",
              "| code | device | grain-steps/s | ratio to LAMMPS serial | wall s |", "|---|---|---|---|---|"]
     for name, device, rate, ratio, wall in rows:
         lines.append(f"| {name} | {device} | {rate:.3g} | {ratio:.2f} | {wall:.1f} |")
     lines += ["", "Physical outcome (tolerances stated before the run):", "",
               "| quantity | code | value | vs LAMMPS | tolerance | within |", "|---|---|---|---|---|---|"]
     for q, name, value, diff, tol, ok in physics:
-        lines.append(f"| {q} | {name} | {value} | {diff} | {tol} | {'yes' if ok else 'NO'} |")
+        lines.append(f"| {q} | {name} | {value} | {diff} | {tol} | {'-' if ok is None else 'yes' if ok else 'NO'} |")
     lines += ["",
               "Notes: the bounce is a grain of four coincident spheres (edge 1 um) dropped without spin, so it "
               "measures the normal contact law alone; LAMMPS's Tsuji polynomial is not the Hertz oscillator's, so "
@@ -312,7 +321,7 @@ def main():
         tmp = markdown + ".tmp"
         open(tmp, "w").write(doc[:i] + text + doc[j:])
         os.replace(tmp, markdown)
-    return 0 if all(p[-1] for p in physics) else 1
+    return 0 if all(p[-1] is not False for p in physics) else 1
 
 
 if __name__ == "__main__":

@@ -15,6 +15,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "peers"))
+from sim_peers import repose_angle  # noqa: E402  (one definition of the heap's slope for both reports)
+
 RADIUS = 1e-3  # m, grain sphere radius of every run
 DENSITY = 2600.0  # kg/m^3
 GRAIN_MASS = DENSITY * 4 * 4.0 / 3.0 * np.pi * RADIUS**3  # kg, four full spheres
@@ -36,6 +39,11 @@ def restitution(run, docs):
     tsuji_spread = float(np.max(np.abs(et - 0.65)))
     # Kuwabara & Kono 1987 / Brilliantov 1996: 1 - e ~ v^(1/5) for viscoelastic Hertz (thesis damping).
     slope = np.polyfit(np.log(v), np.log(1 - eh), 1)[0]
+    # Schwager & Poeschel 2008: 1 - e = A v^(1/5) - B v^(2/5) + ..., A, B > 0 (leading term: Kuwabara &
+    # Kono 1987); the single power law only holds where 1 - e is small.
+    basis = np.stack([v ** 0.2, -(v ** 0.4)], axis=1)
+    (A, B), *_ = np.linalg.lstsq(basis, 1 - eh, rcond=None)
+    residual = float(np.max(np.abs(basis @ np.array([A, B]) - (1 - eh))))
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.semilogx(v, et, "o-", label="Tsuji damping")
     ax.semilogx(v, eh, "s-", label="thesis damping (eq. 3.27)")
@@ -44,7 +52,7 @@ def restitution(run, docs):
     ax.set_ylabel("coefficient of restitution")
     ax.legend()
     img = save(fig, docs, "restitution.png")
-    ok_t, ok_h = tsuji_spread < 0.005, abs(slope - 0.2) < 0.05
+    ok_t, ok_h = tsuji_spread < 0.005, residual < 0.01 and A > 0 and B > 0
     return f"""## Restitution against impact speed
 
 One solid sphere (r = 1 mm, E = 10 MPa, requested e = 0.65) hits a smooth wall head on, no gravity,
@@ -53,18 +61,24 @@ One solid sphere (r = 1 mm, E = 10 MPa, requested e = 0.65) hits a smooth wall h
 {img}
 
 - Expected: Tsuji damping gives a restitution independent of impact speed (Tsuji et al. 1992);
-  the thesis's viscoelastic damping gives 1 - e growing as v^(1/5) (Kuwabara & Kono 1987;
-  Brilliantov et al. 1996), equal to e at the reference speed 1 m/s.
+  the thesis's viscoelastic damping gives 1 - e growing as v^(1/5) at small damping (Kuwabara & Kono
+  1987; Brilliantov et al. 1996), more precisely 1 - e = A v^(1/5) - B v^(2/5) + ... with A, B > 0
+  (Schwager & Poeschel 2008), and e = 0.65 at its reference speed 1 m/s.
 - Measured: Tsuji e within {tsuji_spread:.4f} of 0.65 from {v.min():g} to {v.max():g} m/s
-  (**{'meets' if ok_t else 'does not meet'}** it, tolerance 0.005); thesis damping 1 - e ~ v^{slope:.3f}
-  (**{'meets' if ok_h else 'does not meet'}** 0.2 within 0.05).
+  (**{'meets' if ok_t else 'does not meet'}** it, tolerance 0.005). Thesis damping: e = {eh[np.argmin(np.abs(v - 1))]:.4f}
+  at 1 m/s; 1 - e = {A:.3f} v^(1/5) - {B:.3f} v^(2/5) fits every speed within {residual:.4f}
+  (**{'meets' if ok_h else 'does not meet'}** it, tolerance 0.01); a single power law over the whole range
+  gives v^{slope:.3f}, flatter than 1/5 because 1 - e is not small here.
 """
 
 
 def repose(run, docs):
     d = np.genfromtxt(os.path.join(run, "repose.csv"), delimiter=",", names=True)
-    mu, angle = d["mu"], d["angle_deg"]
+    mu = d["mu"]
+    angle = np.array([repose_angle(np.loadtxt(os.path.join(run, f"heap_mu{m:g}.csv"), delimiter=",", skiprows=1))
+                      for m in mu])
     rising = bool(np.all(np.diff(angle[:2]) > 0))
+    monotonic = bool(np.all(np.diff(angle) > 0))
     saturates = bool(abs(angle[-1] - angle[-2]) < max(3.0, 0.5 * (angle[1] - angle[0])))
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(mu, angle, "o-", label="tetrasand (CPU reference, 400 grains)")
@@ -76,8 +90,8 @@ def repose(run, docs):
     return f"""## Angle of repose against friction
 
 400 grains poured at 1000 grains/s from a 1.6 cm box 3-6 cm above a rough floor (fixed spheres of the
-grains' size), no side walls, 0.8 s; angle = slope of the heap's surface (highest grain per 2 mm
-ring, fitted between 20 % and 80 % of the heap's height).
+grains' size), no side walls, 0.8 s; angle = slope of the heap's flank (highest grain centre per 2 mm
+ring, fitted from the edge of the flat top, above 80 % of the height, out to 20 % of the height).
 
 {img}
 
@@ -89,7 +103,8 @@ ring, fitted between 20 % and 80 % of the heap's height).
   spheres; non-spherical grains stand steeper through interlocking); thesis ch. 7 reports 30-40 deg
   for its tetrahedral grains with thousands of grains.
 - Measured: rising from mu = {mu[0]:g} to {mu[1]:g}: **{'yes' if rising else 'no'}**; levelling off
-  at the top: **{'yes' if saturates else 'no'}**. A heap of 400 grains is only a few grains high, so
+  at the top (last two within 3 deg): **{'yes' if saturates else 'no'}**; rising at every step:
+  **{'yes' if monotonic else 'no'}**. A heap of 400 grains is only a few grains high, so
   each angle carries several degrees of noise (one run per point); a meaningful curve needs
   10^4-10^5 grains per heap, a GPU run.
 """
@@ -103,7 +118,8 @@ def silo(run, docs):
         s = d[d["orifice_m"] == D]
         t, n = s["time_s"], s["discharged"]
         total = n.max()
-        sel = (t >= 0.2) & (n <= 0.7 * 600)  # after the column's first fall, before the silo runs low
+        # After the column's first fall (0.15 s) and while the silo still holds 40 % of its grains.
+        sel = (t >= 0.15) & (n >= 0.1 * 600) & (n <= 0.6 * 600)
         if sel.sum() < 3:
             continue
         rate = np.polyfit(t[sel], n[sel], 1)[0]  # grains/s
@@ -114,13 +130,15 @@ def silo(run, docs):
     ax1.legend()
     D = np.array([r[0] for r in rows])
     W = np.array([r[1] for r in rows])
+    grows = bool(np.all(np.diff(W) > 0))
     # Beverloo W = C rho_b sqrt(g) (D - k d)^(5/2): W^(2/5) is linear in D.
     a, b = np.polyfit(D, W ** 0.4, 1)
     k = -b / a / D_EQ
     rho_b = 0.6 * DENSITY
     C = a ** 2.5 / (rho_b * np.sqrt(9.81))
-    # Free exponent with k fixed at the fitted value.
-    n_exp = np.polyfit(np.log(D - k * D_EQ), np.log(W), 1)[0] if np.all(D > k * D_EQ) else float("nan")
+    # Free exponent with k fixed at Beverloo's 1.5 (fitting k and the exponent together on three orifices
+    # would fit anything).
+    n_exp = np.polyfit(np.log(D - 1.5 * D_EQ), np.log(W), 1)[0]
     Dfit = np.linspace(D.min() * 0.9, D.max() * 1.1, 50)
     ax2.plot(D * 1e3, W * 1e3, "o", label="tetrasand")
     ax2.plot(Dfit * 1e3, np.clip(a * Dfit + b, 0, None) ** 2.5 * 1e3, "-", label=f"Beverloo fit, k = {k:.2f}")
@@ -136,7 +154,7 @@ def silo(run, docs):
 
 A flat-bottomed silo: smooth cylinder of 40 mm diameter, rough plate with a round orifice, 600
 grains (d = {D_EQ * 1e3:.2f} mm volume-equivalent) released as a column at t = 0, 0.6 s; rate fitted
-from t = 0.2 s (after the column's first fall) while fewer than 70 % of the grains had left.
+from t = 0.15 s (after the column's first fall) while 10-60 % of the grains had left.
 
 {img}
 
@@ -148,12 +166,16 @@ from t = 0.2 s (after the column's first fall) while fewer than 70 % of the grai
   1961); Mankoc et al. 2007 show the 5/2 law holds only when the silo is wider than 2.5 D and D + 30 d
   and filled above 1.2 widths.
 - Measured: with the exponent fixed at 5/2, k = {k:.2f} and C = {C:.2f} (taking rho_b = 0.6 rho);
-  with k fixed there, the free exponent is {n_exp:.2f}.
+  with k fixed at 1.5, the free exponent is {n_exp:.2f} (5/2 expected:
+  **{'meets' if abs(n_exp - 2.5) < 0.5 else 'does not meet'}** it within 0.5).
 - Honestly: this silo does **not** meet Mankoc's conditions (width > 2.5 D: {'yes' if cond1 else 'no'};
   width > D + 30 d = {(D.max() + 30 * D_EQ) * 1e3:.0f} mm: {'yes' if cond2 else 'no'}; the 600 grains
   fill it about 2 widths at the start and drain below 1.2 widths while the rate is measured), and
-  three orifices at 4-6 grain diameters cannot test an exponent. The rate does grow with D as the
-  law says; testing 5/2 needs a silo of 10^5 grains (width 10 cm, D from 5 to 20 d), a GPU run.
+  three orifices at 4-6 grain diameters cannot test an exponent: the silo empties within 0.3 s, so the
+  rate is taken over a few tens of milliseconds right after the column's fall, and the fitted k, C and
+  exponent above are no test of the law either way. Rate growing with D:
+  **{'yes' if grows else 'no'}**. Testing 5/2 needs a silo of 10^5 grains (width 10 cm, D from 5 to 20 d,
+  fill > 12 cm), a GPU run.
 """
 
 
@@ -185,7 +207,7 @@ def forces(run, docs):
     ax.set_ylabel("P(f)")
     ax.legend()
     img = save(fig, docs, "contact_forces.png")
-    faster = alpha > 1.0
+    exponential_better = e_exp < e_gauss
     return f"""## Normal contact forces in a resting pile (thesis 7.2)
 
 The grain-grain and grain-floor particle contacts of the mu = 0.5 heap at rest, normal force
@@ -196,10 +218,12 @@ magnitudes over their mean.
 - Expected: a plateau or peak near f = 1 and a tail for f > 1 that is exponential, P ~ exp(-beta f) with
   beta ~ 1.5 (Mueth, Jaeger & Nagel 1998), or falls faster, Gaussian-like exp(-c f^2) (van Eerd et al.
   2007, thesis table 7.2) once there are enough contacts.
-- Measured: exponential tail beta = {beta:.2f}; best tail exponent alpha = {alpha:.2f} in exp(-c f^alpha)
-  (squared log residuals: exponential {e_exp:.2f}, Gaussian {e_gauss:.2f}). Tail falls at least as fast as
-  an exponential: **{'yes' if faster else 'no'}**. With {len(f)} contacts the tail holds few forces above
-  f = 3; the thesis's distributions came from 10^4-10^5 grains.
+- Measured: peak below f = 1: **{'yes' if centres[np.argmax(hist)] < 1 else 'no'}**; exponential tail with
+  beta = {beta:.2f} ({'within' if 0.75 <= beta <= 2.25 else 'outside'} a factor 1.5 of 1.5); best tail
+  exponent alpha = {alpha:.2f} in exp(-c f^alpha); squared log residuals: exponential {e_exp:.2f},
+  Gaussian {e_gauss:.2f}, so the {'exponential' if exponential_better else 'Gaussian'} tail fits better
+  here. With {len(f)} contacts the tail holds few forces above f = 3 (single counts per bin), too few to
+  tell a Gaussian tail from an exponential one; the thesis's distributions came from 10^4-10^5 grains.
 """
 
 
@@ -215,6 +239,10 @@ reference in double precision; no GPU was used). Each run is sized to finish in 
 shared cores, which is far below the grain counts the literature's laws are stated for; each section says
 what the small run can and cannot show. Tetrahedral grains of four touching spheres, r = 1 mm, quartz
 density; E = 1 MPa in the scene runs (a soft sand keeps the time step near 40 us).
+
+The same contact law run by LAMMPS (through `tetrasand export lammps`) settles beds, rebounds grains and
+builds heaps like tetrasand does: see the section "Simulation against LAMMPS" of docs/benchmarks.md,
+also produced by `scripts/bench.sh`.
 
 Not run here: column-collapse runout against aspect ratio (Lube et al. 2004, Lajeunesse et al. 2004:
 runout ~ a for a < 3, ~ a^(2/3) above) needs tens of thousands of grains per column and a real GPU

@@ -125,7 +125,7 @@ Run run(const std::string& text, const fs::path& dir, const std::string& name, b
 // Grains poured from a 1.6 cm x 1.6 cm box 3-6 cm above a rough floor with no side walls pile up
 // into a heap; its surface slope is the angle of repose. Also writes the resting pile's contact forces.
 void repose(const fs::path& out) {
-  std::string csv = "mu,angle_deg,grains,seconds\n";
+  std::string csv = "mu,grains,seconds\n";
   for (double mu : {0.1, 0.3, 0.5, 0.8}) {
     const std::string text = materials(mu) + R"(
 [[emitter]]
@@ -151,26 +151,15 @@ every = 2000
 csv = false
 )";
     const Run r = run(text, out / "runs", fmt::format("repose_mu{}", mu), false);
-    // Surface height per radial ring of 2 mm: the highest grain top; slope fitted where the heap is
-    // between 20 % and 80 % of its height (not the flat top, not the thin rim).
-    std::vector<double> top(40, 0.0);
+    // The resting heap's grain centres; report.py measures its slope (bench/peers/sim_peers.py).
+    std::string heap = "x_m,y_m,z_m\n";
     for (std::size_t b = 0; b < r.last.bodies.size(); ++b) {
       if (r.last.bodies.motion[b] != MotionType::Dynamic) continue;
       const Eigen::Vector3d& x = r.last.bodies.position[b];
-      const auto ring = static_cast<std::size_t>(std::hypot(x.x(), x.y()) / 2e-3);
-      if (ring < top.size()) top[ring] = std::max(top[ring], x.z());
+      heap += fmt::format("{:.6e},{:.6e},{:.6e}\n", x.x(), x.y(), x.z());
     }
-    const double h = *std::max_element(top.begin(), top.end());
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    int n = 0;
-    for (std::size_t i = 0; i < top.size(); ++i) {
-      if (top[i] < 0.2 * h || top[i] > 0.8 * h) continue;
-      const double x = (static_cast<double>(i) + 0.5) * 2e-3;
-      sx += x, sy += top[i], sxx += x * x, sxy += x * top[i];
-      ++n;
-    }
-    const double slope = n >= 2 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : 0.0;
-    csv += fmt::format("{},{:.3f},{},{:.1f}\n", mu, std::atan(-slope) * 180 / std::numbers::pi, r.grains, r.seconds);
+    ts::write_file_atomically(out / fmt::format("heap_mu{}.csv", mu), heap);
+    csv += fmt::format("{},{},{:.1f}\n", mu, r.grains, r.seconds);
     if (mu == 0.5) {
       // Normal contact forces of the resting heap (grain-grain and grain-floor particle contacts).
       StepSettings settings;
