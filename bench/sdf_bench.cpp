@@ -1,122 +1,177 @@
-// SDF construction side by side on the same mesh and voxel size, in one run: tetrasand's GPU scan
-// conversion against OpenVDB's meshToLevelSet (all cores), with their agreement in voxels. Usage:
-//   tetrasand_bench_sdf MESH [--resolutions 64,128,256] [--band 3] [--markdown]
+// SDF construction three ways on the same mesh, voxel size and band, in one run: tetrasand's GPU scan
+// conversion, the CPU exact SDF (CGAL AABB tree, TBB on all cores) and OpenVDB's meshToLevelSet (all
+// cores), with the error of the GPU path and of OpenVDB against exact distance. Usage:
+//   tetrasand_bench_sdf CASE... [--band 3] [--csv FILE] [--markdown]
+// CASE is MESH@R1,R2,... (a mesh file, or icosphere:S for a generated sphere of 20 * 4^S triangles)
+// with the resolutions (voxels along the longest side) to run it at.
 #include <fmt/format.h>
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/MeshToVolume.h>
 
-#include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/mesh_io.h"
+#include "core/primitives.h"
 #include "gpu/context.h"
+#include "sdf/exact_sdf.h"
+#include "sdf/grid.h"
+#include "sdf/openvdb_compare.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
+#include "sdf/vdb_io.h"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-ts::sdf::GridSpec grid_for(const ts::TriangleMesh& mesh, int resolution, double band) {
-  const ts::Aabb box = ts::bounding_box(mesh);
-  ts::sdf::GridSpec s;
-  s.voxel_size = box.size().maxCoeff() / resolution;
-  const int padding = static_cast<int>(std::ceil(band)) + 1;
-  for (int a = 0; a < 3; ++a) {
-    s.index_offset[a] = static_cast<int>(std::floor(box.min[a] / s.voxel_size)) - padding;
-    s.dims[a] = static_cast<int>(std::ceil(box.max[a] / s.voxel_size)) + padding - s.index_offset[a] + 1;
-  }
-  s.origin = s.voxel_size * s.index_offset.cast<double>();
-  return s;
-}
-
-struct Agreement {
-  double mean = 0, p99 = 0, max = 0;  // voxels
-  std::size_t voxels = 0, sign_disagreements = 0;
+struct Case {
+  std::string mesh;
+  std::vector<int> resolutions;
 };
 
-Agreement agreement(const openvdb::FloatGrid& a, const openvdb::FloatGrid& b, double h, double band) {
-  std::vector<double> diffs;
-  Agreement out;
-  auto other = b.getConstAccessor();
-  for (auto it = a.cbeginValueOn(); it; ++it) {
-    const float va = *it, vb = other.getValue(it.getCoord());
-    if (std::abs(va) >= band * h || std::abs(vb) >= band * h) continue;
-    diffs.push_back(std::abs(va - vb) / h);
-    out.sign_disagreements += (va < 0) != (vb < 0) ? 1 : 0;
-  }
-  if (diffs.empty()) return out;
-  std::sort(diffs.begin(), diffs.end());
-  out.voxels = diffs.size();
-  for (double d : diffs) out.mean += d;
-  out.mean /= static_cast<double>(diffs.size());
-  out.p99 = diffs[static_cast<std::size_t>(0.99 * static_cast<double>(diffs.size() - 1))];
-  out.max = diffs.back();
-  return out;
+Case parse_case(const std::string& text) {
+  const auto at = text.rfind('@');
+  if (at == std::string::npos) throw std::runtime_error("case '" + text + "' needs @resolutions, e.g. bunny.off@64,128");
+  Case c;
+  c.mesh = text.substr(0, at);
+  std::stringstream list(text.substr(at + 1));
+  for (std::string item; std::getline(list, item, ',');) c.resolutions.push_back(std::stoi(item));
+  return c;
+}
+
+ts::TriangleMesh load_case_mesh(const std::string& name) {
+  if (name.rfind("icosphere:", 0) == 0) return ts::make_icosphere(0.5, std::stoi(name.substr(10)));
+  return ts::load_mesh(name);
+}
+
+std::string short_name(const std::string& name) {
+  return name.rfind("icosphere:", 0) == 0 ? name : std::filesystem::path(name).stem().string();
+}
+
+struct Row {
+  std::string mesh;
+  std::size_t triangles = 0;
+  int resolution = 0;
+  Eigen::Vector3i dims;
+  double gpu_s = 0, exact_s = 0, vdb_s = 0;
+  std::size_t band_voxels = 0, slabs = 0, peak_gpu_bytes = 0;
+  ts::sdf::GridComparison gpu, vdb;  // against exact
+};
+
+Row run_case(ts::gpu::Context& context, const ts::TriangleMesh& mesh, const ts::sdf::Pseudonormals& normals,
+             int resolution, double band) {
+  ts::sdf::SdfSettings settings;
+  settings.resolution = resolution;
+  settings.band = band;
+  const ts::sdf::GridSpec spec = ts::sdf::make_grid(ts::bounding_box(mesh), settings);
+  Row row;
+  row.triangles = mesh.triangle_count();
+  row.resolution = resolution;
+  row.dims = spec.dims;
+  ts::sdf::ScanConvertOptions options;
+  options.band = band;
+  auto start = Clock::now();
+  const auto gpu = ts::sdf::scan_convert(context, mesh, normals, spec, options);
+  row.gpu_s = since(start);
+  row.band_voxels = gpu.stats.band_voxels;
+  row.slabs = static_cast<std::size_t>(gpu.stats.slabs);
+  row.peak_gpu_bytes = gpu.stats.peak_gpu_bytes;
+  start = Clock::now();
+  const auto exact = ts::sdf::exact_sdf_grid(mesh, spec, band, ts::sdf::SignMethod::Pseudonormal);
+  row.exact_s = since(start);
+  start = Clock::now();
+  const auto vdb = ts::sdf::openvdb_level_set(mesh, spec.voxel_size, band);
+  row.vdb_s = since(start);
+  const double band_world = band * spec.voxel_size;
+  row.gpu = ts::sdf::compare_grids(*gpu.grid, *exact, spec.voxel_size, band_world);
+  row.vdb = ts::sdf::compare_grids(*vdb, *exact, spec.voxel_size, band_world);
+  return row;
+}
+
+void print_markdown_header() {
+  fmt::print("| mesh | triangles | grid | band voxels | GPU s | CPU exact s | OpenVDB s | exact / GPU | OpenVDB / GPU "
+             "| GPU err mean / max (voxels) | OpenVDB err mean / p99 / max (voxels) | OpenVDB wrong signs |\n");
+  fmt::print("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+}
+
+void print_markdown_row(const Row& r) {
+  fmt::print("| {} | {} | {}x{}x{} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.1e} / {:.1e} | {:.4f} / {:.3f} / "
+             "{:.3f} | {} |\n",
+             r.mesh, r.triangles, r.dims.x(), r.dims.y(), r.dims.z(), r.band_voxels, r.gpu_s, r.exact_s, r.vdb_s,
+             r.exact_s / r.gpu_s, r.vdb_s / r.gpu_s, r.gpu.mean, r.gpu.max, r.vdb.mean, r.vdb.p99, r.vdb.max,
+             r.vdb.sign_disagreements);
+  std::fflush(stdout);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   try {
-    if (argc < 2) throw std::runtime_error("usage: tetrasand_bench_sdf MESH [--resolutions 64,128] [--band 3] [--markdown]");
-    std::vector<int> resolutions{64, 128, 256};
+    std::vector<Case> cases;
     double band = 3.0;
     bool markdown = false;
-    for (int i = 2; i < argc; ++i) {
+    std::string csv_path;
+    for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
-      if (arg == "--resolutions" && i + 1 < argc) {
-        resolutions.clear();
-        std::stringstream list(argv[++i]);
-        for (std::string item; std::getline(list, item, ',');) resolutions.push_back(std::stoi(item));
-      } else if (arg == "--band" && i + 1 < argc) {
+      if (arg == "--band" && i + 1 < argc) {
         band = std::stod(argv[++i]);
+      } else if (arg == "--csv" && i + 1 < argc) {
+        csv_path = argv[++i];
       } else if (arg == "--markdown") {
         markdown = true;
-      } else {
+      } else if (arg.rfind("--", 0) == 0) {
         throw std::runtime_error("unknown option " + arg);
+      } else {
+        cases.push_back(parse_case(arg));
       }
     }
-    openvdb::initialize();
-    const ts::TriangleMesh mesh = ts::load_mesh(argv[1]);
+    if (cases.empty()) throw std::runtime_error("usage: tetrasand_bench_sdf MESH@64,128... [--band 3] [--csv FILE] [--markdown]");
+    ts::sdf::ensure_openvdb_initialized();
     ts::gpu::Context context;
-    const ts::sdf::Pseudonormals normals = ts::sdf::compute_pseudonormals(mesh);
-    std::vector<openvdb::Vec3s> points;
-    std::vector<openvdb::Vec3I> triangles;
-    for (const auto& v : mesh.vertices) points.emplace_back(v.x(), v.y(), v.z());
-    for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-    fmt::print(stderr, "{}: {} triangles on {}\n", argv[1], mesh.triangle_count(), context.summary());
-    if (markdown) {
-      fmt::print("| mesh | grid | GPU scan conversion s | OpenVDB meshToLevelSet s | OpenVDB / GPU | band voxels | mean | p99 | max (voxels) | sign disagreements |\n");
-      fmt::print("|---|---|---|---|---|---|---|---|---|---|\n");
+    fmt::print(stderr, "renderer: {}\n", context.summary());
+    std::ofstream csv;
+    if (!csv_path.empty()) {
+      csv.open(csv_path);
+      if (!csv) throw std::runtime_error("cannot write " + csv_path);
+      csv << "mesh,triangles,resolution,nx,ny,nz,band_voxels,slabs,peak_gpu_mib,gpu_s,exact_s,openvdb_s,gpu_mean,gpu_p99,"
+             "gpu_max,gpu_wrong_signs,openvdb_mean,openvdb_p99,openvdb_max,openvdb_wrong_signs\n";
     }
-    for (int resolution : resolutions) {
-      const ts::sdf::GridSpec spec = grid_for(mesh, resolution, band);
-      ts::sdf::ScanConvertOptions options;
-      options.band = band;
-      ts::sdf::scan_convert(context, mesh, normals, grid_for(mesh, 16, band), options);  // warm-up: shader compile
-      auto start = Clock::now();
-      const auto gpu = ts::sdf::scan_convert(context, mesh, normals, spec, options);
-      const double gpu_seconds = since(start);
-      start = Clock::now();
-      auto transform = openvdb::math::Transform::createLinearTransform(spec.voxel_size);
-      const auto vdb = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*transform, points, triangles,
-                                                                          static_cast<float>(band));
-      const double vdb_seconds = since(start);
-      const Agreement a = agreement(*gpu.grid, *vdb, spec.voxel_size, band);
-      const std::string grid = fmt::format("{}x{}x{}", spec.dims.x(), spec.dims.y(), spec.dims.z());
-      if (markdown) {
-        fmt::print("| {} | {} | {:.3f} | {:.3f} | {:.2f} | {} | {:.4f} | {:.4f} | {:.3f} | {} |\n",
-                   std::filesystem::path(argv[1]).filename().string(), grid, gpu_seconds, vdb_seconds,
-                   vdb_seconds / gpu_seconds, a.voxels, a.mean, a.p99, a.max, a.sign_disagreements);
-      } else {
-        fmt::print("{:>14}: GPU {:.3f} s, OpenVDB {:.3f} s (ratio {:.2f}); |GPU - OpenVDB| mean {:.4f}, p99 {:.4f}, max {:.3f} voxels, {} sign disagreements over {} voxels\n",
-                   grid, gpu_seconds, vdb_seconds, vdb_seconds / gpu_seconds, a.mean, a.p99, a.max,
-                   a.sign_disagreements, a.voxels);
+    if (markdown) print_markdown_header();
+    for (const Case& c : cases) {
+      const ts::TriangleMesh mesh = load_case_mesh(c.mesh);
+      const ts::sdf::Pseudonormals normals = ts::sdf::compute_pseudonormals(mesh);
+      fmt::print(stderr, "{}: {} triangles\n", c.mesh, mesh.triangle_count());
+      // Warm-up: shader compilation is not part of any timing.
+      {
+        ts::sdf::SdfSettings warm;
+        warm.resolution = 8;
+        ts::sdf::scan_convert(context, ts::make_icosphere(0.5, 1), ts::sdf::compute_pseudonormals(ts::make_icosphere(0.5, 1)),
+                              ts::sdf::make_grid(ts::bounding_box(ts::make_icosphere(0.5, 1)), warm), {});
+      }
+      for (int resolution : c.resolutions) {
+        Row r = run_case(context, mesh, normals, resolution, band);
+        r.mesh = short_name(c.mesh);
+        if (markdown) {
+          print_markdown_row(r);
+        } else {
+          fmt::print("{} {}^3 ({}x{}x{}): GPU {:.3f} s, exact {:.3f} s, OpenVDB {:.3f} s; vs exact: GPU mean {:.2e} max "
+                     "{:.2e}, OpenVDB mean {:.4f} p99 {:.4f} max {:.3f} voxels, {} wrong signs\n",
+                     r.mesh, resolution, r.dims.x(), r.dims.y(), r.dims.z(), r.gpu_s, r.exact_s, r.vdb_s, r.gpu.mean,
+                     r.gpu.max, r.vdb.mean, r.vdb.p99, r.vdb.max, r.vdb.sign_disagreements);
+          std::fflush(stdout);
+        }
+        if (csv) {
+          csv << fmt::format("{},{},{},{},{},{},{},{},{:.1f},{:.4f},{:.4f},{:.4f},{:.3e},{:.3e},{:.3e},{},{:.5f},{:.5f},{:.5f},{}\n",
+                             r.mesh, r.triangles, r.resolution, r.dims.x(), r.dims.y(), r.dims.z(), r.band_voxels, r.slabs,
+                             r.peak_gpu_bytes / 1048576.0, r.gpu_s, r.exact_s, r.vdb_s, r.gpu.mean, r.gpu.p99, r.gpu.max,
+                             r.gpu.sign_disagreements, r.vdb.mean, r.vdb.p99, r.vdb.max, r.vdb.sign_disagreements);
+          csv.flush();
+        }
       }
     }
     return 0;
