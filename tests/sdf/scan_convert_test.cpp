@@ -258,6 +258,22 @@ TEST_F(ScanConvert, DegenerateAndNeedleTrianglesLeaveNoHolesOrNaN) {
   EXPECT_LE(a.max_error_voxels, 1e-3);
 }
 
+TEST_F(ScanConvert, SheetAndNeedleThinnerThanAVoxelAreExactWithNoSignErrors) {
+  const double h = 1.0 / 20.0;
+  // A closed plate a tenth of a voxel thick, and a closed ring whose tube is a fifth of a voxel across.
+  const TriangleMesh sheet = make_plate(0.8, 0.6, 0.1 * h, 4, 3);
+  const TriangleMesh needle = make_torus(0.4, 0.1 * h, 48, 6);
+  for (const TriangleMesh* mesh : {&sheet, &needle}) {
+    const GridSpec spec = grid_around(*mesh, h, 4);
+    const auto result = run(*mesh, spec);
+    const Agreement a = compare_with_exact(*mesh, spec, result, 3.0);
+    EXPECT_GT(a.band_voxels, 1000u);
+    EXPECT_EQ(a.missing, 0u);
+    EXPECT_EQ(a.sign_errors, 0u);
+    EXPECT_LE(a.max_error_voxels, 1e-3);
+  }
+}
+
 TEST_F(ScanConvert, NeedleTriangleIsCoveredByItsRectanglePrism) {
   // A single sliver (angle ~0.006 degrees at one corner) as an open mesh: unsigned distance must be exact.
   TriangleMesh needle;
