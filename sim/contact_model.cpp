@@ -85,6 +85,8 @@ PairCoefficients make_pair_coefficients(const Material& a, const Material& b, No
   const double exponent = damping == NormalDamping::Tsuji ? 0.25 : 0.5;
   p.damping_strength = damping_strength_for_restitution(p.restitution, exponent);
   p.thesis_reference_speed = thesis_reference_speed;
+  const double g_a = a.youngs_modulus / (2 * (1 + a.poisson_ratio)), g_b = b.youngs_modulus / (2 * (1 + b.poisson_ratio));
+  p.effective_shear_modulus = 1.0 / ((2 - a.poisson_ratio) / g_a + (2 - b.poisson_ratio) / g_b);
   return p;
 }
 

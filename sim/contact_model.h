@@ -55,6 +55,9 @@ struct PairCoefficients {
   // damping_strength_for_restitution): Tsuji p = 1/4 with c = -sqrt(5) beta; thesis p = 1/2.
   double damping_strength = 0;
   double thesis_reference_speed = 1;  // m/s: thesis form only, the speed at which e_n is exact
+  // G*, Pa: 1/G* = (2 - nu1)/G1 + (2 - nu2)/G2, G = E / (2 (1 + nu)); the tangential spring's
+  // Mindlin stiffness k_t = 8 G* sqrt(R* delta) (only with TangentialModel::Spring).
+  double effective_shear_modulus = 0;
 };
 
 // Mixing rules and damping calibration for one pair of materials. The damping strength is chosen so
@@ -87,9 +90,10 @@ template <typename Real>
 struct ContactCoefficients {
   Real effective_modulus, friction, tangential_damping, damping_strength, thesis_reference_speed;
   NormalDamping damping;
+  Real effective_shear_modulus = 0;  // Pa, tangential spring only
   static ContactCoefficients from(const PairCoefficients& p, NormalDamping d) {
     return {Real(p.effective_modulus), Real(p.friction), Real(p.tangential_damping), Real(p.damping_strength),
-            Real(p.thesis_reference_speed), d};
+            Real(p.thesis_reference_speed), d, Real(p.effective_shear_modulus)};
   }
 };
 
@@ -106,10 +110,41 @@ struct ContactForce {
 // Normal plus tangential force for a contact with normal n (towards body 1), overlap delta > 0,
 // relative contact velocity v_c = v1 - v2 at the contact point, effective radius R* (m) and
 // effective mass m* (kg). Hertz elastic part (eq. 3.19), damping per coefficients, no attraction,
-// viscous tangential force capped by Coulomb (eq. 3.28).
+// viscous tangential force capped by Coulomb (eq. 3.28), or with `spring` the spring form above
+// (dt, s: the step that advances the spring).
+// The static-friction alternative to eq. 3.28's purely viscous tangential force, which cannot hold a
+// load at zero slip, so a heap creeps down its slope at the slip speed F_t / gamma_s (thesis figure
+// 2.8). A spring per contact (Cundall & Strack 1979; LAMMPS's "tangential mindlin") stores the
+// elastic tangential displacement `spring` (m, of particle 1 relative to 2): it is turned onto the
+// current tangent plane keeping its length, advanced by the slip v_s dt, and the force
+// -k_t spring - gamma_s v_s with k_t = 8 G* sqrt(R* delta) is capped at mu F_n; while sliding, the
+// spring is cut back to what the capped force implies. Both partners of a pair keep their own
+// spring; the arithmetic is antisymmetric term by term, so the two stay exact negatives.
+template <typename Real>
+Vec3<Real> spring_tangential_force(const Vec3<Real>& n, Real delta, const Vec3<Real>& v_c, Real effective_radius,
+                                   Real normal_force, const ContactCoefficients<Real>& c, Real dt,
+                                   Vec3<Real>& spring) {
+  const Vec3<Real> v_s = v_c - v_c.dot(n) * n;  // m/s
+  const Real length = spring.norm();
+  spring -= spring.dot(n) * n;
+  const Real projected = spring.norm();
+  if (projected > Real(0)) spring *= length / projected;
+  spring += v_s * dt;
+  const Real k_t = Real(8) * c.effective_shear_modulus * std::sqrt(effective_radius * delta);  // N/m
+  Vec3<Real> force = -k_t * spring - c.tangential_damping * v_s;
+  const Real cap = c.friction * normal_force;
+  const Real magnitude = force.norm();
+  if (magnitude > cap) {
+    force *= magnitude > Real(0) ? cap / magnitude : Real(0);
+    spring = -(force + c.tangential_damping * v_s) / k_t;
+  }
+  return force;
+}
+
 template <typename Real>
 Vec3<Real> hertz_contact_force(const Vec3<Real>& n, Real delta, const Vec3<Real>& v_c, Real effective_radius,
-                               Real effective_mass, const ContactCoefficients<Real>& c) {
+                               Real effective_mass, const ContactCoefficients<Real>& c, Real dt = Real(0),
+                               Vec3<Real>* spring = nullptr) {
   const Real k_n = Real(4.0 / 3.0) * c.effective_modulus * std::sqrt(effective_radius);  // N/m^1.5
   const Real delta_dot = -v_c.dot(n);  // m/s, > 0 while approaching
   Real damping_force;                  // N, along n
@@ -126,6 +161,9 @@ Vec3<Real> hertz_contact_force(const Vec3<Real>& n, Real delta, const Vec3<Real>
     damping_force = gamma_n * std::sqrt(delta) * delta_dot;
   }
   const Real normal_force = std::max(Real(0), k_n * delta * std::sqrt(delta) + damping_force);  // N
+  if (spring) {
+    return normal_force * n + spring_tangential_force(n, delta, v_c, effective_radius, normal_force, c, dt, *spring);
+  }
 
   const Vec3<Real> v_s = v_c - v_c.dot(n) * n;  // m/s, tangential slip
   const Real slip = v_s.norm();
@@ -152,7 +190,8 @@ template <typename Real>
 ContactForce<Real> sphere_sphere_contact(const Vec3<Real>& p1, const Vec3<Real>& v1, const Vec3<Real>& w1, Real r1,
                                          Real inverse_mass1, const Vec3<Real>& p2, const Vec3<Real>& v2,
                                          const Vec3<Real>& w2, Real r2, Real inverse_mass2, Real max_overlap,
-                                         const ContactCoefficients<Real>& c) {
+                                         const ContactCoefficients<Real>& c, Real dt = Real(0),
+                                         Vec3<Real>* spring = nullptr) {
   ContactForce<Real> out;
   const Vec3<Real> d = p1 - p2;
   const Real distance = d.norm();
@@ -169,7 +208,7 @@ ContactForce<Real> sphere_sphere_contact(const Vec3<Real>& p1, const Vec3<Real>&
   const Real effective_radius = r1 * r2 / (r1 + r2);
   const Real effective_mass = Real(1) / (inverse_mass1 + inverse_mass2);
   out.arm = arm1;
-  out.force = hertz_contact_force(n, out.overlap, v_c, effective_radius, effective_mass, c);
+  out.force = hertz_contact_force(n, out.overlap, v_c, effective_radius, effective_mass, c, dt, spring);
   out.elastic_energy = hertz_elastic_energy(out.overlap, effective_radius, c.effective_modulus);
   return out;
 }
@@ -179,7 +218,8 @@ ContactForce<Real> sphere_sphere_contact(const Vec3<Real>& p1, const Vec3<Real>&
 // infinite radius of curvature (R* = r).
 template <typename Real>
 ContactForce<Real> sphere_wall_contact(const Vec3<Real>& n, Real gap, const Vec3<Real>& v, const Vec3<Real>& w, Real r,
-                                       Real inverse_mass, Real max_overlap, const ContactCoefficients<Real>& c) {
+                                       Real inverse_mass, Real max_overlap, const ContactCoefficients<Real>& c,
+                                       Real dt = Real(0), Vec3<Real>* spring = nullptr) {
   ContactForce<Real> out;
   const Real raw_overlap = r - gap;
   if (raw_overlap <= Real(0) || inverse_mass <= Real(0)) return out;
@@ -189,7 +229,7 @@ ContactForce<Real> sphere_wall_contact(const Vec3<Real>& n, Real gap, const Vec3
   const Vec3<Real> arm = -(r - Real(0.5) * raw_overlap) * n;
   const Vec3<Real> v_c = v + w.cross(arm);
   out.arm = arm;
-  out.force = hertz_contact_force(n, out.overlap, v_c, r, Real(1) / inverse_mass, c);
+  out.force = hertz_contact_force(n, out.overlap, v_c, r, Real(1) / inverse_mass, c, dt, spring);
   out.elastic_energy = hertz_elastic_energy(out.overlap, r, c.effective_modulus);
   return out;
 }

@@ -105,13 +105,34 @@ double max_radius(const World& world) {
 }  // namespace
 
 template <typename Fn>
-void CpuStepper::visit_contacts(const World& world, std::uint32_t i, Fn&& fn) const {
+void CpuStepper::visit_contacts(const World& world, std::uint32_t i, Fn&& fn, SpringSlots* springs) const {
   const Bodies& b = world.bodies;
   const Particles& p = world.particles;
   const double overlap_ratio_cap = settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30;
   const std::uint32_t bi = p.body[i];
   const double ri = p.radius[i];
   const Eigen::Vector3d& wi = b.angular_velocity[bi];
+  const double dt = settings_.dt;
+  // The contact's spring (zero for a new contact), or null without springs.
+  Eigen::Vector3d spring = Eigen::Vector3d::Zero();
+  auto find_spring = [&](std::int64_t partner) -> Eigen::Vector3d* {
+    if (!springs) return nullptr;
+    spring.setZero();
+    for (std::size_t k = 0; k < ContactSprings::kSlots && springs->old_partner; ++k) {
+      if (springs->old_partner[k] == partner) spring = springs->old_displacement[k];
+    }
+    return &spring;
+  };
+  auto keep_spring = [&](std::int64_t partner) {
+    if (!springs || !springs->new_partner) return;
+    if (springs->used == ContactSprings::kSlots) {
+      ++springs->overflows;
+      return;
+    }
+    springs->new_partner[springs->used] = partner;
+    springs->new_displacement[springs->used] = spring;
+    ++springs->used;
+  };
   // Other bodies' particles in the 27 cells around, each bucket in increasing id.
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
@@ -127,10 +148,16 @@ void CpuStepper::visit_contacts(const World& world, std::uint32_t i, Fn&& fn) co
           const double rj = p.radius[j];
           const auto& coefficients = pairs_[p.material[i] * material_count_ + p.material[j]];
           const double smaller = std::min(ri, rj);
+          // With springs, only touching pairs look theirs up (the force repeats this test).
+          if (springs && (position_[i] - position_[j]).squaredNorm() >= (ri + rj) * (ri + rj)) continue;
+          const auto partner = static_cast<std::int64_t>(j);
           const ContactForce<double> f = sphere_sphere_contact(
               position_[i], velocity_[i], wi, ri, b.inverse_mass[bi], position_[j], velocity_[j],
-              b.angular_velocity[bj], rj, b.inverse_mass[bj], overlap_ratio_cap * smaller, coefficients);
-          if (f.touching) fn(f, static_cast<std::int64_t>(j), smaller);
+              b.angular_velocity[bj], rj, b.inverse_mass[bj], overlap_ratio_cap * smaller, coefficients, dt,
+              find_spring(partner));
+          if (!f.touching) continue;
+          keep_spring(partner);
+          fn(f, partner, smaller);
         }
       }
     }
@@ -142,9 +169,14 @@ void CpuStepper::visit_contacts(const World& world, std::uint32_t i, Fn&& fn) co
   for (const PlaneWall& wall : world.walls.planes) {
     const auto& coefficients = pairs_[p.material[i] * material_count_ + wall.material];
     const double gap = wall.normal.dot(position_[i] - wall.point);
-    const ContactForce<double> f =
-        sphere_wall_contact(wall.normal, gap, velocity_[i], wi, ri, inverse_mass, max_overlap, coefficients);
-    if (f.touching) fn(f, -1 - wall_index, ri);
+    if (gap < ri) {
+      const ContactForce<double> f = sphere_wall_contact(wall.normal, gap, velocity_[i], wi, ri, inverse_mass,
+                                                         max_overlap, coefficients, dt, find_spring(-1 - wall_index));
+      if (f.touching) {
+        keep_spring(-1 - wall_index);
+        fn(f, -1 - wall_index, ri);
+      }
+    }
     ++wall_index;
   }
   for (const CylinderWall& wall : world.walls.cylinders) {
@@ -155,8 +187,12 @@ void CpuStepper::visit_contacts(const World& world, std::uint32_t i, Fn&& fn) co
       const Eigen::Vector3d normal(-radial.x() / distance, -radial.y() / distance, 0.0);
       const auto& coefficients = pairs_[p.material[i] * material_count_ + wall.material];
       const ContactForce<double> f = sphere_wall_contact(normal, wall.radius - distance, velocity_[i], wi, ri,
-                                                         inverse_mass, max_overlap, coefficients);
-      if (f.touching) fn(f, -1 - wall_index, ri);
+                                                         inverse_mass, max_overlap, coefficients, dt,
+                                                         find_spring(-1 - wall_index));
+      if (f.touching) {
+        keep_spring(-1 - wall_index);
+        fn(f, -1 - wall_index, ri);
+      }
     }
     ++wall_index;
   }
@@ -187,10 +223,21 @@ std::vector<ContactRecord> CpuStepper::contacts(const World& world) {
   std::vector<ContactRecord> records;
   for (std::uint32_t i = 0; i < world.particles.size(); ++i) {
     if (world.bodies.inverse_mass[world.particles.body[i]] == 0) continue;
-    visit_contacts(world, i, [&](const ContactForce<double>& f, std::int64_t partner, double) {
-      if (!counted_here(world, i, partner)) return;
-      records.push_back({i, partner, position_[i] + f.arm, f.force, f.overlap});
-    });
+    // Springs are read (the forces include them) but not advanced.
+    SpringSlots slots;
+    const bool springs = settings_.tangential == TangentialModel::Spring &&
+                         world.springs.partner.size() == world.particles.size() * ContactSprings::kSlots;
+    if (springs) {
+      slots.old_partner = &world.springs.partner[i * ContactSprings::kSlots];
+      slots.old_displacement = &world.springs.displacement[i * ContactSprings::kSlots];
+    }
+    visit_contacts(
+        world, i,
+        [&](const ContactForce<double>& f, std::int64_t partner, double) {
+          if (!counted_here(world, i, partner)) return;
+          records.push_back({i, partner, position_[i] + f.arm, f.force, f.overlap});
+        },
+        springs ? &slots : nullptr);
   }
   return records;
 }
@@ -199,19 +246,42 @@ void CpuStepper::compute_forces(const World& world, StepStats& stats) {
   prepare_particles(world);
   const auto n = static_cast<std::uint32_t>(world.particles.size());
 
+  const bool springs = settings_.tangential == TangentialModel::Spring;
+  constexpr std::size_t K = ContactSprings::kSlots;
+  // Each particle reads only its own old slots and writes only its own new ones: thread-safe.
+  const bool have_old = world.springs.partner.size() == std::size_t{n} * K;
+  if (springs) {
+    next_springs_.partner.assign(std::size_t{n} * K, ContactSprings::kNoPartner);
+    next_springs_.displacement.assign(std::size_t{n} * K, Eigen::Vector3d::Zero());
+  }
   std::vector<ParticleContacts> contacts(n);
+  std::vector<std::size_t> overflows(springs ? n : 0, 0);
   tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
     ParticleContacts& out = contacts[i];
     // Static and kinematic particles need no force: their partners compute their own side.
     if (world.bodies.inverse_mass[world.particles.body[i]] == 0) return;
-    visit_contacts(world, i, [&](const ContactForce<double>& f, std::int64_t partner, double smaller_radius) {
-      const bool wall = partner < 0;
-      const bool counted = counted_here(world, i, partner);
-      out.add(f, smaller_radius, counted);
-      out.pairs += (!wall && counted) ? 1 : 0;
-      out.walls += wall ? 1 : 0;
-    });
+    SpringSlots slots;
+    if (springs) {
+      if (have_old) {
+        slots.old_partner = &world.springs.partner[i * K];
+        slots.old_displacement = &world.springs.displacement[i * K];
+      }
+      slots.new_partner = &next_springs_.partner[i * K];
+      slots.new_displacement = &next_springs_.displacement[i * K];
+    }
+    visit_contacts(
+        world, i,
+        [&](const ContactForce<double>& f, std::int64_t partner, double smaller_radius) {
+          const bool wall = partner < 0;
+          const bool counted = counted_here(world, i, partner);
+          out.add(f, smaller_radius, counted);
+          out.pairs += (!wall && counted) ? 1 : 0;
+          out.walls += wall ? 1 : 0;
+        },
+        springs ? &slots : nullptr);
+    if (springs) overflows[i] = slots.overflows;
   });
+  for (std::size_t o : overflows) stats.spring_overflows += o;
 
   // Statistics in particle order.
   for (std::uint32_t i = 0; i < n; ++i) {
@@ -325,6 +395,7 @@ StepStats CpuStepper::step(World& world) {
   if (world.materials.size() != material_count_) reset_energy_reference(world);
   StepStats stats;
   compute_forces(world, stats);
+  if (settings_.tangential == TangentialModel::Spring) std::swap(world.springs, next_springs_);
   // Kinetic + potential + spring energy at the start of the step: what the contacts may only lose.
   const Energy start = energy(world);
   const double mechanical = start.total() + stats.elastic_energy;  // J

@@ -18,9 +18,16 @@ enum class Integrator {
   SemiImplicitEuler,  // symplectic: velocities first, then positions/orientations with the new ones
 };
 
+// The tangential force law.
+enum class TangentialModel {
+  Viscous,  // thesis eq. 3.28: viscous, capped at mu F_n; no static friction, so heaps creep slowly
+  Spring,   // elastic spring per contact plus the viscous term, capped (static friction; CPU reference only)
+};
+
 struct StepSettings {
   double dt = 1e-5;  // s
   NormalDamping normal_damping = NormalDamping::Tsuji;
+  TangentialModel tangential = TangentialModel::Viscous;
   double thesis_reference_speed = 1.0;  // m/s: where the thesis damping gives exactly the restitution
   Integrator integrator = Integrator::ForwardEuler;
   // Velocity clamp (thesis 3.3.1, CFL): no particle may move more than `cfl` grid cells in a step;
@@ -50,6 +57,7 @@ struct StepStats {
   std::size_t velocity_clamps = 0;        // bodies whose linear speed was capped
   std::size_t angular_velocity_clamps = 0;
   std::size_t overlap_clamps = 0;         // contacts whose overlap was capped
+  std::size_t spring_overflows = 0;       // contacts beyond a particle's spring slots (no spring: viscous only)
 };
 
 // The hashed uniform grid: cell = largest particle diameter; a table of next_pow2(2 N) buckets
@@ -96,8 +104,17 @@ class CpuStepper {
  private:
   void prepare_particles(const World& world);
   // Calls fn(force, partner, smaller radius) for each touching partner of particle i, in a fixed order.
+  // With springs (TangentialModel::Spring) each touching contact takes its spring from `old_slots`
+  // (particle i's kSlots) and, when `new_slots` is given, writes it back there, advanced.
+  struct SpringSlots {
+    const std::int64_t* old_partner = nullptr;
+    const Eigen::Vector3d* old_displacement = nullptr;
+    std::int64_t* new_partner = nullptr;
+    Eigen::Vector3d* new_displacement = nullptr;
+    std::size_t used = 0, overflows = 0;
+  };
   template <typename Fn>
-  void visit_contacts(const World& world, std::uint32_t i, Fn&& fn) const;
+  void visit_contacts(const World& world, std::uint32_t i, Fn&& fn, SpringSlots* springs = nullptr) const;
   void compute_forces(const World& world, StepStats& stats);
   void integrate(World& world, StepStats& stats) const;
   void check_stability(const World& world, double mechanical_energy) const;
@@ -108,6 +125,7 @@ class CpuStepper {
   NeighbourGrid grid_;
   // Per-particle scratch, reused between steps.
   std::vector<Eigen::Vector3d> position_, velocity_, force_, torque_;
+  ContactSprings next_springs_;  // written by compute_forces, swapped into the world by step()
   double energy_reference_ = 0;  // J: kinetic + potential + spring energy when the reference was taken
   double energy_scale_ = 0;      // J
   double dynamic_mass_ = 0;      // kg

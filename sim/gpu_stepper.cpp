@@ -52,6 +52,10 @@ GpuStepper::GpuStepper(gpu::Context& context, const World& world, const StepSett
       metrics_(gpu::Program::compute(library_, "sim/reduce_metrics.comp", precision_defines(precision))),
       particle_stats_(gpu::Program::compute(library_, "sim/reduce_particle_stats.comp")),
       grid_(library_) {
+  if (settings.tangential == TangentialModel::Spring) {
+    throw Error(ExitCode::BadInput, "simulation.tangential = \"spring\" (static friction) runs on the CPU reference "
+                                    "only so far: use --cpu, or tangential = \"viscous\"");
+  }
   upload(world);
 }
 

@@ -22,7 +22,9 @@ StepStats CpuReferenceStepper::advance(World& world, std::int64_t steps) {
     clamps.velocity_clamps += last.velocity_clamps;
     clamps.angular_velocity_clamps += last.angular_velocity_clamps;
     clamps.overlap_clamps += last.overlap_clamps;
+    clamps.spring_overflows += last.spring_overflows;
   }
+  last.spring_overflows = clamps.spring_overflows;
   last.velocity_clamps = clamps.velocity_clamps;
   last.angular_velocity_clamps = clamps.angular_velocity_clamps;
   last.overlap_clamps = clamps.overlap_clamps;

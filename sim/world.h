@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "sim/contact_model.h"
@@ -69,9 +70,21 @@ struct Walls {
   std::vector<CylinderWall> cylinders;
 };
 
+// Tangential springs of the contacts (TangentialModel::Spring only): kSpringSlots per particle, each
+// the partner (particle id, or -1 - wall index; kNoPartner when free) and the elastic tangential
+// displacement (m). Particle ids are stable (grains are only appended), so the springs survive
+// emitters adding grains. Empty until a spring step runs.
+struct ContactSprings {
+  static constexpr std::size_t kSlots = 12;
+  static constexpr std::int64_t kNoPartner = std::numeric_limits<std::int64_t>::max();
+  std::vector<std::int64_t> partner;          // particles * kSlots
+  std::vector<Eigen::Vector3d> displacement;  // m, particles * kSlots
+};
+
 struct World {
   Bodies bodies;
   Particles particles;
+  ContactSprings springs;
   Walls walls;                               // rough walls are static bodies made of particles
   std::vector<Material> materials;
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2

@@ -6,6 +6,7 @@
 #include <limits>
 #include <random>
 
+#include "core/error.h"
 #include "sim/cpu_reference.h"
 #include "sim/grain.h"
 #include "sim/world.h"
@@ -97,6 +98,18 @@ TEST_F(GpuStepperTest, TwoGrainCollisionTrajectoryAgrees) {
   }
   // They did collide: the x velocities reversed.
   EXPECT_LT(cpu_world.bodies.linear_velocity[0].x(), 0.0);
+}
+
+TEST_F(GpuStepperTest, TangentialSpringIsRefusedWithAClearMessage) {
+  StepSettings settings = small_step();
+  settings.tangential = TangentialModel::Spring;
+  try {
+    GpuStepper gpu(context, jostling_grains(8, 1), settings);
+    FAIL() << "the GPU pipeline has no contact springs yet";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::BadInput);
+    EXPECT_NE(std::string(e.what()).find("CPU reference only"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(GpuStepperTest, SameSceneGivesBitwiseTheSameState) {
