@@ -285,6 +285,10 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
     deck.approximations.push_back(
         "dynamic props: gravity acts on the atoms (weighted to the body's mass), whose centroid may sit slightly off "
         "the mesh's centre of mass: a small gravity torque tetrasand does not have");
+    deck.approximations.push_back(
+        "dynamic props: LAMMPS's tangential damping grows with sqrt(m*), and the coefficients are matched at a "
+        "grain's contact, so a heavy prop's contacts get about sqrt(M_prop / m_grain) times tetrasand's gamma_s "
+        "(a 1 kg cube on a floor: ~150 times): props slide much less in LAMMPS than in tetrasand");
   }
   if (!pours.empty()) {
     deck.approximations.push_back(
