@@ -33,6 +33,16 @@ std::string vec(const Eigen::Vector3d& v) { return fmt::format("{} {} {}", num(v
 struct ReferenceContact {
   double effective_mass;    // kg
   double effective_radius;  // m
+  double weight;            // N, the load pressing the contact at rest
+};
+
+// Atom types: one per material (grains, walls, static and kinematic props), plus one per dynamic
+// prop, so that its contacts get coefficients matched at its own mass (LAMMPS's tangential damping
+// grows with sqrt(m*)). `mass` and `radius` describe the body a contact of this type belongs to.
+struct AtomType {
+  std::uint16_t material;
+  double mass;    // kg
+  double radius;  // m
 };
 
 struct PairModel {
@@ -53,8 +63,7 @@ PairModel pair_model(const Scene& scene, const Material& a, const Material& b, c
   }
   m.lammps_restitution = lammps_restitution_for_alpha(p.damping_strength);
   const double k_n = 4.0 / 3.0 * p.effective_modulus * std::sqrt(ref.effective_radius);  // N/m^1.5
-  const double weight = ref.effective_mass * 2.0 * std::max(scene.gravity.norm(), 1e-3);  // N, one grain
-  m.reference_overlap = std::pow(weight / k_n, 2.0 / 3.0);
+  m.reference_overlap = std::pow(ref.weight / k_n, 2.0 / 3.0);
   const double knfac = k_n * std::sqrt(m.reference_overlap);  // N/m
   const double eta_n = p.damping_strength * std::sqrt(ref.effective_mass * knfac);  // N s/m
   m.tangential_factor = eta_n > 0 ? p.tangential_damping / eta_n : 0.0;
@@ -91,10 +100,11 @@ struct Box {
   }
 };
 
-std::string data_file(const World& w, const std::vector<std::int64_t>& mol, const Box& box) {
+std::string data_file(const World& w, const std::vector<std::int64_t>& mol, const std::vector<int>& body_type,
+                      std::size_t type_count, const Box& box) {
   const std::vector<Eigen::Vector3d> x = particle_positions(w);
   std::string out = "LAMMPS data file written by tetrasand export lammps (SI units: m, kg)\n\n";
-  out += fmt::format("{} atoms\n{} atom types\n\n", x.size(), w.materials.size());
+  out += fmt::format("{} atoms\n{} atom types\n\n", x.size(), type_count);
   out += fmt::format("{} {} xlo xhi\n{} {} ylo yhi\n{} {} zlo zhi\n\n", num(box.lo.x()), num(box.hi.x()),
                      num(box.lo.y()), num(box.hi.y()), num(box.lo.z()), num(box.hi.z()));
   // fix gravity pulls on atom masses: a dynamic body's atom densities are scaled so that its atoms
@@ -114,7 +124,8 @@ std::string data_file(const World& w, const std::vector<std::int64_t>& mol, cons
   for (std::size_t i = 0; i < x.size(); ++i) {
     const std::uint16_t m = w.particles.material[i];
     const double density = w.materials[m].density * density_scale[w.particles.body[i]];  // kg/m^3
-    out += fmt::format("{} {} {} {} {}\n", i + 1, m + 1, num(2 * w.particles.radius[i]), num(density), vec(x[i]));
+    const int type = body_type[w.particles.body[i]] > 0 ? body_type[w.particles.body[i]] : m + 1;
+    out += fmt::format("{} {} {} {} {}\n", i + 1, type, num(2 * w.particles.radius[i]), num(density), vec(x[i]));
   }
   out += "\nMolecules\n\n";
   for (std::size_t i = 0; i < x.size(); ++i) out += fmt::format("{} {}\n", i + 1, mol[w.particles.body[i]]);
@@ -177,15 +188,13 @@ void check_exportable(const Scene& scene, const World& w) {
       refuse(scene, "a kinematic prop that both translates and spins (LAMMPS fix move does one or the other)");
     }
   }
-  std::set<std::uint16_t> dynamic_materials;
-  for (std::size_t i = 0; i < w.particles.size(); ++i) {
-    if (is_dynamic(w, w.particles.body[i])) dynamic_materials.insert(w.particles.material[i]);
-  }
-  dynamic_materials.insert(scene.grain.material);
   const bool pours = std::any_of(scene.emitters.begin(), scene.emitters.end(),
                                  [](const Emitter& e) { return e.type == EmitterType::Pour; });
-  if (pours && dynamic_materials.size() > 1) {
-    refuse(scene, "pour emitters together with dynamic props of another material than the grains'");
+  const bool dynamic_props = std::any_of(scene.props.begin(), scene.props.end(),
+                                         [](const Prop& p) { return p.motion == MotionType::Dynamic; });
+  if (pours && dynamic_props) {
+    refuse(scene, "pour emitters together with dynamic props (fix deposit cannot add grains to the per-type wall "
+                  "groups the props need)");
   }
 }
 
@@ -258,12 +267,34 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
   std::stable_sort(pours.begin(), pours.end(), [](const PourEvent& a, const PourEvent& b) { return a.step < b.step; });
 
   // Pair and wall coefficients (grain-grain and grain-wall reference contacts).
-  const ReferenceContact grain_pair{grain.mass / 2, grain.particle_radius / 2};
-  const ReferenceContact grain_wall{grain.mass, grain.particle_radius};
-  std::set<std::uint16_t> dynamic_materials{scene.grain.material};
-  for (std::size_t i = 0; i < w.particles.size(); ++i) {
-    if (is_dynamic(w, w.particles.body[i])) dynamic_materials.insert(w.particles.material[i]);
+  // Atom types: materials first (type = material + 1), then one per dynamic prop.
+  const double g_ref = std::max(scene.gravity.norm(), 1e-3);  // m/s^2, for the reference overlaps
+  std::vector<AtomType> types;
+  for (std::uint16_t m = 0; m < w.materials.size(); ++m) types.push_back({m, grain.mass, grain.particle_radius});
+  std::vector<int> body_type(w.bodies.size(), 0);  // 0: the material's type
+  std::set<int> dynamic_types{scene.grain.material + 1};
+  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+    if (!is_dynamic(w, b)) continue;
+    const std::uint32_t first = w.bodies.first_particle[b];
+    const bool is_grain = w.bodies.particle_count[b] == 4 && w.particles.radius[first] == grain.particle_radius &&
+                          w.particles.material[first] == scene.grain.material;
+    if (is_grain) continue;
+    types.push_back({w.particles.material[first], 1.0 / w.bodies.inverse_mass[b], w.particles.radius[first]});
+    body_type[b] = static_cast<int>(types.size());
+    dynamic_types.insert(body_type[b]);
   }
+  auto type_pair = [&](std::size_t a, std::size_t b) {
+    const AtomType &ta = types[a], &tb = types[b];
+    return ReferenceContact{ta.mass * tb.mass / (ta.mass + tb.mass), ta.radius * tb.radius / (ta.radius + tb.radius),
+                            std::min(ta.mass, tb.mass) * g_ref};
+  };
+  auto type_wall = [&](int t) {
+    const AtomType& ta = types[static_cast<std::size_t>(t - 1)];
+    return ReferenceContact{ta.mass, ta.radius, ta.mass * g_ref};
+  };
+  auto name = [&](std::uint16_t m) {
+    return scene.material_names.size() > m ? scene.material_names[m] : std::to_string(m);
+  };
 
   std::string in;
   auto line = [&](const std::string& s) { in += s + "\n"; };
@@ -286,9 +317,9 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
         "dynamic props: gravity acts on the atoms (weighted to the body's mass), whose centroid may sit slightly off "
         "the mesh's centre of mass: a small gravity torque tetrasand does not have");
     deck.approximations.push_back(
-        "dynamic props: LAMMPS's tangential damping grows with sqrt(m*), and the coefficients are matched at a "
-        "grain's contact, so a heavy prop's contacts get about sqrt(M_prop / m_grain) times tetrasand's gamma_s "
-        "(a 1 kg cube on a floor: ~150 times): props slide much less in LAMMPS than in tetrasand");
+        "dynamic props: each has its own atom type, so its tangential damping is matched at its own mass, at the "
+        "overlap its whole weight would make on one contact; spread over many contacts the overlaps are smaller "
+        "and LAMMPS's damping (~ delta^(1/4)) somewhat lower than tetrasand's gamma_s");
   }
   if (!pours.empty()) {
     deck.approximations.push_back(
@@ -345,12 +376,12 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
   line("");
   line("# Contacts: one coefficient set per pair of materials (atom type = material index + 1).");
   line("pair_style      granular");
-  for (std::size_t a = 0; a < w.materials.size(); ++a) {
-    for (std::size_t b = a; b < w.materials.size(); ++b) {
-      const PairModel m = pair_model(scene, w.materials[a], w.materials[b], grain_pair);
-      line(fmt::format("pair_coeff      {} {} {}   # {} - {}", a + 1, b + 1, granular_model(m),
-                       scene.material_names.size() > a ? scene.material_names[a] : std::to_string(a),
-                       scene.material_names.size() > b ? scene.material_names[b] : std::to_string(b)));
+  for (std::size_t a = 0; a < types.size(); ++a) {
+    for (std::size_t b = a; b < types.size(); ++b) {
+      const PairModel m = pair_model(scene, w.materials[types[a].material], w.materials[types[b].material], type_pair(a, b));
+      line(fmt::format("pair_coeff      {} {} {}   # {}{} - {}{}", a + 1, b + 1, granular_model(m),
+                       name(types[a].material), a < w.materials.size() ? "" : " (dynamic prop)",
+                       name(types[b].material), b < w.materials.size() ? "" : " (dynamic prop)"));
     }
   }
   line("");
@@ -376,15 +407,15 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
   }
   line("");
 
-  // Smooth walls, one fix per wall and dynamic material (each material pair has its own coefficients).
-  std::vector<std::pair<std::string, std::uint16_t>> wall_groups;
-  if (dynamic_materials.size() == 1) {
-    wall_groups.emplace_back("dynamic", *dynamic_materials.begin());
+  // Smooth walls, one fix per wall and dynamic atom type (each has its own coefficients).
+  std::vector<std::pair<std::string, int>> wall_groups;
+  if (dynamic_types.size() == 1) {
+    wall_groups.emplace_back("dynamic", *dynamic_types.begin());
   } else {
-    for (std::uint16_t m : dynamic_materials) {
-      line(fmt::format("group           type{} type {}", m + 1, m + 1));
-      line(fmt::format("group           dynamic{} intersect dynamic type{}", m + 1, m + 1));
-      wall_groups.emplace_back(fmt::format("dynamic{}", m + 1), m);
+    for (int t : dynamic_types) {
+      line(fmt::format("group           type{} type {}", t, t));
+      line(fmt::format("group           dynamic{} intersect dynamic type{}", t, t));
+      wall_groups.emplace_back(fmt::format("dynamic{}", t), t);
     }
   }
   int wall_id = 0;
@@ -395,16 +426,17 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
     if (!aligned) {
       line(fmt::format("region          wall{} plane {} {} side in units box", wall_id, vec(p.point), vec(p.normal)));
     }
-    for (const auto& [group, material] : wall_groups) {
-      const std::string model = granular_model(pair_model(scene, w.materials[material], w.materials[p.material], grain_wall));
+    for (const auto& [group, type] : wall_groups) {
+      const std::string model = granular_model(pair_model(scene, w.materials[types[static_cast<std::size_t>(type - 1)].material],
+                                                          w.materials[p.material], type_wall(type)));
       if (aligned) {
         const std::string at = num(p.point[axis]);
         const std::string bounds = p.normal[axis] > 0 ? at + " NULL" : "NULL " + at;
-        line(fmt::format("fix             wall{}_{} {} wall/gran granular {} {}plane {}", wall_id, material + 1, group,
+        line(fmt::format("fix             wall{}_{} {} wall/gran granular {} {}plane {}", wall_id, type, group,
                          model, "xyz"[axis], bounds));
       } else {
         line(fmt::format("fix             wall{}_{} {} wall/gran/region granular {} region wall{}", wall_id,
-                         material + 1, group, model, wall_id));
+                         type, group, model, wall_id));
       }
     }
   }
@@ -413,10 +445,11 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
     auto bound = [](double z) { return std::abs(z) >= 1e29 ? std::string("INF") : num(z); };
     line(fmt::format("region          wall{} cylinder z {} {} {} {} {} side in open 1 open 2 units box", wall_id,
                      num(c.axis.x()), num(c.axis.y()), num(c.radius), bound(c.z_min), bound(c.z_max)));
-    for (const auto& [group, material] : wall_groups) {
-      const std::string model = granular_model(pair_model(scene, w.materials[material], w.materials[c.material], grain_wall));
+    for (const auto& [group, type] : wall_groups) {
+      const std::string model = granular_model(pair_model(scene, w.materials[types[static_cast<std::size_t>(type - 1)].material],
+                                                          w.materials[c.material], type_wall(type)));
       line(fmt::format("fix             wall{}_{} {} wall/gran/region granular {} region wall{}", wall_id,
-                       material + 1, group, model, wall_id));
+                       type, group, model, wall_id));
     }
   }
   line("");
@@ -454,7 +487,7 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
   fs::create_directories(dir);
   const std::vector<fs::path> inputs{scene.file};
   deck.input = dir / "in.tetrasand";
-  write_file_atomically(dir / "data.tetrasand", data_file(w, mol, box), inputs);
+  write_file_atomically(dir / "data.tetrasand", data_file(w, mol, body_type, types.size(), box), inputs);
   write_file_atomically(dir / "bodies.rigid", bodies_file(w, mol, dynamic_count), inputs);
   write_file_atomically(dir / "grain.mol",
                         molecule_file(grain, scene.grain.material), inputs);
