@@ -169,6 +169,27 @@ TEST_F(ScanConvert, TwelveTriangleCubeAt512CubedIsExact) {
   EXPECT_LE(worst, 1e-3);
 }
 
+TEST_F(ScanConvert, AutomaticPaddingKeepsTheWholeBandAndZeroPaddingCutsItWithoutSignErrors) {
+  // A sphere whose band would cross the border of a grid fitted tightly to its box.
+  const TriangleMesh sphere = icosphere(1.0, 2);
+  SdfSettings automatic;
+  automatic.resolution = 20;
+  SdfSettings wide = automatic, none = automatic;
+  wide.padding = 10;
+  none.padding = 0;
+  const auto a = run(sphere, make_grid(bounding_box(sphere), automatic));
+  const auto w = run(sphere, make_grid(bounding_box(sphere), wide));
+  const auto n = run(sphere, make_grid(bounding_box(sphere), none));
+  EXPECT_EQ(a.stats.band_voxels, w.stats.band_voxels);
+  auto wa = w.grid->getConstAccessor();
+  // Grid-local coordinates differ by the padding, so values agree to float rounding, not bit for bit.
+  const double tolerance = 1e-4 * a.grid->voxelSize()[0];
+  for (auto it = a.grid->cbeginValueOn(); it; ++it) ASSERT_NEAR(*it, wa.getValue(it.getCoord()), tolerance);
+  // Without padding the band is cut at the border; what remains is the same field, with the same signs.
+  EXPECT_LT(n.stats.band_voxels, a.stats.band_voxels);
+  for (auto it = n.grid->cbeginValueOn(); it; ++it) ASSERT_NEAR(*it, wa.getValue(it.getCoord()), tolerance);
+}
+
 TEST_F(ScanConvert, LongTrianglesSpanningHundredsOfLayersComeOutExact) {
   // Each side triangle spans ~480 z-layers: far more slices than one geometry-shader invocation may emit.
   const TriangleMesh bar = box_mesh({-0.2, -0.2, -4.0}, {0.2, 0.2, 4.0});
