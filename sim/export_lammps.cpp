@@ -49,7 +49,8 @@ struct PairModel {
   double lammps_modulus = 0;      // E handed to hertz/material (Pa), with nu = 0
   double lammps_restitution = 0;  // e whose Tsuji alpha equals tetrasand's damping strength
   double friction = 0;
-  double tangential_factor = 0;   // x_gamma_t of linear_nohistory
+  double tangential_factor = 0;   // x_gamma_t of linear_nohistory / mindlin
+  double tangential_stiffness = 0;  // Pa: 8 G* for mindlin (tetrasand's spring model), 0 = no spring
   double reference_overlap = 0;   // m, where eta_t == gamma_s
 };
 
@@ -67,12 +68,19 @@ PairModel pair_model(const Scene& scene, const Material& a, const Material& b, c
   const double knfac = k_n * std::sqrt(m.reference_overlap);  // N/m
   const double eta_n = p.damping_strength * std::sqrt(ref.effective_mass * knfac);  // N s/m
   m.tangential_factor = eta_n > 0 ? p.tangential_damping / eta_n : 0.0;
+  if (scene.simulation.step.tangential == TangentialModel::Spring) {
+    m.tangential_stiffness = 8.0 * p.effective_shear_modulus;  // k_t = 8 G* sqrt(R* delta), as LAMMPS's mindlin
+  }
   return m;
 }
 
 std::string granular_model(const PairModel& m) {
-  return fmt::format("hertz/material {} {} 0.0 tangential linear_nohistory {} {} damping tsuji limit_damping",
-                     num(m.lammps_modulus), num(m.lammps_restitution), num(m.tangential_factor), num(m.friction));
+  const std::string tangential =
+      m.tangential_stiffness > 0
+          ? fmt::format("mindlin {} {} {}", num(m.tangential_stiffness), num(m.tangential_factor), num(m.friction))
+          : fmt::format("linear_nohistory {} {}", num(m.tangential_factor), num(m.friction));
+  return fmt::format("hertz/material {} {} 0.0 tangential {} damping tsuji limit_damping", num(m.lammps_modulus),
+                     num(m.lammps_restitution), tangential);
 }
 
 bool is_dynamic(const World& w, std::size_t b) { return w.bodies.motion[b] == MotionType::Dynamic; }
@@ -300,8 +308,12 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
   auto line = [&](const std::string& s) { in += s + "\n"; };
   const double skin = 0.3 * 2 * max_radius;  // m
   deck.approximations = {
-      "tangential force: tetrasand's constant viscous gamma_s becomes linear_nohistory, whose damping scales with "
-      "the normal damping (as delta^(1/4)); equal at the overlap of one grain resting on another",
+      scene.simulation.step.tangential == TangentialModel::Spring
+          ? "tangential force: tetrasand's spring (k_t = 8 G* sqrt(R* delta)) becomes mindlin with the same k_t; its "
+            "viscous part gamma_s scales with the normal damping in LAMMPS (as delta^(1/4)), equal at the overlap of "
+            "one grain resting on another"
+          : "tangential force: tetrasand's constant viscous gamma_s becomes linear_nohistory, whose damping scales "
+            "with the normal damping (as delta^(1/4)); equal at the overlap of one grain resting on another",
       "integrator: LAMMPS fix rigid/small is velocity Verlet with Richardson quaternion updates; tetrasand uses " +
           std::string(scene.simulation.step.integrator == Integrator::ForwardEuler ? "forward Euler (thesis 3.44-3.50)"
                                                                                    : "semi-implicit Euler"),
