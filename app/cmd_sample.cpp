@@ -1,9 +1,13 @@
-// `tetrasand sample MESH`: the main job. A closed mesh becomes a particle rigid body.
+// `tetrasand sample MESH...`: the main job. A closed mesh becomes a particle rigid body; many meshes
+// (or list files) make a batch with one GPU context, a summary CSV and --shard I/N.
 #include <fmt/format.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
+#include <set>
+#include <sstream>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
@@ -17,18 +21,124 @@
 
 namespace ts::app {
 
+namespace {
+
+// Batch conversion (a whole asset library, split across machines with no coordination): mesh k of the
+// expanded input list belongs to shard k mod N, so `--shard I/N` for I = 0..N-1 converts every mesh
+// exactly once; a failed mesh is a row of the summary CSV, not the end of the batch.
+struct Options {
+  std::string mesh, output = ".";  // mesh: the one being converted
+  std::vector<std::string> inputs;  // meshes and @list files from the command line
+  std::string list, shard, summary;
+  bool batch = false;
+  double radius = 0, coverage = 1.0, grain_radius = 0, voxel = 0, density = 1000.0, scale = 1.0;
+  std::size_t count = 0, probes = 1'000'000;
+  std::uint64_t seed = 1;
+  int rounds = 12;
+  bool json = false, timings = false, allow_open = false;
+};
+
+struct BatchRow {
+  std::string mesh, status = "ok", error, body_json;
+  int exit_code = 0;
+  std::size_t particles = 0;
+  sampler::ParticleBody::Quality quality;
+  double radius = 0.0;
+};
+
+int convert_one(const std::shared_ptr<Options>& o, gpu::Context& context, BatchRow& row);
+
+// Lines of a list file: one mesh path each, relative to the list's folder unless absolute; blank
+// lines and lines starting with # are skipped.
+void append_list(const std::filesystem::path& list, std::vector<std::string>& out) {
+  std::istringstream in(read_file(list));
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const auto last = line.find_last_not_of(" \t\r");
+    const std::filesystem::path path = line.substr(first, last - first + 1);
+    out.push_back((path.is_absolute() ? path : list.parent_path() / path).lexically_normal().string());
+  }
+}
+
+struct Shard {
+  std::size_t index = 0, count = 1;
+};
+
+Shard parse_shard(const std::string& text) {
+  Shard s;
+  const auto slash = text.find('/');
+  try {
+    if (slash == std::string::npos) throw std::invalid_argument("no slash");
+    std::size_t used = 0;
+    s.index = std::stoul(text.substr(0, slash), &used);
+    if (used != slash) throw std::invalid_argument("index");
+    s.count = std::stoul(text.substr(slash + 1), &used);
+    if (used != text.size() - slash - 1) throw std::invalid_argument("count");
+  } catch (const std::exception&) {
+    throw Error(ExitCode::Usage, "--shard wants I/N with 0 <= I < N (got '" + text + "')");
+  }
+  if (s.count == 0 || s.index >= s.count) throw Error(ExitCode::Usage, "--shard wants I/N with 0 <= I < N (got '" + text + "')");
+  return s;
+}
+
+std::vector<std::string> expand_inputs(const Options& o) {
+  std::vector<std::string> all;
+  for (const std::string& item : o.inputs) {
+    if (item.size() > 1 && item[0] == '@') {
+      append_list(item.substr(1), all);
+    } else {
+      all.push_back(item);
+    }
+  }
+  if (!o.list.empty()) append_list(o.list, all);
+  if (all.empty()) throw InputError("no meshes to convert (empty list)");
+  const Shard shard = parse_shard(o.shard.empty() ? "0/1" : o.shard);
+  std::vector<std::string> mine;
+  for (std::size_t k = 0; k < all.size(); ++k)
+    if (k % shard.count == shard.index) mine.push_back(all[k]);
+  return mine;
+}
+
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
+  return quoted + "\"";
+}
+
+void write_summary(const std::filesystem::path& path, const std::vector<BatchRow>& rows) {
+  std::string csv =
+      "mesh,status,exit_code,particles,particle_radius_m,relative_radius,cv,covering_over_r,max_abs_phi_over_r,"
+      "iterations,injection_rounds,converged,seconds,body_json,error\n";
+  for (const BatchRow& r : rows) {
+    const auto& q = r.quality;
+    csv += fmt::format("{},{},{},{},{:.9g},{:.6f},{:.6f},{:.6f},{:.3e},{},{},{},{:.3f},{},{}\n", csv_field(r.mesh),
+                       r.status, r.exit_code, r.particles, r.radius, q.relative_radius, q.cv, q.covering_over_r,
+                       q.max_abs_phi_over_r, q.iterations, q.injection_rounds, q.converged ? 1 : 0, q.seconds,
+                       csv_field(r.body_json), csv_field(r.error));
+  }
+  std::filesystem::create_directories(path.parent_path().empty() ? "." : path.parent_path());
+  write_file_atomically(path, csv);
+}
+
+std::filesystem::path summary_path(const Options& o) {
+  if (!o.summary.empty()) return o.summary;
+  if (o.shard.empty()) return std::filesystem::path(o.output) / "summary.csv";
+  const Shard s = parse_shard(o.shard);
+  return std::filesystem::path(o.output) / fmt::format("summary-{}-of-{}.csv", s.index, s.count);
+}
+
+}  // namespace
+
 Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
   auto* cmd = app.add_subcommand("sample", "Convert a closed mesh into a particle rigid body (NAME.particles.ply + NAME.body.json)");
-  struct Options {
-    std::string mesh, output = ".";
-    double radius = 0, coverage = 1.0, grain_radius = 0, voxel = 0, density = 1000.0, scale = 1.0;
-    std::size_t count = 0, probes = 1'000'000;
-    std::uint64_t seed = 1;
-    int rounds = 8;
-    bool json = false, timings = false, allow_open = false;
-  };
   auto o = std::make_shared<Options>();
-  cmd->add_option("MESH", o->mesh, "Closed, consistently oriented triangle mesh")->required();
+  cmd->add_option("MESH", o->inputs, "Closed, consistently oriented triangle meshes; @FILE reads a list (one path a line)");
+  cmd->add_option("--list", o->list, "File listing meshes to convert, one path a line (relative to the file)");
+  cmd->add_option("--shard", o->shard, "I/N: convert only meshes k with k mod N = I of the expanded list (0 <= I < N)");
+  cmd->add_option("--summary", o->summary, "Summary CSV of a batch (default DIR/summary.csv, DIR/summary-I-of-N.csv with --shard)");
   cmd->add_option("-o,--output", o->output, "Output directory")->capture_default_str();
   auto* radius = cmd->add_option("--radius", o->radius, "Particle radius [m]")->check(CLI::PositiveNumber);
   cmd->add_option("--count", o->count, "Particle count instead of a radius")->check(CLI::PositiveNumber)->excludes(radius);
@@ -49,6 +159,51 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_flag("--json", o->json, "Print the body.json summary on stdout");
   cmd->add_flag("--timings", o->timings, "Per-kernel GPU times");
   return [o, &global] {
+    if (o->inputs.empty() && o->list.empty()) throw Error(ExitCode::Usage, "sample: give at least one MESH or --list FILE");
+    const std::vector<std::string> meshes = expand_inputs(*o);
+    o->batch = meshes.size() > 1 || !o->list.empty() || !o->shard.empty() || !o->summary.empty() ||
+               (!o->inputs.empty() && o->inputs[0].rfind('@', 0) == 0);
+    gpu::ContextOptions context_options;
+    context_options.device = global.device;
+    context_options.debug = global.gl_debug;
+    gpu::Context context(context_options);  // one context for the whole batch
+    BatchRow row;
+    if (!o->batch) {
+      o->mesh = meshes.front();
+      return convert_one(o, context, row);
+    }
+    std::vector<BatchRow> rows;
+    std::set<std::string> names;
+    int failed = 0, first_code = 0;
+    for (const std::string& path : meshes) {
+      auto one = std::make_shared<Options>(*o);
+      one->mesh = path;
+      BatchRow r;
+      r.mesh = path;
+      try {
+        if (!names.insert(std::filesystem::path(path).stem().string()).second) {
+          throw InputError(path, "another mesh of the batch has the same name; its outputs would overwrite");
+        }
+        convert_one(one, context, r);
+      } catch (const GpuError&) {
+        throw;  // the context is gone: no later mesh can run
+      } catch (const Error& e) {
+        r.status = "failed", r.error = e.what(), r.exit_code = static_cast<int>(e.code());
+        log::error("{}", e.what());
+      }
+      if (r.exit_code != 0 && failed++ == 0) first_code = r.exit_code;
+      rows.push_back(r);
+    }
+    const std::filesystem::path csv = summary_path(*o);
+    write_summary(csv, rows);
+    if (!o->json) fmt::print("{} of {} meshes converted; summary: {}\n", rows.size() - failed, rows.size(), csv.string());
+    return first_code;
+  };
+}
+
+namespace {
+int convert_one(const std::shared_ptr<Options>& o, gpu::Context& context, BatchRow& row) {
+  {
     TriangleMesh mesh = load_mesh(o->mesh);
     if (o->scale != 1.0) scale_mesh(mesh, o->scale);
     const MeshReport report = analyze_mesh(mesh);
@@ -69,10 +224,6 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
     settings.probes = o->probes;
     settings.timings = o->timings;
 
-    gpu::ContextOptions context_options;
-    context_options.device = global.device;
-    context_options.debug = global.gl_debug;
-    gpu::Context context(context_options);
     const bool terminal = ::isatty(STDERR_FILENO) != 0;
     const auto progress = [&](const sampler::SampleProgress& p) {
       const std::string line = fmt::format("round {}  iteration {:>5}  particles {:>8}  residual {:.2e}", p.round,
@@ -89,9 +240,11 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
     const std::string name = std::filesystem::path(o->mesh).stem().string();
     const std::filesystem::path json = sampler::write_body(o->output, name, body);
     const auto& q = body.quality;
+    row.status = "ok", row.body_json = json.string(), row.particles = body.positions.size();
+    row.quality = q, row.radius = body.particle_radius;
     if (o->json) {
       std::ifstream in(json);
-      fmt::print("{}\n", nlohmann::json::parse(in).dump(2));
+      fmt::print("{}\n", nlohmann::json::parse(in).dump(o->batch ? -1 : 2));  // a batch prints JSON Lines
     } else {
       fmt::print("{} -> {}\n", o->mesh, json.string());
       fmt::print("  particles        {} of radius {:.6g} m (area estimate {}, {:+.1f} %)\n", body.positions.size(),
@@ -109,7 +262,8 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
     }
     if (o->timings) fmt::print("{}", result.timing_report);
     return 0;
-  };
+  }
 }
+}  // namespace
 
 }  // namespace ts::app

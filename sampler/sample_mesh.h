@@ -26,7 +26,7 @@ struct SampleSettings {
   double voxel_size = 0.0;     // SDF voxel [m]; 0: r / 2, so trilinear interpolation error stays far below r
   double density = 1000.0;     // kg/m^3
   std::uint64_t seed = 1;
-  int max_rounds = 8;                  // coverage repair rounds
+  int max_rounds = 12;                 // coverage repair rounds
   std::size_t probes = 1'000'000;      // surface points the covering radius is measured on
   std::size_t max_particles = 20'000'000;
   std::size_t max_sdf_bytes = 1ull << 30;  // dense SDF texture budget; the voxel grows (with a warning) past it

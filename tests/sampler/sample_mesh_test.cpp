@@ -1,0 +1,175 @@
+// The whole sampler (tetrasand sample's pipeline) against the quality figures of the sample issue,
+// measured independently of what the sampler reports: relative radius rho >= 0.7, CV of nearest-
+// neighbour distances <= 0.1, covering radius c <= r over a million area-uniform probes, largest
+// |phi| <= 0.05 r, particle count within 10 % of the area estimate, mass properties equal to the
+// mesh's. Counts are small (300-900) so the set stays within a few minutes on llvmpipe.
+#include "sampler/sample_mesh.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "core/error.h"
+#include "core/mass_properties.h"
+#include "core/mesh_io.h"
+#include "sampler/sampling_quality.h"
+#include "tests/test_support.h"
+
+namespace ts::sampler {
+namespace {
+
+gpu::Context& shared_context() {
+  static gpu::Context context;
+  return context;
+}
+
+struct Case {
+  std::string name;  // assets/NAME.obj, or cgal:NAME for libcgal-demo's data/meshes/NAME.off
+  std::size_t count;
+};
+
+std::string case_name(const ::testing::TestParamInfo<Case>& info) {
+  std::string n = info.param.name;
+  for (char& c : n)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return n + "_" + std::to_string(info.param.count);
+}
+
+TriangleMesh load_case(const std::string& name) {
+  if (name.rfind("cgal:", 0) == 0) return load_mesh(test::cgal_mesh(name.substr(5)));
+  return load_mesh(test::asset(name + ".obj"));
+}
+
+void expect_meets_quality_targets(const TriangleMesh& mesh, const SampleResult& result, double density) {
+  const ParticleBody& body = result.body;
+  const double r = body.particle_radius;
+  std::vector<Eigen::Vector3d> points;
+  for (const auto& p : body.positions) points.push_back(p.cast<double>());
+  CoverageSettings probes;
+  probes.probes = 1'000'000;
+  probes.seed = 777;  // not one the sampler used
+  const SamplingQuality q = measure_quality(mesh, points, r, probes);
+
+  EXPECT_GE(q.relative_radius, 0.7);
+  EXPECT_LE(q.cv_nn, 0.1);
+  EXPECT_LE(body.quality.covering_over_r, 1.0);  // the sampler's own 1M-probe pass
+  // Other probes can land a little deeper in the same largest hole; not by more than 1 %.
+  EXPECT_LE(q.covering_over_r, 1.01);
+  EXPECT_LE(q.max_abs_phi / r, 0.05);
+  EXPECT_NEAR(static_cast<double>(q.count), static_cast<double>(result.estimated_count),
+              0.1 * static_cast<double>(result.estimated_count));
+  EXPECT_TRUE(body.quality.converged);
+  // The reported figures are the measured ones.
+  EXPECT_NEAR(body.quality.relative_radius, q.relative_radius, 1e-6);
+  EXPECT_NEAR(body.quality.cv, q.cv_nn, 1e-6);
+
+  const MassProperties m = compute_mass_properties(mesh, density);
+  EXPECT_NEAR(body.mass, m.mass, 1e-9 * m.mass);
+  EXPECT_NEAR(body.volume, m.volume, 1e-9 * m.volume);
+  const double size = std::cbrt(m.volume);
+  EXPECT_LE((body.center_of_mass - m.center_of_mass).norm(), 1e-9 * size);
+  EXPECT_LE((body.inertia - m.inertia).norm(), 1e-9 * m.inertia.norm());
+}
+
+class SampleQuality : public ::testing::TestWithParam<Case> {};
+
+TEST_P(SampleQuality, MeetsEveryTargetOfTheIssue) {
+  const TriangleMesh mesh = load_case(GetParam().name);
+  SampleSettings settings;
+  settings.count = GetParam().count;
+  settings.density = 1250.0;
+  const SampleResult result = sample_mesh(shared_context(), mesh, settings);
+  expect_meets_quality_targets(mesh, result, settings.density);
+}
+
+// Generated assets (the plate is 2 mm thick: only far finer radii than a test can afford resolve it;
+// the bunny's ears are thinner than the voxel at these counts; both are reported as thin features;
+// the cube at 300 particles does not converge: particles on the rounded corners of the field ring).
+INSTANTIATE_TEST_SUITE_P(Assets, SampleQuality,
+                         ::testing::Values(Case{"sphere", 300}, Case{"sphere", 700}, Case{"cube", 500},
+                                           Case{"cube", 700}, Case{"torus", 300}, Case{"torus", 700},
+                                           Case{"trefoil", 400}, Case{"trefoil", 700}),
+                         case_name);
+
+// Real closed meshes from libcgal-demo, two radii each. Not here, because they miss a target at counts a
+// test can afford (see docs/benchmarks.md): elephant, fandisk, bunny00 (features thinner than the
+// spacing), joint and handle (holes left at sharp creases after the round limit).
+INSTANTIATE_TEST_SUITE_P(CgalMeshes, SampleQuality,
+                         ::testing::Values(Case{"cgal:knot1", 400}, Case{"cgal:knot1", 700}, Case{"cgal:eight", 400},
+                                           Case{"cgal:eight", 700}, Case{"cgal:blobby", 400}, Case{"cgal:blobby", 700},
+                                           Case{"cgal:cactus", 400}, Case{"cgal:cactus", 600},
+                                           Case{"cgal:bear", 300}, Case{"cgal:bear", 500}),
+                         case_name);
+
+TEST(SampleMesh, IsDeterministicForAFixedSeed) {
+  const TriangleMesh mesh = load_mesh(test::asset("torus.obj"));
+  SampleSettings settings;
+  settings.count = 300;
+  settings.probes = 200'000;
+  const SampleResult a = sample_mesh(shared_context(), mesh, settings);
+  const SampleResult b = sample_mesh(shared_context(), mesh, settings);
+  ASSERT_EQ(a.body.positions.size(), b.body.positions.size());
+  for (std::size_t i = 0; i < a.body.positions.size(); ++i) ASSERT_EQ(a.body.positions[i], b.body.positions[i]) << i;
+  settings.seed = 2;
+  const SampleResult c = sample_mesh(shared_context(), mesh, settings);
+  EXPECT_NE(a.body.positions.front(), c.body.positions.front());
+}
+
+TEST(SampleMesh, TinyAndHugeCopiesOfAMeshGiveTheSameQualityFigures) {
+  const TriangleMesh unit = load_mesh(test::asset("torus.obj"));
+  std::vector<ParticleBody::Quality> figures;
+  for (const double factor : {1e-4 / 0.1, 1e4 / 0.1}) {  // the torus is about 0.1 m across
+    TriangleMesh mesh = unit;
+    scale_mesh(mesh, factor);
+    SampleSettings settings;
+    settings.count = 400;
+    settings.probes = 1'000'000;
+    const SampleResult result = sample_mesh(shared_context(), mesh, settings);
+    expect_meets_quality_targets(mesh, result, settings.density);
+    figures.push_back(result.body.quality);
+  }
+  EXPECT_NEAR(figures[0].relative_radius, figures[1].relative_radius, 0.05);
+  EXPECT_NEAR(figures[0].cv, figures[1].cv, 0.02);
+  EXPECT_NEAR(figures[0].covering_over_r, figures[1].covering_over_r, 0.05);
+}
+
+TEST(SampleMesh, RadiusLargerThanTheMeshIsRefused) {
+  const TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));
+  SampleSettings settings;
+  settings.radius = 1.0;
+  try {
+    sample_mesh(shared_context(), mesh, settings);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("too large"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SampleMesh, CountOverTheMemoryCapNamesTheLargestThatFits) {
+  const TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));
+  SampleSettings settings;
+  settings.count = 5000;
+  settings.max_particles = 1000;
+  try {
+    sample_mesh(shared_context(), mesh, settings);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cap of 1000"), std::string::npos) << what;
+    EXPECT_NE(what.find("smallest radius that fits"), std::string::npos) << what;
+  }
+}
+
+TEST(SampleMesh, ZeroVolumeMeshIsRefused) {
+  // A closed but flat mesh: two copies of one square with opposite windings.
+  TriangleMesh flat;
+  flat.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  flat.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 2, 1}, {0, 3, 2}};
+  SampleSettings settings;
+  settings.count = 100;
+  EXPECT_THROW(sample_mesh(shared_context(), flat, settings), InputError);
+}
+
+}  // namespace
+}  // namespace ts::sampler
