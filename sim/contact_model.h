@@ -175,11 +175,15 @@ Vec3<Real> hertz_contact_force(const Vec3<Real>& n, Real delta, const Vec3<Real>
   return normal_force * n + tangential;
 }
 
-// Energy stored in the Hertz spring (J): the integral of k_n delta^(3/2), 2/5 k_n delta^(5/2).
+// Energy stored in the Hertz spring (J): the integral of k_n delta^(3/2), 2/5 k_n delta^(5/2). Past the
+// overlap clamp (raw overlap > the clamped one) the force stays at the clamp's, so the spring holds
+// that force times the extra depth more: what it gives back as the overlap relaxes, which the
+// blow-up check must count.
 template <typename Real>
-Real hertz_elastic_energy(Real delta, Real effective_radius, Real effective_modulus) {
+Real hertz_elastic_energy(Real delta, Real effective_radius, Real effective_modulus, Real raw_delta = Real(0)) {
   const Real k_n = Real(4.0 / 3.0) * effective_modulus * std::sqrt(effective_radius);
-  return Real(0.4) * k_n * delta * delta * std::sqrt(delta);
+  const Real beyond = std::max(Real(0), raw_delta - delta);
+  return Real(0.4) * k_n * delta * delta * std::sqrt(delta) + k_n * delta * std::sqrt(delta) * beyond;
 }
 
 // Sphere-sphere contact. Positions p (m), centre velocities v (m/s), angular velocities w (rad/s) of
@@ -209,7 +213,7 @@ ContactForce<Real> sphere_sphere_contact(const Vec3<Real>& p1, const Vec3<Real>&
   const Real effective_mass = Real(1) / (inverse_mass1 + inverse_mass2);
   out.arm = arm1;
   out.force = hertz_contact_force(n, out.overlap, v_c, effective_radius, effective_mass, c, dt, spring);
-  out.elastic_energy = hertz_elastic_energy(out.overlap, effective_radius, c.effective_modulus);
+  out.elastic_energy = hertz_elastic_energy(out.overlap, effective_radius, c.effective_modulus, raw_overlap);
   return out;
 }
 
@@ -230,7 +234,7 @@ ContactForce<Real> sphere_wall_contact(const Vec3<Real>& n, Real gap, const Vec3
   const Vec3<Real> v_c = v + w.cross(arm);
   out.arm = arm;
   out.force = hertz_contact_force(n, out.overlap, v_c, r, Real(1) / inverse_mass, c, dt, spring);
-  out.elastic_energy = hertz_elastic_energy(out.overlap, r, c.effective_modulus);
+  out.elastic_energy = hertz_elastic_energy(out.overlap, r, c.effective_modulus, raw_overlap);
   return out;
 }
 
