@@ -3,9 +3,10 @@
 //   1. SDF by GPU scan conversion, voxel = r / 2 unless set (see SampleSettings::voxel_size);
 //   2. seeds spread area-uniformly with the injected seed, as many as the coverage target needs;
 //   3. GPU relaxation (attraction to the zero level set + Gaussian repulsion);
-//   4. exact projection onto the mesh, coverage measured on many surface points, particles
-//      injected at the worst uncovered points and relaxed again, until the covering radius meets
-//      the target or the round limit;
+//   4. exact projection onto the mesh, crowded pairs (closer than 0.6 spacing) thinned, coverage
+//      measured on many surface points, particles injected at the worst uncovered points; the first
+//      3 rounds relax them with their neighbours (the rest frozen), later ones only place them, until
+//      the covering radius meets the target over the full probe set or the round limit;
 //   5. quality figures and mass properties (from the closed mesh, never from the particles).
 #include <functional>
 #include <string>
