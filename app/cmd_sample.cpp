@@ -16,6 +16,7 @@
 #include "core/log.h"
 #include "core/mesh_io.h"
 #include "core/mesh_report.h"
+#include "preview/body_preview.h"
 #include "sampler/particle_body.h"
 #include "sampler/sample_mesh.h"
 
@@ -46,7 +47,8 @@ struct BatchRow {
   double radius = 0.0;
 };
 
-int convert_one(const std::shared_ptr<Options>& o, gpu::Context& context, BatchRow& row);
+int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& write_preview, gpu::Context& context,
+                BatchRow& row);
 
 // Lines of a list file: one mesh path each, relative to the list's folder unless absolute; blank
 // lines and lines starting with # are skipped.
@@ -158,7 +160,9 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_flag("--allow-open", o->allow_open, "Sample an open or non-manifold mesh anyway (its mass properties are then approximate)");
   cmd->add_flag("--json", o->json, "Print the body.json summary on stdout");
   cmd->add_flag("--timings", o->timings, "Per-kernel GPU times");
-  return [o, &global] {
+  auto write_preview = std::make_shared<bool>(false);
+  cmd->add_flag("--preview", *write_preview, "Also write NAME.preview.png: the mesh's SDF ray-cast with the particles over it");
+  return [o, write_preview, &global] {
     if (o->inputs.empty() && o->list.empty()) throw Error(ExitCode::Usage, "sample: give at least one MESH or --list FILE");
     const std::vector<std::string> meshes = expand_inputs(*o);
     o->batch = meshes.size() > 1 || !o->list.empty() || !o->shard.empty() || !o->summary.empty() ||
@@ -170,7 +174,7 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
     BatchRow row;
     if (!o->batch) {
       o->mesh = meshes.front();
-      return convert_one(o, context, row);
+      return convert_one(o, write_preview, context, row);
     }
     std::vector<BatchRow> rows;
     std::set<std::string> names;
@@ -184,7 +188,7 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
         if (!names.insert(std::filesystem::path(path).stem().string()).second) {
           throw InputError(path, "another mesh of the batch has the same name; its outputs would overwrite");
         }
-        convert_one(one, context, r);
+        convert_one(one, write_preview, context, r);
       } catch (const GpuError&) {
         throw;  // the context is gone: no later mesh can run
       } catch (const Error& e) {
@@ -202,7 +206,8 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
 }
 
 namespace {
-int convert_one(const std::shared_ptr<Options>& o, gpu::Context& context, BatchRow& row) {
+int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& write_preview, gpu::Context& context,
+                BatchRow& row) {
   {
     TriangleMesh mesh = load_mesh(o->mesh);
     if (o->scale != 1.0) scale_mesh(mesh, o->scale);
@@ -261,6 +266,11 @@ int convert_one(const std::shared_ptr<Options>& o, gpu::Context& context, BatchR
                  body.volume, body.center_of_mass.x(), body.center_of_mass.y(), body.center_of_mass.z());
     }
     if (o->timings) fmt::print("{}", result.timing_report);
+    if (*write_preview) {
+      const std::filesystem::path png = std::filesystem::path(o->output) / (name + ".preview.png");
+      preview::write_body_preview(context, mesh, body, png, {o->mesh});
+      log::info("preview: {}", png.string());
+    }
     return 0;
   }
 }

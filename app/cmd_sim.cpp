@@ -8,6 +8,7 @@
 #include "app/commands.h"
 #include "core/log.h"
 #include "gpu/context.h"
+#include "preview/sim_frames.h"
 #include "sim/gpu_stepper.h"
 #include "sim/scene.h"
 #include "sim/scene_runner.h"
@@ -54,6 +55,14 @@ Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
     const bool terminal = ::isatty(STDERR_FILENO) != 0;
     const auto start = std::chrono::steady_clock::now();
     sim::RunHooks hooks;
+    std::unique_ptr<preview::SimFrameWriter> frames;  // [output] frames = true: PNGs through the preview renderer
+    if (scene.output.frames) {
+      if (!context) context = std::make_unique<gpu::Context>(gpu::ContextOptions{global.device, global.gl_debug});
+      frames = std::make_unique<preview::SimFrameWriter>(*context, scene);
+      hooks.write_frame = [&frames](const sim::World& world, std::int64_t frame, const std::filesystem::path& dir) {
+        frames->write(world, frame, dir);
+      };
+    }
     hooks.on_output = [&](const sim::World& world, const sim::StepStats& stats, std::int64_t step) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const double rate = elapsed > 0 ? static_cast<double>(step) / elapsed : 0.0;

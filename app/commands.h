@@ -18,6 +18,7 @@ using Runner = std::function<int()>;
 Runner add_devices_command(CLI::App& app, const GlobalOptions& global);
 Runner add_export_command(CLI::App& app, const GlobalOptions& global);
 Runner add_info_command(CLI::App& app, const GlobalOptions& global);
+Runner add_preview_command(CLI::App& app, const GlobalOptions& global);
 Runner add_sample_command(CLI::App& app, const GlobalOptions& global);
 Runner add_sdf_command(CLI::App& app, const GlobalOptions& global);
 Runner add_sim_command(CLI::App& app, const GlobalOptions& global);

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   add(app::add_info_command(app, global));
   add(app::add_sdf_command(app, global));
   add(app::add_sample_command(app, global));
+  add(app::add_preview_command(app, global));
   add(app::add_sim_command(app, global));
   add(app::add_export_command(app, global));
 

@@ -1,0 +1,28 @@
+#include "preview/body_preview.h"
+
+#include "preview/renderer.h"
+
+namespace ts::preview {
+
+void write_body_preview(gpu::Context& context, const TriangleMesh& mesh, const sampler::ParticleBody& body,
+                        const std::filesystem::path& png, const std::vector<std::filesystem::path>& inputs,
+                        const BodyPreviewSettings& settings) {
+  Renderer renderer(context);
+  sdf::SdfSettings grid;
+  grid.resolution = settings.resolution;
+  renderer.set_volume(volume_from_mesh(context, mesh, grid));
+  Particles particles;
+  for (const auto& p : body.positions) particles.centers.push_back(p.cast<double>());
+  particles.radii = {static_cast<float>(body.particle_radius)};
+  if (!particles.centers.empty()) renderer.set_particles(particles);
+
+  RenderSettings s;
+  s.width = settings.width;
+  s.height = settings.height;
+  s.up = Eigen::Vector3d::UnitY();
+  s.camera = frame_box(renderer.content_box(), view_direction(View::Iso, s.up), view_image_up(View::Iso, s.up),
+                       static_cast<double>(s.width) / s.height, false, 30.0);
+  write_png(png, renderer.render(s).image, inputs);
+}
+
+}  // namespace ts::preview

@@ -1,0 +1,24 @@
+#pragma once
+// `tetrasand sample --preview`: NAME.preview.png beside the body, the mesh's SDF ray-cast with the
+// particles over it (the thesis's figure 6.13), from the iso view, y up.
+#include <filesystem>
+#include <vector>
+
+#include "core/mesh.h"
+#include "gpu/context.h"
+#include "sampler/particle_body.h"
+
+namespace ts::preview {
+
+struct BodyPreviewSettings {
+  int width = 800, height = 800;  // pixels
+  int resolution = 192;           // SDF voxels along the mesh's longest side
+};
+
+// Scan-converts `mesh` and renders it with `body`'s particles; writes `png` atomically, never over
+// one of `inputs`.
+void write_body_preview(gpu::Context& context, const TriangleMesh& mesh, const sampler::ParticleBody& body,
+                        const std::filesystem::path& png, const std::vector<std::filesystem::path>& inputs = {},
+                        const BodyPreviewSettings& settings = {});
+
+}  // namespace ts::preview

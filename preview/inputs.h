@@ -1,0 +1,24 @@
+#pragma once
+// What `tetrasand preview` reads besides the SDF: particle files, with their radius.
+#include <filesystem>
+#include <string>
+
+#include "preview/renderer.h"
+
+namespace ts::preview {
+
+struct LoadedParticles {
+  Particles particles;
+  std::string radius_source;  // "body.json", "--particle-radius", "estimated from spacing"
+};
+
+// NAME.body.json (particles and radius), or a PLY of particle centres (sampler/particle_body.h
+// readers). A PLY's radius is `radius` when positive, else that of the NAME.body.json beside a
+// NAME.particles.ply, else half the median nearest-neighbour distance. ts::InputError naming the file.
+LoadedParticles load_particles(const std::filesystem::path& file, double radius = 0.0);
+
+// Half the median nearest-neighbour distance [m] (touching spheres on an even sampling); 0 for fewer
+// than two points.
+double estimate_radius(const std::vector<Eigen::Vector3d>& points);
+
+}  // namespace ts::preview

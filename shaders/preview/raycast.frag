@@ -1,0 +1,83 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Ray casting, fragment stage: sphere tracing through the narrow-band SDF from where the pixel's
+// ray enters the box to the far face, or to the particle already drawn at this pixel (the hybrid:
+// where a particle covers the pixel only the stretch in front of it is marched, and nothing when it
+// lies in front of the box). Steps are the sampled distance, which is the band width outside the
+// band (values there saturate at +-band, and the true distance is at least that); a sign change is
+// refined by regula falsi. The normal is the SDF's gradient; depth is the hit's true depth.
+#include "preview/bindings.h"
+#include "preview/camera.glsl"
+#include "preview/volume.glsl"
+
+uniform sampler2D particle_depth;  // window depth of the particle layer (1: none)
+uniform int use_particle_depth;
+uniform int depth_only;            // shadow pass: depth, no normal
+uniform int max_steps;
+uniform float min_step;            // [voxels]: grazing rays still advance
+uniform vec3 surface_color;        // sRGB
+
+in vec3 v_world;
+
+layout(location = 0) out vec4 albedo;
+layout(location = 1) out vec4 normal_layer;
+
+void main() {
+  // The ray from the near plane to the far face, in voxel units.
+  vec3 start = world_from_window(gl_FragCoord.xy, 0.0);
+  vec3 segment = v_world - start;
+  float seg_length = length(segment);
+  if (seg_length <= 0.0) discard;
+  vec3 dir = segment / seg_length;
+  vec3 o = to_voxel(start);
+  float t_exit = seg_length / voxel_size;
+  if (use_particle_depth == 1) {
+    float particle = texelFetch(particle_depth, ivec2(gl_FragCoord.xy), 0).r;
+    if (particle < 1.0) {
+      t_exit = min(t_exit, dot(world_from_window(gl_FragCoord.xy, particle) - start, dir) / voxel_size);
+    }
+  }
+  // Entry: the slab test against the voxel-centre box [0, dims - 1].
+  vec3 safe = mix(dir, vec3(1e-20), lessThan(abs(dir), vec3(1e-20)));
+  vec3 t0 = -o / safe, t1 = (volume_dims - 1.0 - o) / safe;
+  vec3 near3 = min(t0, t1);
+  float t = max(max(near3.x, near3.y), max(near3.z, 0.0));
+  if (t >= t_exit) discard;
+
+  float f = sdf_at(o + t * dir);
+  float t_hit = t;
+  bool entered_inside = f <= 0.0;  // the near plane cuts the solid
+  bool hit = entered_inside;
+  for (int i = 0; i < max_steps && !hit; ++i) {
+    float t_next = min(t + max(f, min_step), t_exit);
+    float f_next = sdf_at(o + t_next * dir);
+    if (f_next <= 0.0) {
+      float a = t, fa = f, b = t_next, fb = f_next;
+      for (int k = 0; k < 6; ++k) {
+        float m = a + (b - a) * clamp(fa / (fa - fb), 0.1, 0.9);
+        float fm = sdf_at(o + m * dir);
+        if (fm > 0.0) {
+          a = m;
+          fa = fm;
+        } else {
+          b = m;
+          fb = fm;
+        }
+      }
+      t_hit = a + (b - a) * (fa / max(fa - fb, 1e-12));
+      hit = true;
+    } else if (t_next >= t_exit) {
+      break;
+    }
+    t = t_next;
+    f = f_next;
+  }
+  if (!hit) discard;
+
+  vec3 p = start + dir * (t_hit * voxel_size);
+  gl_FragDepth = window_depth(p);
+  if (depth_only == 1) return;
+  vec3 n = entered_inside ? -dir : sdf_normal(o + t_hit * dir);
+  albedo = vec4(surface_color, 1.0);
+  normal_layer = vec4(n, float(TS_PREVIEW_LAYER_SURFACE));
+}

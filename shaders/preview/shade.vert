@@ -1,0 +1,6 @@
+#version 450
+// One triangle covering the viewport (vertices from gl_VertexID): the lighting pass runs once per pixel.
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0);
+}

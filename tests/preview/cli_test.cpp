@@ -1,0 +1,141 @@
+// `tetrasand preview`, `sample --preview` and `sim` frames through the executable: outputs, and
+// clear errors with the documented exit codes for bad inputs.
+#include <gtest/gtest.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetSphere.h>
+
+#include "core/atomic_file.h"
+#include "preview/image.h"
+#include "sdf/vdb_io.h"
+#include "tests/test_support.h"
+
+namespace ts {
+namespace {
+
+std::string q(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+void write_grid(const std::filesystem::path& file, openvdb::GridBase::Ptr grid) {
+  sdf::ensure_openvdb_initialized();
+  openvdb::io::File out(file.string());
+  out.write({grid});
+  out.close();
+}
+
+TEST(CliPreview, WritesAPngOfTheRequestedSize) {
+  const auto dir = test::temp_dir();
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("preview " + q(test::asset("sphere.obj")) + " -o " + q(dir / "s.png") +
+                                    " --size 96x64 --resolution 40 --view side --color-by error",
+                                &out),
+            0)
+      << out;
+  const preview::Image image = preview::read_png(dir / "s.png");
+  EXPECT_EQ(image.width, 96);
+  EXPECT_EQ(image.height, 64);
+  EXPECT_NE(out.find("distance from the rendered surface to the mesh"), std::string::npos) << out;
+  EXPECT_NE(out.find("llvmpipe"), std::string::npos) << out;
+}
+
+TEST(CliPreview, RendersLevelSetsParticlesAndTurntables) {
+  const auto dir = test::temp_dir();
+  sdf::ensure_openvdb_initialized();
+  auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(0.05f, openvdb::Vec3f(0.0f), 0.004f, 3.0f);
+  write_grid(dir / "sphere.vdb", sphere);
+  std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                    "end_header\n0 0 0.05\n0.01 0 0.049\n0 0.01 0.049\n";
+  write_file_atomically(dir / "p.ply", ply);
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("preview " + q(dir / "sphere.vdb") + " --particles " + q(dir / "p.ply") + " -o " +
+                                    q(dir / "t.png") + " --size 48x40 --turntable 3 --alpha --ortho",
+                                &out),
+            0)
+      << out;
+  for (const char* name : {"t_000.png", "t_001.png", "t_002.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / name)) << name << "\n" << out;
+  }
+  EXPECT_TRUE(preview::read_png(dir / "t_000.png").alpha);
+  EXPECT_NE(out.find("estimated from the spacing"), std::string::npos) << out;
+  ASSERT_EQ(test::run_tetrasand("preview " + q(dir / "sphere.vdb") + " -o " + q(dir / "sheet.png") +
+                                    " --size 40x30 --turntable 4 --contact-sheet --eye 0.2,0.1,0.3",
+                                &out),
+            0)
+      << out;
+  const preview::Image sheet = preview::read_png(dir / "sheet.png");
+  EXPECT_EQ(sheet.width, 80);
+  EXPECT_EQ(sheet.height, 60);
+}
+
+TEST(CliPreview, BadInputsExitWithClearMessages) {
+  const auto dir = test::temp_dir();
+  sdf::ensure_openvdb_initialized();
+  auto fog = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.0f), 0.1f, 3.0f);
+  fog->setGridClass(openvdb::GRID_FOG_VOLUME);
+  write_grid(dir / "fog.vdb", fog);
+  auto empty = openvdb::FloatGrid::create(0.3f);
+  empty->setGridClass(openvdb::GRID_LEVEL_SET);
+  write_grid(dir / "empty.vdb", empty);
+  write_grid(dir / "vector.vdb", openvdb::Vec3SGrid::create());
+  const std::string sphere = q(test::asset("sphere.obj")), png = " -o " + q(dir / "x.png");
+  struct Case {
+    std::string args;
+    int code;
+    std::string message;
+  };
+  for (const Case& c : {Case{q(dir / "fog.vdb") + png, 1, "none is a level set"},
+                        Case{q(dir / "empty.vdb") + png, 1, "is empty"},
+                        Case{q(dir / "vector.vdb") + png, 1, "holds no float grid"},
+                        Case{q(dir / "missing.vdb") + png, 1, "no such file"},
+                        Case{sphere + png + " --size 0x0", 1, "at least 1 pixel"},
+                        Case{sphere + png + " --size 100000x100000", 1, "exceeds this GPU's largest render target"},
+                        Case{sphere + png + " --size big", 1, "expected WIDTHxHEIGHT"},
+                        Case{q(dir / "fog.vdb") + png + " --color-by error", 1, "needs a MESH input"},
+                        Case{sphere + png + " --color-by particle-distance", 1, "needs --particles"},
+                        Case{png, 2, "give a MESH"},
+                        Case{sphere + png + " --view diagonal", 2, "diagonal"}}) {
+    std::string out;
+    EXPECT_EQ(test::run_tetrasand("preview " + c.args, &out), c.code) << c.args << "\n" << out;
+    EXPECT_NE(out.find(c.message), std::string::npos) << c.args << "\n" << out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+  // The output may never replace an input.
+  std::filesystem::copy_file(test::asset("sphere.obj"), dir / "sphere.obj");
+  std::string out;
+  EXPECT_EQ(test::run_tetrasand("preview " + q(dir / "sphere.obj") + " -o " + q(dir / "sphere.obj") + " --size 8x8 --resolution 16", &out), 1) << out;
+  EXPECT_EQ(read_file(dir / "sphere.obj"), read_file(test::asset("sphere.obj")));
+}
+
+TEST(CliPreview, SampleWritesAPreviewBesideTheBody) {
+  const auto dir = test::temp_dir();
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sample " + q(test::asset("sphere.obj")) + " -o " + q(dir) +
+                                    " --count 150 --probes 5000 --preview",
+                                &out),
+            0)
+      << out;
+  ASSERT_TRUE(std::filesystem::exists(dir / "sphere.preview.png")) << out;
+  EXPECT_EQ(preview::read_png(dir / "sphere.preview.png").width, 800);
+  // The body then previews on its own too, radius from the body.json beside the PLY.
+  ASSERT_EQ(test::run_tetrasand("preview --particles " + q(dir / "sphere.particles.ply") + " -o " + q(dir / "p.png") +
+                                    " --size 32x32",
+                                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("(body.json)"), std::string::npos) << out;
+}
+
+TEST(CliPreview, SimulationFramesArePngs) {
+  const auto dir = test::temp_dir();
+  // The free-fall scene with frames on ([output] is its last table).
+  write_file_atomically(dir / "fall.toml", read_file(test::asset("scenes/free_fall.toml")) + "frames = true\n");
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sim " + q(dir / "fall.toml") + " -o " + q(dir / "out") + " --cpu --duration 0.002", &out), 0)
+      << out;
+  ASSERT_TRUE(std::filesystem::exists(dir / "out" / "frame_000000.png")) << out;
+  const preview::Image frame = preview::read_png(dir / "out" / "frame_000000.png");
+  EXPECT_EQ(frame.width, 640);
+  EXPECT_EQ(frame.height, 480);
+  EXPECT_EQ(out.find("no frame renderer"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace ts
