@@ -5,8 +5,8 @@
 function(tetrasand_add_shaders target)
   set(stamps)
   set(shader_root ${CMAKE_SOURCE_DIR}/shaders)
-  # Every kernel may include the shared headers, so each check depends on all of them.
-  file(GLOB_RECURSE shared_headers CONFIGURE_DEPENDS ${shader_root}/common/*.h ${shader_root}/common/*.glsl)
+  # A kernel may include any header of any stage (common/, preview/...), so each check depends on all.
+  file(GLOB_RECURSE shared_headers CONFIGURE_DEPENDS ${shader_root}/*.h ${shader_root}/*.glsl)
   foreach(rel IN LISTS ARGN)
     set(src ${shader_root}/${rel})
     set(dst ${TETRASAND_SHADER_BUILD_DIR}/${rel})
