@@ -2,38 +2,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/error.h"
 
 namespace ts::sampler {
 
-GpuRelaxer::GpuRelaxer(gpu::Context& context, const sdf::DenseSdf& field, bool timings)
+GpuRelaxer::GpuRelaxer(gpu::Context& context, sdf::SdfTexture field, bool timings)
     : context_(context),
-      spec_(field.spec),
+      spec_(field.spec()),
+      texture_(std::move(field)),
       queue_(timings, context.debug()),
       relax_(gpu::Program::compute(library_, "sampler/relax.comp")),
       project_(gpu::Program::compute(library_, "sampler/project.comp")),
       reduce_(gpu::Program::compute(library_, "sampler/reduce_steps.comp")),
       grid_(library_) {
-  const int max_side = context.limits().max_3d_texture_size;
-  if (spec_.dims.maxCoeff() > max_side) {
-    throw GpuError("sampler SDF of " + std::to_string(spec_.dims.maxCoeff()) +
-                   " voxels per side exceeds this GPU's 3D texture limit (" + std::to_string(max_side) +
-                   "); use a larger --voxel or --radius");
-  }
-  glCreateTextures(GL_TEXTURE_3D, 1, &texture_);
-  glTextureStorage3D(texture_, 1, GL_RGBA32F, spec_.dims.x(), spec_.dims.y(), spec_.dims.z());
-  if (glGetError() == GL_OUT_OF_MEMORY) throw GpuError("out of GPU memory for the sampler's SDF texture");
-  glTextureSubImage3D(texture_, 0, 0, 0, 0, spec_.dims.x(), spec_.dims.y(), spec_.dims.z(), GL_RGBA, GL_FLOAT,
-                      field.values.data());
-  glTextureParameteri(texture_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(texture_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  for (GLenum axis : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
-    glTextureParameteri(texture_, axis, GL_CLAMP_TO_EDGE);
-}
-
-GpuRelaxer::~GpuRelaxer() {
-  if (texture_) glDeleteTextures(1, &texture_);
+  if (texture_.empty()) throw Error(ExitCode::Internal, "GpuRelaxer needs scan_convert's texture (keep_texture)");
 }
 
 std::size_t GpuRelaxer::gpu_bytes() const {
@@ -41,7 +25,7 @@ std::size_t GpuRelaxer::gpu_bytes() const {
 }
 
 void GpuRelaxer::bind_sdf(const gpu::Program& program) const {
-  glBindTextureUnit(0, texture_);
+  glBindTextureUnit(0, texture_.id());
   program.set("sdf", 0);
   program.set("voxel_size", static_cast<float>(spec_.voxel_size));
   program.set("sdf_dims", static_cast<float>(spec_.dims.x()), static_cast<float>(spec_.dims.y()),

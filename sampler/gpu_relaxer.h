@@ -45,9 +45,9 @@ struct RelaxStats {
 
 class GpuRelaxer {
  public:
-  // Uploads the dense SDF (xyz gradient, w distance) as an RGBA32F 3D texture with trilinear filtering.
-  GpuRelaxer(gpu::Context& context, const sdf::DenseSdf& field, bool timings = false);
-  ~GpuRelaxer();
+  // Takes the SDF texture scan conversion left on the GPU (ScanConvertOptions::keep_texture: RGBA32F,
+  // xyz gradient, w distance, trilinear filtering); nothing is uploaded.
+  GpuRelaxer(gpu::Context& context, sdf::SdfTexture field, bool timings = false);
   GpuRelaxer(const GpuRelaxer&) = delete;
   GpuRelaxer& operator=(const GpuRelaxer&) = delete;
 
@@ -67,7 +67,7 @@ class GpuRelaxer {
   void project(std::uint32_t count, int steps);
   gpu::Context& context_;
   sdf::GridSpec spec_;
-  GLuint texture_ = 0;
+  sdf::SdfTexture texture_;
   gpu::ShaderLibrary library_;
   gpu::Queue queue_;
   gpu::Program relax_, project_, reduce_;

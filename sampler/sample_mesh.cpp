@@ -202,10 +202,10 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
   sdf::ScanConvertOptions scan;
   scan.band = kBandVoxels;
-  scan.keep_dense = true;
+  scan.keep_texture = true;
   scan.build_grid = false;
   scan.timings = settings.timings;
-  const sdf::ScanConvertResult field = sdf::scan_convert(context, mesh, normals, spec, scan);
+  sdf::ScanConvertResult field = sdf::scan_convert(context, mesh, normals, spec, scan);
   const sdf::ExactDistance exact(mesh);
 
   // 2. Seeds.
@@ -213,7 +213,7 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   std::vector<Eigen::Vector3d> particles = sample_surface_points(mesh, z.count, rng).positions;
 
   // 3-4. Relax, project, measure coverage, inject, relax locally, repeat.
-  GpuRelaxer relaxer(context, field.dense, settings.timings);
+  GpuRelaxer relaxer(context, std::move(field.texture), settings.timings);
   RelaxSettings relax = settings.relax;
   relax.spacing = z.spacing;
   relax.band_limit = 0.95 * kBandVoxels * spec.voxel_size;

@@ -218,18 +218,19 @@ openvdb::FloatGrid::Ptr make_level_set(const GridSpec& spec, float band) {
   return grid;
 }
 
-// Untouched voxels reachable from the grid border through untouched voxels are outside (+band), the
-// rest inside (-band). 6-connected, so a band of at least one voxel seals the surface.
-void fill_outside_band(DenseSdf& dense, float band_world) {
-  const GridSpec& s = dense.spec;
-  std::vector<std::uint8_t> outside(s.voxel_count(), 0);
+// Per-voxel state for the signs off the band (dense copy and texture).
+enum VoxelState : std::uint8_t { kOffBand = 0, kInBand = 1, kOutside = 2 };
+
+// Off-band voxels reachable from the grid border through off-band voxels become kOutside (+band),
+// the ones left kOffBand are inside (-band). 6-connected, so a band of at least one voxel seals the
+// surface.
+void flood_fill_outside(const GridSpec& s, std::vector<std::uint8_t>& state) {
   std::vector<std::size_t> stack;
-  auto untouched = [&](std::size_t idx) { return dense.values[idx].w() == kUntouched; };
   auto push = [&](int i, int j, int k) {
     if (i < 0 || j < 0 || k < 0 || i >= s.dims.x() || j >= s.dims.y() || k >= s.dims.z()) return;
     const std::size_t idx = s.linear_index(i, j, k);
-    if (outside[idx] || !untouched(idx)) return;
-    outside[idx] = 1;
+    if (state[idx] != kOffBand) return;
+    state[idx] = kOutside;
     stack.push_back(idx);
   };
   for (int k = 0; k < s.dims.z(); ++k)
@@ -243,8 +244,35 @@ void fill_outside_band(DenseSdf& dense, float band_world) {
     const int k = static_cast<int>(idx / sxy), j = static_cast<int>((idx % sxy) / sx), i = static_cast<int>(idx % sx);
     push(i - 1, j, k), push(i + 1, j, k), push(i, j - 1, k), push(i, j + 1, k), push(i, j, k - 1), push(i, j, k + 1);
   }
+}
+
+void fill_dense_off_band(DenseSdf& dense, const std::vector<std::uint8_t>& state, float band_world) {
   for (std::size_t idx = 0; idx < dense.values.size(); ++idx)
-    if (untouched(idx)) dense.values[idx] = {0.0f, 0.0f, 0.0f, outside[idx] ? band_world : -band_world};
+    if (state[idx] != kInBand) dense.values[idx] = {0.0f, 0.0f, 0.0f, state[idx] == kOutside ? band_world : -band_world};
+}
+
+// The texture holds the raw slabs (distance in voxels, untouched voxels at kUntouched); one compute
+// pass scales the band to world units and gives the rest +-band from a 1-bit inside mask, the only
+// data uploaded (1/128 of the field).
+void finish_texture(gpu::Queue& queue, const gpu::ShaderLibrary& library, const SdfTexture& texture,
+                    const std::vector<std::uint8_t>& state, float band, float voxel_size, std::size_t& peak_bytes) {
+  const GridSpec& spec = texture.spec();
+  std::vector<std::uint32_t> inside((state.size() + 31) / 32, 0u);
+  for (std::size_t idx = 0; idx < state.size(); ++idx)
+    if (state[idx] == kOffBand) inside[idx >> 5] |= 1u << (idx & 31u);
+  gpu::Buffer bits = gpu::Buffer::from<std::uint32_t>(inside);
+  peak_bytes += bits.bytes();
+  gpu::Program program = gpu::Program::compute(library, "sdf/finish_texture.comp");
+  program.use();
+  program.set("dims", spec.dims.x(), spec.dims.y(), spec.dims.z());
+  program.set("band", band);
+  program.set("voxel_size", voxel_size);
+  bits.bind(0);
+  glBindImageTexture(0, texture.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+  auto groups = [](int n, int local) { return static_cast<std::uint32_t>((n + local - 1) / local); };
+  queue.dispatch(program, groups(spec.dims.x(), 8), groups(spec.dims.y(), 8), groups(spec.dims.z(), 4),
+                 GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  glBindImageTexture(0, 0, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
 }
 
 int choose_slab_layers(const GridSpec& spec, std::size_t budget) {
@@ -323,6 +351,13 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
     result.dense.spec = spec;
     result.dense.values.assign(spec.voxel_count(), Eigen::Vector4f(0, 0, 0, kUntouched));
   }
+  const bool keep_signs = options.keep_dense || options.keep_texture;
+  std::vector<std::uint8_t> state;
+  if (keep_signs) state.assign(spec.voxel_count(), kOffBand);
+  if (options.keep_texture) {
+    result.texture = SdfTexture(spec, max_size);
+    stats.peak_gpu_bytes += result.texture.bytes();
+  }
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer());
   glViewport(0, 0, spec.dims.x(), spec.dims.y());
@@ -369,6 +404,12 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
                            static_cast<GLsizei>(layer_voxels * 4 * static_cast<std::size_t>(layers) * sizeof(float)),
                            readback.data());
     });
+    if (options.keep_texture) {
+      queue.timed("sdf/copy to texture", [&] {
+        glCopyImageSubData(target.color(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, result.texture.id(), GL_TEXTURE_3D, 0, 0,
+                           0, z0, spec.dims.x(), spec.dims.y(), layers);
+      });
+    }
     if (context.debug()) gpu::check_gl("SDF scan conversion (shaders sdf/scan_convert.*)");
     for (int layer = 0; layer < layers; ++layer) {
       const int k = z0 + layer;
@@ -384,6 +425,7 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
                                v[3] * h);
           }
           ++stats.band_voxels;
+          if (keep_signs) state[spec.linear_index(i, j, k)] = kInBand;
           if (options.keep_dense) result.dense.values[spec.linear_index(i, j, k)] = {v[0], v[1], v[2], v[3] * h};
         }
       }
@@ -397,9 +439,11 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
 
   // Voxels outside the band take +-band: a closed band separates the inside from the outside, so a
   // flood fill classifies the whole grid (OpenVDB's signedFloodFill for the level set; a fill from
-  // the grid border for the dense copy).
+  // the grid border for the dense copy and the texture).
   if (result.grid) openvdb::tools::signedFloodFill(result.grid->tree());
-  if (options.keep_dense) fill_outside_band(result.dense, band * h);
+  if (keep_signs) flood_fill_outside(spec, state);
+  if (options.keep_dense) fill_dense_off_band(result.dense, state, band * h);
+  if (options.keep_texture) finish_texture(queue, library, result.texture, state, band, h, stats.peak_gpu_bytes);
   if (options.timings) stats.timing_report = queue.timing_report();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

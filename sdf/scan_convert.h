@@ -15,6 +15,7 @@
 #include "gpu/context.h"
 #include "sdf/grid.h"
 #include "sdf/pseudonormals.h"
+#include "sdf/sdf_texture.h"
 
 namespace ts::sdf {
 
@@ -22,7 +23,10 @@ struct ScanConvertOptions {
   double band = 3.0;                         // half-width of the narrow band [voxels]
   std::size_t max_slab_bytes = 1ull << 30;   // GPU render-target budget per slab [bytes]
   bool timings = false;                      // per-kernel GPU timer queries
-  bool keep_dense = false;                   // also return the whole grid densely (small grids: the sampler)
+  bool keep_dense = false;                   // also return the whole grid densely on the host (tests, preview)
+  // Also leave the whole grid in a GPU 3D texture (the sampler, in the same process): filled slab by
+  // slab on the GPU; only a 1-bit-per-voxel inside mask from the CPU flood fill is uploaded.
+  bool keep_texture = false;
   bool build_grid = true;                    // the OpenVDB level set (needs voxel_size >= kMinVdbVoxelSize)
   std::function<void(double fraction_done)> progress;  // called after each slab
 };
@@ -31,7 +35,7 @@ struct ScanConvertStats {
   int slabs = 0;
   int layers_per_slab = 0;
   int draws = 0;
-  std::size_t peak_gpu_bytes = 0;      // render targets + geometry buffers
+  std::size_t peak_gpu_bytes = 0;      // render targets + geometry buffers (+ texture and mask if keep_texture)
   std::size_t band_voxels = 0;         // voxels with |d| < band written to the grid
   std::size_t degenerate_triangles = 0;  // zero area: skipped, their edges belong to their neighbours
   std::size_t needle_triangles = 0;      // slivers bounded by an in-plane rectangle instead of a miter
@@ -50,6 +54,7 @@ struct ScanConvertResult {
   openvdb::FloatGrid::Ptr grid;  // level set in world units, background = band * voxel_size (if build_grid)
   ScanConvertStats stats;
   DenseSdf dense;                // only when options.keep_dense
+  SdfTexture texture;            // only when options.keep_texture: the same values as `dense`, on the GPU
 };
 
 // Requires a current context (gpu::Context). Throws GpuError when the GPU cannot hold one layer.

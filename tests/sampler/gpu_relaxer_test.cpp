@@ -54,10 +54,10 @@ TEST_F(Relaxer, SpreadsRandomSeedsEvenlyOverASphere) {
   const TriangleMesh sphere = test::icosphere(radius, 4);
   const sdf::GridSpec spec = grid_around_sphere(radius, d_hex / 2.0, 6);
   sdf::ScanConvertOptions options;
-  options.keep_dense = true;
+  options.keep_texture = true;
   options.build_grid = false;
   options.band = 5.0;
-  const auto field = sdf::scan_convert(context, sphere, sdf::compute_pseudonormals(sphere), spec, options);
+  auto field = sdf::scan_convert(context, sphere, sdf::compute_pseudonormals(sphere), spec, options);
 
   std::mt19937_64 rng(42);
   std::normal_distribution<double> gauss;
@@ -68,7 +68,7 @@ TEST_F(Relaxer, SpreadsRandomSeedsEvenlyOverASphere) {
   }
   const NearestNeighbours before = nearest_neighbours(positions);
 
-  GpuRelaxer relaxer(context, field.dense);
+  GpuRelaxer relaxer(context, std::move(field.texture));
   RelaxSettings settings;
   settings.spacing = d_hex;
   settings.band_limit = 4.5 * spec.voxel_size;
@@ -91,9 +91,9 @@ TEST_F(Relaxer, SameSeedsGiveBitwiseTheSameResult) {
   const TriangleMesh sphere = test::icosphere(1.0, 2);
   const sdf::GridSpec spec = grid_around_sphere(1.0, 0.1, 6);
   sdf::ScanConvertOptions options;
-  options.keep_dense = true;
+  options.keep_texture = true;
   options.build_grid = false;
-  const auto field = sdf::scan_convert(context, sphere, sdf::compute_pseudonormals(sphere), spec, options);
+  auto field = sdf::scan_convert(context, sphere, sdf::compute_pseudonormals(sphere), spec, options);
   std::mt19937_64 rng(7);
   std::normal_distribution<double> gauss;
   std::vector<Eigen::Vector3f> seeds(300);
@@ -102,7 +102,7 @@ TEST_F(Relaxer, SameSeedsGiveBitwiseTheSameResult) {
   settings.spacing = 0.2;
   settings.band_limit = 0.25;
   settings.max_iterations = 50;
-  GpuRelaxer relaxer(context, field.dense);
+  GpuRelaxer relaxer(context, std::move(field.texture));
   auto a = seeds, b = seeds;
   relaxer.relax(a, settings);
   relaxer.relax(b, settings);
