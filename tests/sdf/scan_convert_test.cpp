@@ -7,7 +7,9 @@
 #include <cmath>
 #include <map>
 
+#include "core/primitives.h"
 #include "gpu/context.h"
+#include "gpu/gl.h"
 #include "sdf/grid.h"
 #include "sdf/pseudonormals.h"
 #include "tests/test_meshes.h"
@@ -228,6 +230,56 @@ TEST_F(ScanConvert, DenseCopyAgreesWithTheLevelSetEverywhere) {
         const openvdb::Coord c(spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k);
         ASSERT_FLOAT_EQ(result.dense.values[spec.linear_index(i, j, k)].w(), acc.getValue(c)) << i << " " << j << " " << k;
       }
+}
+
+TEST_F(ScanConvert, GpuTextureEqualsTheDenseHostFieldVoxelForVoxelWithOffBandSigns) {
+  // A torus: inside voxels off the band (the tube's core) and an outside region enclosed by the
+  // band in the x-y plane (the hole) that the flood fill must reach around the tube.
+  const TriangleMesh torus = make_torus(1.0, 0.45, 32, 16);
+  const GridSpec spec = grid_around(torus, 0.08, 4);
+  ScanConvertOptions dense_only;
+  dense_only.keep_dense = true;
+  dense_only.build_grid = false;
+  const auto host = run(torus, spec, dense_only);
+  ScanConvertOptions texture_only;
+  texture_only.keep_texture = true;
+  texture_only.build_grid = false;
+  texture_only.max_slab_bytes = bytes_per_layer(spec) * 3;  // slabs copied in at many z offsets
+  const auto device = run(torus, spec, texture_only);
+  ASSERT_GT(device.stats.slabs, 5);
+  ASSERT_TRUE(host.texture.empty());
+  ASSERT_FALSE(device.texture.empty());
+  ASSERT_EQ(device.texture.spec().dims, spec.dims);
+  EXPECT_GE(device.stats.peak_gpu_bytes, device.texture.bytes());
+
+  GLint filter = 0;
+  glGetTextureParameteriv(device.texture.id(), GL_TEXTURE_MIN_FILTER, &filter);
+  EXPECT_EQ(filter, GL_LINEAR);
+  std::vector<Eigen::Vector4f> texels(spec.voxel_count());
+  glGetTextureImage(device.texture.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(texels.size() * sizeof(Eigen::Vector4f)),
+                    texels.data());
+  ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+
+  const float far = 3.0f * static_cast<float>(spec.voxel_size);
+  std::size_t inside_off_band = 0, outside_off_band = 0;
+  for (int k = 0; k < spec.dims.z(); ++k)
+    for (int j = 0; j < spec.dims.y(); ++j)
+      for (int i = 0; i < spec.dims.x(); ++i) {
+        const std::size_t idx = spec.linear_index(i, j, k);
+        const Eigen::Vector4f& h = host.dense.values[idx];
+        for (int c = 0; c < 4; ++c) ASSERT_EQ(texels[idx][c], h[c]) << i << " " << j << " " << k << " component " << c;
+        if (h.w() == far) ++outside_off_band;
+        if (h.w() == -far) ++inside_off_band;
+      }
+  EXPECT_GT(inside_off_band, 200u);
+  EXPECT_GT(outside_off_band, 200u);
+  auto at = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d v = spec.to_voxel(p);
+    return texels[spec.linear_index(static_cast<int>(std::lround(v.x())), static_cast<int>(std::lround(v.y())),
+                                    static_cast<int>(std::lround(v.z())))].w();
+  };
+  EXPECT_EQ(at({1.0, 0.0, 0.0}), -far);  // the tube's core
+  EXPECT_EQ(at({0.0, 0.0, 0.0}), far);   // the hole
 }
 
 TEST_F(ScanConvert, SmallSlabsGiveTheSameFieldAsOneSlab) {
