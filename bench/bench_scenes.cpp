@@ -1,11 +1,18 @@
 #include "bench/bench_scenes.h"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <random>
 
 #include "sim/grain.h"
+#include "sim/scene_runner.h"
 
 namespace ts::bench {
+
+std::filesystem::path reference_scene(const std::string& name) {
+  return std::filesystem::path(TETRASAND_SOURCE_DIR) / "assets" / "scenes" / "reference" / name;
+}
 
 sim::World settling_box(std::uint32_t grains, std::uint64_t seed) {
   sim::World world;
@@ -14,7 +21,7 @@ sim::World settling_box(std::uint32_t grains, std::uint64_t seed) {
   world.materials = {sand};
   const sim::GrainShape grain = sim::make_tetrahedral_grain(0.001, 0.002, sand.density);
   const double spacing = 2.2 * grain.bounding_radius;  // m: lattice spacing, no initial overlap
-  const auto side = static_cast<std::uint32_t>(std::ceil(std::sqrt(grains / 4.0)));  // a column 4x as tall as wide
+  const auto side = static_cast<std::uint32_t>(std::ceil(std::sqrt(grains / 4.0)));  // 4 layers deep
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (std::uint32_t n = 0; n < grains; ++n) {
@@ -30,6 +37,83 @@ sim::World settling_box(std::uint32_t grains, std::uint64_t seed) {
                         {Eigen::Vector3d(width, 0, 0), -Eigen::Vector3d::UnitX(), 0},
                         {Eigen::Vector3d(0, width, 0), -Eigen::Vector3d::UnitY(), 0}};
   return world;
+}
+
+BenchWorld settle(const sim::Scene& scene) {
+  BenchWorld out{sim::make_world(scene), scene.simulation.step};
+  out.settings.dt = sim::resolve_time_step(scene, out.world, nullptr);
+  sim::CpuStepper stepper(out.world, out.settings);
+  const auto steps = static_cast<std::int64_t>(std::ceil(scene.simulation.duration / out.settings.dt));
+  for (std::int64_t s = 0; s < steps; ++s) stepper.step(out.world);
+  return out;
+}
+
+namespace {
+
+// Appends a copy of `body` of `from`, shifted by `shift`, to `to`.
+void copy_body(const sim::World& from, std::size_t body, const Eigen::Vector3d& shift, sim::World& to) {
+  const sim::Bodies& b = from.bodies;
+  sim::BodyDesc desc;
+  desc.position = b.position[body] + shift;
+  desc.orientation = b.orientation[body];
+  desc.linear_velocity = b.linear_velocity[body];
+  desc.angular_velocity = b.angular_velocity[body];
+  desc.inverse_mass = b.inverse_mass[body];
+  desc.inverse_inertia = b.inverse_inertia[body];
+  desc.motion = b.motion[body];
+  std::vector<Eigen::Vector3d> offsets;
+  std::vector<double> radii;
+  for (std::uint32_t p = b.first_particle[body]; p < b.first_particle[body] + b.particle_count[body]; ++p) {
+    offsets.push_back(from.particles.offset[p]);
+    radii.push_back(from.particles.radius[p]);
+  }
+  sim::add_body(to, desc, offsets, radii, from.particles.material[b.first_particle[body]]);
+}
+
+// The most nearly square grid nx x ny holding `tiles`: a divisor pair when one is close to square,
+// else ceil(sqrt) columns with a partly filled last row.
+std::pair<std::size_t, std::size_t> tile_grid(std::size_t tiles) {
+  const auto root = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(tiles))));
+  for (std::size_t nx = root; 2 * nx >= root; --nx) {
+    if (tiles % nx == 0) return {nx, tiles / nx};
+  }
+  return {root, (tiles + root - 1) / root};
+}
+
+}  // namespace
+
+BenchWorld settled_bed(std::uint32_t grains) {
+  struct Tile {
+    sim::Scene scene;
+    BenchWorld settled;
+  };
+  static const Tile tile = [] {
+    Tile t{sim::load_scene(reference_scene("bed_tile.toml")), {}};
+    t.settled = settle(t.scene);
+    return t;
+  }();
+  const sim::Boundary& box = tile.scene.boundaries.at(0);
+  const Eigen::Vector3d extent = box.max - box.min;
+  const sim::World& source = tile.settled.world;
+  const std::size_t tiles = std::max<std::size_t>(1, grains / source.bodies.size());
+  const auto [nx, ny] = tile_grid(tiles);
+  BenchWorld out;
+  out.settings = tile.settled.settings;
+  out.world.materials = source.materials;
+  out.world.gravity = source.gravity;
+  for (std::size_t t = 0; t < tiles; ++t) {
+    const Eigen::Vector3d shift(extent.x() * static_cast<double>(t % nx), extent.y() * static_cast<double>(t / nx), 0);
+    for (std::size_t b = 0; b < source.bodies.size(); ++b) copy_body(source, b, shift, out.world);
+  }
+  const Eigen::Vector3d lo = box.min;
+  const Eigen::Vector3d hi = box.min + Eigen::Vector3d(extent.x() * static_cast<double>(nx),
+                                                       extent.y() * static_cast<double>(ny), extent.z());
+  out.world.walls.planes = {{lo, Eigen::Vector3d::UnitZ(), box.material},
+                            {lo, Eigen::Vector3d::UnitX(), box.material},
+                            {lo, Eigen::Vector3d::UnitY(), box.material},
+                            {hi, -Eigen::Vector3d::UnitX(), box.material},
+                            {hi, -Eigen::Vector3d::UnitY(), box.material}};
+  return out;
 }
 
 }  // namespace ts::bench

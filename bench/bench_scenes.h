@@ -1,14 +1,38 @@
 #pragma once
-// Scenes shared by the benchmarks (defined once, like Box2D's shared/ folder).
+// Scenes shared by the benchmarks (defined once, like Box2D's shared/ folder). The scene files they
+// start from live in assets/scenes/reference/ and are read by the tests and bench/peers too.
 #include <cstdint>
+#include <filesystem>
+#include <string>
 
+#include "sim/cpu_reference.h"
+#include "sim/scene.h"
 #include "sim/world.h"
 
 namespace ts::bench {
 
+// <repo>/assets/scenes/reference/<name>.
+std::filesystem::path reference_scene(const std::string& name);
+
 // `grains` tetrahedral grains (r = 1 mm, edge 2 mm, E = 10 MPa), randomly oriented on a lattice spaced
-// 1.1 bounding diameters (no initial overlap), in a box with a floor and four smooth side walls,
-// falling under gravity: the workload of a pour that is settling.
+// 1.1 bounding diameters (no initial overlap), 4 layers deep in a box with a floor and four smooth side
+// walls, falling under gravity: the workload of a pour that is settling.
 sim::World settling_box(std::uint32_t grains, std::uint64_t seed);
+
+// A world with the step settings it runs with (dt resolved from the scene).
+struct BenchWorld {
+  sim::World world;
+  sim::StepSettings settings;
+};
+
+// `scene` built and run on the CPU reference for its [simulation] duration.
+BenchWorld settle(const sim::Scene& scene);
+
+// A resting bed of `grains` grains (rounded down to whole tiles, at least one): the tile
+// reference/bed_tile.toml (1000 grains settled in a 5 cm box; settled once per process, about
+// 20 s on two cores) copied side by side on a near-square grid, in one box of smooth walls around
+// the whole. Each grain keeps the contacts it had in its tile, so every size is measured on the same
+// per-grain contact load.
+BenchWorld settled_bed(std::uint32_t grains);
 
 }  // namespace ts::bench

@@ -1,30 +1,36 @@
 // Cundall number (grain time steps per second) of the GPU pipeline and of the CPU reference on the
-// same scene, in one run, as ratios. Usage:
-//   tetrasand_bench_sim [--grains 1000,8000] [--seconds 3] [--precision float|double] [--markdown]
+// same scenes, in one run, as ratios, from 1k to 1M grains; memory per grain of both. Usage:
+//   tetrasand_bench_sim [--grains 1000,8000,64000,512000,1000000] [--seconds 2] [--min-steps 2]
+//                       [--precision float|double] [--csv FILE]
+// The scene of every size is the settled bed of bench/bench_scenes.h (reference/bed_tile.toml copied
+// side by side), so each size sees the same contacts per grain. scripts/bench.sh sim plots the CSV.
 #include <fmt/format.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
-#include <cstring>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "bench/bench_scenes.h"
+#include "core/atomic_file.h"
 #include "gpu/context.h"
 #include "sim/cpu_reference.h"
 #include "sim/gpu_stepper.h"
-#include "sim/time_step.h"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
 struct Options {
-  std::vector<std::uint32_t> grains{1000, 8000};
-  double seconds = 3.0;  // wall time per measurement
+  std::vector<std::uint32_t> grains{1000, 8000, 64000, 512000, 1000000};
+  double seconds = 2.0;  // wall time per measurement (at least min_steps steps)
+  int min_steps = 2;
   ts::sim::Precision precision = ts::sim::Precision::Float;
-  bool markdown = false;
+  std::string csv;
 };
 
 Options parse(int argc, char** argv) {
@@ -41,10 +47,14 @@ Options parse(int argc, char** argv) {
       for (std::string item; std::getline(list, item, ',');) o.grains.push_back(static_cast<std::uint32_t>(std::stoul(item)));
     } else if (arg == "--seconds") {
       o.seconds = std::stod(next());
+    } else if (arg == "--min-steps") {
+      o.min_steps = std::max(1, std::stoi(next()));
     } else if (arg == "--precision") {
-      o.precision = next() == "double" ? ts::sim::Precision::Double : ts::sim::Precision::Float;
-    } else if (arg == "--markdown") {
-      o.markdown = true;
+      const std::string p = next();
+      if (p != "float" && p != "double") throw std::runtime_error("--precision: expected float or double, got " + p);
+      o.precision = p == "double" ? ts::sim::Precision::Double : ts::sim::Precision::Float;
+    } else if (arg == "--csv") {
+      o.csv = next();
     } else {
       throw std::runtime_error("unknown option " + arg);
     }
@@ -52,21 +62,71 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-// Steps until `seconds` of wall time have passed (at least `min_steps`); returns steps per second.
+// Resident set size of this process (bytes), from /proc/self/statm.
+double resident_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  double pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
+}
+
+struct Rate {
+  double steps_per_second = 0;
+  int steps = 0;  // timed steps
+};
+
+// One warm-up call (shader compilation, first allocations), then calls of `batch` steps until
+// `seconds` of wall time and `min_steps` steps have passed.
 template <typename StepFn, typename SyncFn>
-double steps_per_second(StepFn step, SyncFn sync, double seconds, int batch) {
-  step(batch);  // warm-up: shader compilation, first allocations
+Rate measure(StepFn step, SyncFn sync, double seconds, int min_steps, int batch) {
+  step(1);
   sync();
-  int steps = 0;
+  Rate r;
   const auto start = Clock::now();
   double elapsed = 0.0;
-  while (elapsed < seconds) {
+  while (elapsed < seconds || r.steps < min_steps) {
     step(batch);
     sync();
-    steps += batch;
+    r.steps += batch;
     elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   }
-  return steps / elapsed;
+  r.steps_per_second = r.steps / elapsed;
+  return r;
+}
+
+struct Row {
+  std::size_t grains = 0, particles = 0;
+  double contacts_per_grain = 0;
+  double dt = 0;  // s
+  Rate gpu, cpu;
+  double gpu_bytes_per_grain = 0, cpu_bytes_per_grain = 0;
+};
+
+Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Options& options) {
+  const ts::bench::BenchWorld bed = ts::bench::settled_bed(requested);
+  Row row;
+  row.grains = bed.world.bodies.size();
+  row.particles = bed.world.particles.size();
+  row.dt = bed.settings.dt;
+  const int batch = std::clamp(static_cast<int>(200000 / row.grains), 1, 100);
+  {
+    // CPU first, so the resident-memory growth it causes is not memory the GPU stepper freed.
+    const double before = resident_bytes();
+    ts::sim::World world = bed.world;
+    ts::sim::CpuStepper cpu(world, bed.settings);
+    ts::sim::StepStats stats;
+    row.cpu = measure(
+        [&](int n) {
+          for (int s = 0; s < n; ++s) stats = cpu.step(world);
+        },
+        [] {}, options.seconds, options.min_steps, std::max(1, batch / 10));
+    row.cpu_bytes_per_grain = (resident_bytes() - before) / static_cast<double>(row.grains);
+    row.contacts_per_grain = static_cast<double>(stats.contacts + stats.wall_contacts) / static_cast<double>(row.grains);
+  }
+  ts::sim::GpuStepper gpu(context, bed.world, bed.settings, options.precision);
+  row.gpu = measure([&](int n) { gpu.step(n); }, [] { glFinish(); }, options.seconds, options.min_steps, batch);
+  row.gpu_bytes_per_grain = static_cast<double>(gpu.gpu_bytes()) / static_cast<double>(row.grains);
+  return row;
 }
 
 }  // namespace
@@ -75,30 +135,26 @@ int main(int argc, char** argv) {
   try {
     const Options options = parse(argc, argv);
     ts::gpu::Context context;
-    ts::sim::StepSettings settings;
-    settings.dt = 2e-6;  // s: below t_c/20 for 1 mm grains at 1 m/s with E = 10 MPa
-    const std::string header = fmt::format("| grains | GPU grain-steps/s | CPU grain-steps/s | GPU / CPU |");
-    if (options.markdown) fmt::print("{}\n|---|---|---|---|\n", header);
     fmt::print(stderr, "renderer: {}\n", context.summary());
-    for (std::uint32_t grains : options.grains) {
-      const ts::sim::World world = ts::bench::settling_box(grains, 1);
-      ts::sim::GpuStepper gpu(context, world, settings, options.precision);
-      const double gpu_rate = steps_per_second([&](int n) { gpu.step(n); }, [&] { glFinish(); }, options.seconds, 10);
-      ts::sim::World cpu_world = world;
-      ts::sim::CpuStepper cpu(cpu_world, settings);
-      const double cpu_rate = steps_per_second(
-          [&](int n) {
-            for (int s = 0; s < n; ++s) cpu.step(cpu_world);
-          },
-          [] {}, options.seconds, 2);
-      const double g = gpu_rate * grains, c = cpu_rate * grains;
-      if (options.markdown) {
-        fmt::print("| {} | {:.3g} | {:.3g} | {:.2f} |\n", grains, g, c, g / c);
-      } else {
-        fmt::print("grains {:>8}: GPU {:.3g} grain-steps/s, CPU reference {:.3g} grain-steps/s, ratio {:.2f}\n", grains,
-                   g, c, g / c);
-      }
+    std::string csv =
+        "grains,particles,contacts_per_grain,dt_s,gpu_steps,gpu_grain_steps_per_s,cpu_steps,cpu_grain_steps_per_s,"
+        "gpu_over_cpu,gpu_bytes_per_grain,cpu_bytes_per_grain,precision,renderer\n";
+    for (std::uint32_t requested : options.grains) {
+      const Row r = measure_size(context, requested, options);
+      const double g = r.gpu.steps_per_second * static_cast<double>(r.grains);
+      const double c = r.cpu.steps_per_second * static_cast<double>(r.grains);
+      fmt::print(
+          "grains {:>8}: {:.1f} contacts/grain; GPU {:.3g} grain-steps/s ({} steps), CPU reference {:.3g} "
+          "grain-steps/s ({} steps), ratio {:.2f}; memory per grain GPU {:.0f} B, CPU {:.0f} B\n",
+          r.grains, r.contacts_per_grain, g, r.gpu.steps, c, r.cpu.steps, g / c, r.gpu_bytes_per_grain,
+          r.cpu_bytes_per_grain);
+      std::fflush(stdout);
+      csv += fmt::format("{},{},{:.3f},{:.4g},{},{:.5g},{},{:.5g},{:.4f},{:.1f},{:.1f},{},\"{}\"\n", r.grains,
+                         r.particles, r.contacts_per_grain, r.dt, r.gpu.steps, g,
+                         r.cpu.steps, c, g / c, r.gpu_bytes_per_grain, r.cpu_bytes_per_grain,
+                         options.precision == ts::sim::Precision::Double ? "double" : "float", context.summary());
     }
+    if (!options.csv.empty()) ts::write_file_atomically(options.csv, csv);
     return 0;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());

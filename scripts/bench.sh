@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
-# Usage: scripts/bench.sh [peers-sim|validation|sdf|all] [--build-dir DIR] [--no-build] [--cases 'MESH@R1,R2 ...']
+# Usage: scripts/bench.sh [sim|peers-sim|validation|sdf|all] [--build-dir DIR] [--no-build] [--grains LIST] [--cases 'MESH@R1,R2 ...']
+#   sim         Cundall number (grain-steps/s) of the GPU pipeline and the CPU reference on the same
+#               settled beds, 1k to 1M grains (--grains 1000,8000 for fewer), memory per grain
+#               -> the Cundall table and plot in section sim of docs/benchmarks.md      (~8 min, 2 cores)
 #   peers-sim   tetrasand (CPU reference, GPU pipeline) against LAMMPS on the same scenes, one run:
 #               grain-steps/s as ratios, settled bed height, rebound, angle of repose
 #               -> section peers-sim of docs/benchmarks.md                              (~5 min, 2 cores)
@@ -21,15 +24,17 @@ what=${1:-all}
 build="$root/build-release"
 do_build=1
 sdf_cases="knot1@64,128,256,512,1024 armadillo@64,128,256,512,1024 icosphere:8@64,128,256,512,1024"
+grains=1000,8000,64000,512000,1000000
 while [ $# -gt 0 ]; do
   case "$1" in
     --build-dir) build=$2; shift 2 ;;
     --no-build) do_build=0; shift ;;
     --cases) sdf_cases=$2; shift 2 ;;
+    --grains) grains=$2; shift 2 ;;
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in peers-sim|validation|sdf|all) ;; *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;; esac
+case "$what" in sim|peers-sim|validation|sdf|all) ;; *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;; esac
 
 # The bench's own packages (not needed to build or test): LAMMPS, numpy, matplotlib.
 bench_packages=(lammps openmpi-bin python3-numpy python3-matplotlib)
@@ -55,6 +60,11 @@ status=0
 # numpy and matplotlib are Debian's: run the system interpreter, not a pyenv one.
 py=/usr/bin/python3
 
+if [ "$what" = sim ] || [ "$what" = all ]; then
+  "$bin/tetrasand_bench_sim" --grains "$grains" --csv "$work/sim.csv"
+  "$py" "$root/bench/plot_sim.py" "$work/sim.csv" "$root/docs" "scripts/bench.sh sim --grains $grains"
+  echo "bench: wrote the Cundall table of docs/benchmarks.md and docs/benchmarks/sim_cundall.png"
+fi
 if [ "$what" = peers-sim ] || [ "$what" = all ]; then
   "$py" "$root/bench/peers/sim_peers.py" "$bin" "$work/peers-sim" --markdown "$root/docs/benchmarks.md" || status=1
 fi
