@@ -35,7 +35,8 @@ struct Options {
   double radius = 0, coverage = 1.0, grain_radius = 0, voxel = 0, density = 1000.0, scale = 1.0;
   std::size_t count = 0, probes = 1'000'000;
   std::uint64_t seed = 1;
-  int rounds = 12;
+  int rounds = 12, max_iterations = 2000;
+  std::string sign = "pseudonormal";
   bool json = false, timings = false, allow_open = false;
 };
 
@@ -157,7 +158,16 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--rounds", o->rounds, "Most hole-closing rounds")->check(CLI::NonNegativeNumber)->capture_default_str();
   cmd->add_option("--probes", o->probes, "Surface points the covering radius is measured on")->capture_default_str();
   cmd->add_option("--scale", o->scale, "Multiply coordinates by this factor first")->check(CLI::PositiveNumber);
-  cmd->add_flag("--allow-open", o->allow_open, "Sample an open or non-manifold mesh anyway (its mass properties are then approximate)");
+  cmd->add_option("--max-iterations", o->max_iterations, "Most relaxation steps of the first relaxation (later rounds: 200)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--sign", o->sign,
+                  "Inside/outside by pseudonormals (closed meshes only) or by the generalised winding number "
+                  "(also open or non-manifold meshes: they are sampled with a warning, their mass properties "
+                  "integrated over the winding-number solid)")
+      ->check(CLI::IsMember({"pseudonormal", "winding"}))
+      ->capture_default_str();
+  cmd->add_flag("--allow-open", o->allow_open, "Same as --sign winding (the older name)");
   cmd->add_flag("--json", o->json, "Print the body.json summary on stdout");
   cmd->add_flag("--timings", o->timings, "Per-kernel GPU times");
   auto write_preview = std::make_shared<bool>(false);
@@ -212,12 +222,20 @@ int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& 
     TriangleMesh mesh = load_mesh(o->mesh);
     if (o->scale != 1.0) scale_mesh(mesh, o->scale);
     const MeshReport report = analyze_mesh(mesh);
-    if (!report.watertight() && !o->allow_open) {
-      throw InputError(o->mesh, "is not a closed, consistently oriented solid (" + closed_solid_problems(report) +
-                                    "); `tetrasand info` shows the full report; --allow-open samples it anyway\n" +
-                                    format_report(report));
-    }
+    const bool winding = o->sign == "winding" || o->allow_open;
     sampler::SampleSettings settings;
+    settings.sign = winding ? sdf::SignMethod::Winding : sdf::SignMethod::Pseudonormal;
+    if (!report.watertight()) {
+      if (!winding) {
+        throw InputError(o->mesh, "is not a closed, consistently oriented solid (" + closed_solid_problems(report) +
+                                      "); `tetrasand info` shows the full report; --sign winding samples it anyway\n" +
+                                      format_report(report));
+      }
+      log::warn("{}: not a closed solid ({}): sampled with winding-number signs; the particles cover the mesh's own "
+                "surface only (holes stay open), mass properties come from the winding-number solid",
+                o->mesh, closed_solid_problems(report));
+      settings.mass_method = sampler::MassMethod::WindingCells;
+    }
     settings.radius = o->radius;
     settings.count = o->count;
     settings.coverage = o->coverage;
@@ -228,6 +246,7 @@ int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& 
     settings.max_rounds = o->rounds;
     settings.probes = o->probes;
     settings.timings = o->timings;
+    settings.relax.max_iterations = o->max_iterations;
 
     const bool terminal = ::isatty(STDERR_FILENO) != 0;
     const auto progress = [&](const sampler::SampleProgress& p) {
@@ -262,8 +281,11 @@ int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& 
       fmt::print("  on the surface   largest |phi| = {:.2e} r\n", q.max_abs_phi_over_r);
       fmt::print("  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {}\n", q.iterations,
                  q.injection_rounds, q.converged ? "converged" : "NOT converged", q.seconds, context.summary());
-      fmt::print("  mass properties  {:.6g} kg, volume {:.6g} m^3, centre of mass ({:.6g}, {:.6g}, {:.6g}) m\n", body.mass,
-                 body.volume, body.center_of_mass.x(), body.center_of_mass.y(), body.center_of_mass.z());
+      fmt::print("  mass properties  {:.6g} kg, volume {:.6g} m^3, centre of mass ({:.6g}, {:.6g}, {:.6g}) m, {}\n", body.mass,
+                 body.volume, body.center_of_mass.x(), body.center_of_mass.y(), body.center_of_mass.z(),
+                 body.mass_method == sampler::MassMethod::WindingCells
+                     ? fmt::format("from the winding-number solid (cells of {:.3g} m)", body.mass_cell)
+                     : std::string("from the closed mesh"));
     }
     if (o->timings) fmt::print("{}", result.timing_report);
     if (*write_preview) {

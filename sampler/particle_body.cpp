@@ -259,6 +259,8 @@ Json body_json(const ParticleBody& body, const std::string& ply_name) {
   j["principal_moments"] = vector_json(body.principal_moments);
   j["principal_axes"] = Json::array();
   for (int k = 0; k < 3; ++k) j["principal_axes"].push_back(vector_json(body.principal_axes.col(k)));
+  j["mass_properties_method"] = mass_method_name(body.mass_method);
+  j["mass_properties_cell"] = body.mass_method == MassMethod::WindingCells ? Json(body.mass_cell) : Json();
   j["sdf_voxel_size"] = body.sdf_voxel_size;
   Json quality;
   quality["relative_radius"] = q.relative_radius;
@@ -423,12 +425,17 @@ void validate_for_writing(const fs::path& json_path, const ParticleBody& b) {
   positive("mass", b.mass);
   positive("volume", b.volume);
   positive("sdf_voxel_size", b.sdf_voxel_size);
+  if (b.mass_method == MassMethod::WindingCells) positive("mass_properties_cell", b.mass_cell);
   if (!is_sha256(b.source_sha256)) f.fail("source.sha256", "must be 64 lowercase hex digits");
   check_particles(f, b);
   check_mass_properties(f, b);
 }
 
 }  // namespace
+
+const char* mass_method_name(MassMethod method) {
+  return method == MassMethod::WindingCells ? "winding_cells" : "closed_mesh";
+}
 
 void set_mass_properties(ParticleBody& body, const MassProperties& mass) {
   body.density = mass.density;
@@ -500,14 +507,20 @@ ParticleBody read_body(const fs::path& json_path) {
   } catch (const nlohmann::json::exception& e) {
     throw InputError(json_path, fmt::format("not valid JSON: {}", e.what()));
   }
-  const Fields f(json_path, j, "",
-                 {"format_version", "units", "source", "particle_radius", "particle_count", "particles", "density", "mass",
-                  "volume", "center_of_mass", "inertia", "principal_moments", "principal_axes", "sdf_voxel_size",
-                  "quality"});
-  const std::int64_t version = f.count("format_version");
-  if (version != kBodyFormatVersion) {
-    f.fail("format_version", fmt::format("{} is not supported (this tetrasand reads version {})", version, kBodyFormatVersion));
+  // The version decides which keys belong, so it is checked first.
+  const std::int64_t version = j.is_object() && j.contains("format_version") && j["format_version"].is_number_integer()
+                                   ? j["format_version"].get<std::int64_t>()
+                                   : kBodyFormatVersion;  // Fields reports what is wrong with it
+  if (version < 1 || version > kBodyFormatVersion) {
+    throw InputError(json_path, fmt::format("format_version: {} is not supported (this tetrasand reads versions 1 to {})",
+                                            version, kBodyFormatVersion));
   }
+  std::vector<std::string> keys = {"format_version", "units", "source", "particle_radius", "particle_count",
+                                   "particles", "density", "mass", "volume", "center_of_mass", "inertia",
+                                   "principal_moments", "principal_axes", "sdf_voxel_size", "quality"};
+  if (version >= 2) keys.insert(keys.end() - 2, {"mass_properties_method", "mass_properties_cell"});
+  const Fields f(json_path, j, "", keys);
+  f.count("format_version");
   read_units(json_path, f.at("units"));
   ParticleBody b;
   const Fields source(json_path, f.at("source"), "source.", {"path", "sha256"});
@@ -526,6 +539,17 @@ ParticleBody read_body(const fs::path& json_path) {
   b.principal_moments = f.vector("principal_moments");
   b.principal_axes = f.rows("principal_axes").transpose();  // stored one axis per array
   b.sdf_voxel_size = f.positive("sdf_voxel_size");
+  if (version >= 2) {
+    const std::string method = f.string("mass_properties_method");
+    if (method == mass_method_name(MassMethod::WindingCells)) {
+      b.mass_method = MassMethod::WindingCells;
+      b.mass_cell = f.positive("mass_properties_cell");
+    } else if (method != mass_method_name(MassMethod::ClosedMesh)) {
+      f.fail("mass_properties_method", fmt::format("must be \"closed_mesh\" or \"winding_cells\", not \"{}\"", method));
+    } else if (!f.at("mass_properties_cell").is_null()) {
+      f.fail("mass_properties_cell", "must be null for closed_mesh");
+    }
+  }
   b.quality = read_quality(json_path, f.at("quality"));
   check_mass_properties(f, b);
 

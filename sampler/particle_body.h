@@ -12,7 +12,16 @@
 
 namespace ts::sampler {
 
-inline constexpr int kBodyFormatVersion = 1;
+// Version 2 added mass_properties_method and mass_properties_cell; version 1 files are still read
+// (their mass properties came from the closed mesh).
+inline constexpr int kBodyFormatVersion = 2;
+
+// Where a body's mass properties come from (body.json `mass_properties_method`).
+enum class MassMethod {
+  ClosedMesh,    // "closed_mesh": divergence theorem over the closed mesh, exact to rounding
+  WindingCells,  // "winding_cells": octree integration over the winding-number solid (open meshes)
+};
+const char* mass_method_name(MassMethod method);
 
 struct ParticleBody {
   std::vector<Eigen::Vector3f> positions;  // m, mesh coordinates (they overlay the mesh)
@@ -25,6 +34,8 @@ struct ParticleBody {
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();             // kg m^2, about the centre of mass, mesh axes
   Eigen::Matrix3d principal_axes = Eigen::Matrix3d::Identity();  // columns: unit axes in mesh coordinates
   Eigen::Vector3d principal_moments = Eigen::Vector3d::Zero();   // kg m^2, moment k about column k
+  MassMethod mass_method = MassMethod::ClosedMesh;
+  double mass_cell = 0.0;                  // m, finest octree cell of MassMethod::WindingCells (else 0)
   double sdf_voxel_size = 0.0;             // m, of the field the particles were relaxed on
   std::string source_path;                 // the mesh file, as given on the command line
   std::string source_sha256;               // lowercase hex SHA-256 of its bytes

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <random>
 #include <span>
 
@@ -16,6 +18,7 @@
 #include "sampler/point_grid.h"
 #include "sampler/sampling_quality.h"
 #include "sampler/surface_points.h"
+#include "sampler/winding_solid.h"
 #include "sdf/exact_sdf.h"
 #include "sdf/grid.h"
 #include "sdf/pseudonormals.h"
@@ -78,9 +81,11 @@ sdf::GridSpec choose_grid(const TriangleMesh& mesh, double radius, const SampleS
   sdf::SdfSettings grid;
   grid.voxel_size = s.voxel_size > 0.0 ? s.voxel_size : 0.5 * radius;
   grid.band = kBandVoxels;
+  // The texture budget below decides; make_grid's own cap (far larger) must not refuse first.
+  grid.max_voxels = std::numeric_limits<std::size_t>::max();
   for (;;) {
     const sdf::GridSpec spec = sdf::make_grid(bounding_box(mesh), grid);
-    if (spec.voxel_count() * 16 <= s.max_sdf_bytes) {
+    if (static_cast<double>(spec.voxel_count()) * 16.0 <= static_cast<double>(s.max_sdf_bytes)) {
       if (grid.voxel_size > 0.5 * radius && s.voxel_size <= 0.0) {
         warnings.push_back(fmt::format("the SDF voxel was enlarged to {:.4g} m (r / {:.2f}) to fit the {} MiB texture "
                                        "budget; relaxation is coarser, the exact projection keeps particles on the surface",
@@ -167,6 +172,19 @@ void project_exactly(const sdf::ExactDistance& exact, std::vector<Eigen::Vector3
   });
 }
 
+// On an open or inconsistently oriented mesh a pseudonormal can point inwards. The outward side is
+// where the winding number drops: a normal whose tip (a quarter radius out) sees a clearly larger
+// |w| than its tail is turned round. Thin features (both ends outside, |w| about 0) keep theirs.
+void orient_normals_by_winding(const sdf::ExactDistance& exact, const std::vector<Eigen::Vector3d>& points,
+                               std::vector<Eigen::Vector3d>& normals, double radius) {
+  tbb::parallel_for(std::size_t{0}, points.size(), [&](std::size_t i) {
+    const Eigen::Vector3d step = 0.25 * radius * normals[i];
+    const double ahead = std::abs(exact.winding_number(points[i] + step));
+    const double behind = std::abs(exact.winding_number(points[i] - step));
+    if (ahead - behind > 0.5) normals[i] = -normals[i];
+  });
+}
+
 ThinFeatures find_thin_features(const TriangleMesh& mesh, const sdf::ExactDistance& exact, double spacing) {
   const sdf::Pseudonormals& pn = exact.pseudonormals();
   // A triangle whose solid is thinner than the spacing: half a spacing inward from its centroid,
@@ -192,7 +210,10 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   SampleResult result;
   const double area = surface_area(mesh);
   if (!(area > 0.0)) throw InputError("the mesh has no surface area");
-  const MassProperties mass = compute_mass_properties(mesh, settings.density);
+  // A closed mesh's mass properties come first, so a zero-volume mesh is refused before any GPU work;
+  // the winding-number solid's need the exact distance below.
+  std::optional<MassProperties> mass;
+  if (settings.mass_method == MassMethod::ClosedMesh) mass = compute_mass_properties(mesh, settings.density);
   const Sizing z = size_particles(area, settings);
   check_sizes(z, settings, area);
   result.estimated_count = z.count;
@@ -207,6 +228,12 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   scan.timings = settings.timings;
   sdf::ScanConvertResult field = sdf::scan_convert(context, mesh, normals, spec, scan);
   const sdf::ExactDistance exact(mesh);
+  double mass_cell = 0.0;
+  if (!mass) {
+    const WindingSolid solid = winding_mass_properties(mesh, exact, settings.density, settings.mass_cell);
+    mass = solid.mass;
+    mass_cell = solid.cell;
+  }
 
   // 2. Seeds.
   std::mt19937_64 rng(settings.seed);
@@ -290,13 +317,18 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
                                           result.thin.where.min.y(), result.thin.where.min.z(), result.thin.where.max.x(),
                                           result.thin.where.max.y(), result.thin.where.max.z()));
   }
+  if (settings.sign == sdf::SignMethod::Winding) orient_normals_by_winding(exact, particles, particle_normals, z.radius);
   ParticleBody& body = result.body;
   for (std::size_t i = 0; i < particles.size(); ++i) {
     body.positions.push_back(particles[i].cast<float>());
     body.normals.push_back(particle_normals[i].cast<float>());
   }
   body.particle_radius = z.radius;
-  set_mass_properties(body, mass);
+  set_mass_properties(body, *mass);
+  if (settings.mass_method == MassMethod::WindingCells) {
+    body.mass_method = MassMethod::WindingCells;
+    body.mass_cell = mass_cell;
+  }
   body.sdf_voxel_size = spec.voxel_size;
   body.quality.relative_radius = spacing.relative_radius;
   body.quality.cv = spacing.cv_nn;

@@ -7,7 +7,8 @@
 //      measured on many surface points, particles injected at the worst uncovered points; the first
 //      3 rounds relax them with their neighbours (the rest frozen), later ones only place them, until
 //      the covering radius meets the target over the full probe set or the round limit;
-//   5. quality figures and mass properties (from the closed mesh, never from the particles).
+//   5. quality figures and mass properties (from the closed mesh, never from the particles; for a mesh
+//      that encloses no volume by itself, from its winding-number solid: sampler/winding_solid.h).
 #include <functional>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "gpu/context.h"
 #include "sampler/gpu_relaxer.h"
 #include "sampler/particle_body.h"
+#include "sdf/settings.h"
 
 namespace ts::sampler {
 
@@ -31,6 +33,14 @@ struct SampleSettings {
   std::size_t probes = 1'000'000;      // surface points the covering radius is measured on
   std::size_t max_particles = 20'000'000;
   std::size_t max_sdf_bytes = 1ull << 30;  // dense SDF texture budget; the voxel grows (with a warning) past it
+  // Inside and outside (particle normals, thin features, interior fill): pseudonormals need a closed,
+  // consistently oriented mesh; the generalised winding number also works on open or non-manifold
+  // ones (normals then point to where the winding number drops).
+  sdf::SignMethod sign = sdf::SignMethod::Pseudonormal;
+  // Mass, centre of mass and inertia: of the closed mesh (divergence theorem), or integrated over the
+  // winding-number solid (octree, sampler/winding_solid.h) when the mesh encloses no volume by itself.
+  MassMethod mass_method = MassMethod::ClosedMesh;
+  double mass_cell = 0.0;              // finest octree cell of MassMethod::WindingCells [m]; 0: longest side / 128
   bool timings = false;
   RelaxSettings relax;                 // spacing and band are filled in from the radius
 };

@@ -61,6 +61,21 @@ TEST(CliSample, OpenMeshIsRefusedWithTheInfoReport) {
   EXPECT_TRUE(files_in(dir).empty());
 }
 
+TEST(CliSample, SignWindingSamplesAnOpenMeshWithAWarning) {
+  const std::string mesh = quoted(test::assimp_model("STL/sphereWithHole.stl"));
+  for (const std::string flag : {"--sign winding", "--allow-open"}) {  // --allow-open: the older name
+    const auto dir = test::temp_dir();
+    std::string out;
+    ASSERT_EQ(test::run_tetrasand("sample " + mesh + " -o " + quoted(dir) + kFast + flag + " --json", &out), 0) << out;
+    EXPECT_NE(out.find("not a closed solid"), std::string::npos) << out;
+    EXPECT_NE(out.find("winding-number solid"), std::string::npos) << out;
+    const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
+    EXPECT_EQ(json.at("mass_properties_method").get<std::string>(), "winding_cells") << flag;
+    EXPECT_GT(json.at("mass_properties_cell").get<double>(), 0.0);
+    EXPECT_GT(json.at("volume").get<double>(), 0.0);
+  }
+}
+
 TEST(CliSample, JsonPrintsTheBodyAndOnlyFinishedFilesRemain) {
   const auto dir = test::temp_dir();
   std::string out;

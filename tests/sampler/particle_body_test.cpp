@@ -189,6 +189,17 @@ TEST(ParticleBody, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(back.quality.seconds, body.quality.seconds);
   EXPECT_EQ(back.quality.converged, body.quality.converged);
   EXPECT_EQ(back.quality.injection_rounds, body.quality.injection_rounds);
+  EXPECT_EQ(back.mass_method, MassMethod::ClosedMesh);
+  EXPECT_TRUE(nlohmann::json::parse(read_file(json))["mass_properties_cell"].is_null());
+
+  // Mass properties of a winding-number solid name their method and cell.
+  ParticleBody open = body;
+  open.mass_method = MassMethod::WindingCells;
+  open.mass_cell = 0.004;
+  const fs::path json3 = write_body(dir, "open", open);
+  EXPECT_EQ(nlohmann::json::parse(read_file(json3))["mass_properties_method"], "winding_cells");
+  EXPECT_EQ(read_body(json3).mass_method, MassMethod::WindingCells);
+  EXPECT_EQ(read_body(json3).mass_cell, 0.004);
 
   // Without a grain radius the grain-relative covering ratio is null, and reads back as absent.
   ParticleBody no_grain = body;
@@ -206,7 +217,8 @@ TEST(ParticleBody, JsonHasExactlyTheDocumentedKeys) {
   for (const auto& item : j["quality"].items()) quality_keys.push_back(item.key());
   EXPECT_EQ(keys, (std::vector<std::string>{"format_version", "units", "source", "particle_radius", "particle_count",
                                             "particles", "density", "mass", "volume", "center_of_mass", "inertia",
-                                            "principal_moments", "principal_axes", "sdf_voxel_size", "quality"}));
+                                            "principal_moments", "principal_axes", "mass_properties_method",
+                                            "mass_properties_cell", "sdf_voxel_size", "quality"}));
   EXPECT_EQ(quality_keys, (std::vector<std::string>{"relative_radius", "cv", "covering_radius", "covering_over_r",
                                                     "covering_over_r_plus_grain", "max_abs_phi_over_r", "iterations",
                                                     "seconds", "converged", "injection_rounds"}));
@@ -236,7 +248,14 @@ TEST(ParticleBody, ValidationErrorsNameTheFileAndTheKey) {
   EXPECT_EQ(error_after([](auto& j) { j["quality"]["converged"] = 1; }), prefix + "quality.converged: must be true or false");
   EXPECT_NE(error_after([](auto& j) { j["quality"]["colour"] = "red"; }).find(prefix + "quality.colour: unknown key"),
             std::string::npos);
-  EXPECT_NE(error_after([](auto& j) { j["format_version"] = 2; }).find(prefix + "format_version: 2 is not supported"),
+  EXPECT_NE(error_after([](auto& j) { j["format_version"] = 3; }).find(prefix + "format_version: 3 is not supported"),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["mass_properties_method"] = "guess"; }).find(prefix + "mass_properties_method: must be"),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["mass_properties_cell"] = 0.1; }).find(prefix + "mass_properties_cell: must be null"),
+            std::string::npos);
+  // Version 1 has no mass_properties_* keys.
+  EXPECT_NE(error_after([](auto& j) { j["format_version"] = 1; }).find(prefix + "mass_properties_method: unknown key"),
             std::string::npos);
   EXPECT_NE(error_after([](auto& j) { j["units"]["length"] = "mm"; }).find(prefix + "units.length: must be \"m\""),
             std::string::npos);
@@ -253,6 +272,20 @@ TEST(ParticleBody, ValidationErrorsNameTheFileAndTheKey) {
   EXPECT_NE(error_after([](auto& j) { j["particles"] = "gone.ply"; }).find("gone.ply: no such file"), std::string::npos);
   write_text(json, "{ not json");
   EXPECT_NE(input_error([&] { read_body(json); }).find(prefix + "not valid JSON"), std::string::npos);
+}
+
+TEST(ParticleBody, VersionOneFilesAreStillRead) {
+  const fs::path dir = test::temp_dir();
+  const fs::path json = write_body(dir, "box", box_body());
+  auto j = nlohmann::ordered_json::parse(read_file(json));
+  j["format_version"] = 1;
+  j.erase("mass_properties_method");
+  j.erase("mass_properties_cell");
+  write_text(json, j.dump(2));
+  const ParticleBody back = read_body(json);
+  EXPECT_EQ(back.mass_method, MassMethod::ClosedMesh);
+  EXPECT_EQ(back.mass, box_body().mass);
+  EXPECT_NO_THROW(read_body(test::asset("bodies/cube.body.json")));  // a version 1 asset
 }
 
 TEST(ParticleBody, InvalidBodiesAreNotWritten) {
