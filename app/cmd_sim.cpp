@@ -86,6 +86,10 @@ Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
                o->cpu ? "CPU reference" : context->summary());
     fmt::print("clamps: {} velocity, {} angular velocity, {} overlap (each clamp means a less accurate result)\n",
                result.last.velocity_clamps, result.last.angular_velocity_clamps, result.last.overlap_clamps);
+    if (scene.simulation.step.tangential == sim::TangentialModel::Spring) {
+      fmt::print("spring slots: {} overflows over the run (a contact past {} per particle has no static friction)\n",
+                 result.spring_overflows, sim::ContactSprings::kSlots);
+    }
     fmt::print("outputs: {}/metrics.csv ({} rows)\n", o->output, result.outputs);
     if (o->timings && gpu_stepper) fmt::print("{}", gpu_stepper->timing_report());
     return 0;

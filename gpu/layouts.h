@@ -24,5 +24,10 @@ static_assert(offsetof(SimPlane, extent) == 16);
 static_assert(offsetof(SimPlane, material) == 32);
 static_assert(sizeof(SimCylinder) == 48);
 static_assert(offsetof(SimCylinder, material) == 32);
+static_assert(sizeof(SimSpringSlots) == 240);
+static_assert(offsetof(SimSpringSlots, displacement) == 48);
+static_assert(sizeof(dvec4) == 32 && alignof(dvec4) == 32);
+static_assert(sizeof(SimSpringSlots64) == 448);
+static_assert(offsetof(SimSpringSlots64, displacement) == 64);
 
 }  // namespace ts::gpu::layout

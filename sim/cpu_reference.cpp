@@ -226,7 +226,7 @@ std::vector<ContactRecord> CpuStepper::contacts(const World& world) {
     // Springs are read (the forces include them) but not advanced.
     SpringSlots slots;
     const bool springs = settings_.tangential == TangentialModel::Spring &&
-                         world.springs.partner.size() == world.particles.size() * ContactSprings::kSlots;
+                         world.springs.partner.size() >= (i + 1) * ContactSprings::kSlots;
     if (springs) {
       slots.old_partner = &world.springs.partner[i * ContactSprings::kSlots];
       slots.old_displacement = &world.springs.displacement[i * ContactSprings::kSlots];
@@ -248,8 +248,9 @@ void CpuStepper::compute_forces(const World& world, StepStats& stats) {
 
   const bool springs = settings_.tangential == TangentialModel::Spring;
   constexpr std::size_t K = ContactSprings::kSlots;
-  // Each particle reads only its own old slots and writes only its own new ones: thread-safe.
-  const bool have_old = world.springs.partner.size() == std::size_t{n} * K;
+  // Each particle reads only its own old slots and writes only its own new ones: thread-safe. Grains
+  // appended since the last step (emitters) have no slots yet; everyone else keeps theirs.
+  const std::size_t old_particles = world.springs.partner.size() / K;
   if (springs) {
     next_springs_.partner.assign(std::size_t{n} * K, ContactSprings::kNoPartner);
     next_springs_.displacement.assign(std::size_t{n} * K, Eigen::Vector3d::Zero());
@@ -262,7 +263,7 @@ void CpuStepper::compute_forces(const World& world, StepStats& stats) {
     if (world.bodies.inverse_mass[world.particles.body[i]] == 0) return;
     SpringSlots slots;
     if (springs) {
-      if (have_old) {
+      if (i < old_particles) {
         slots.old_partner = &world.springs.partner[i * K];
         slots.old_displacement = &world.springs.displacement[i * K];
       }

@@ -21,7 +21,7 @@ enum class Integrator {
 // The tangential force law.
 enum class TangentialModel {
   Viscous,  // thesis eq. 3.28: viscous, capped at mu F_n; no static friction, so heaps creep slowly
-  Spring,   // elastic spring per contact plus the viscous term, capped (static friction; CPU reference only)
+  Spring,   // elastic spring per contact plus the viscous term, capped (static friction)
 };
 
 struct StepSettings {

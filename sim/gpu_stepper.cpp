@@ -14,6 +14,9 @@ namespace {
 using gpu::layout::SimCylinder;
 using gpu::layout::SimPair;
 using gpu::layout::SimPlane;
+using gpu::layout::SimSpringSlots;
+using gpu::layout::SimSpringSlots64;
+static_assert(ContactSprings::kSlots == TS_SIM_SPRING_SLOTS, "CPU and GPU keep the same number of springs");
 
 std::vector<std::string> precision_defines(Precision precision) {
   return precision == Precision::Double ? std::vector<std::string>{"TS_FP64 1"} : std::vector<std::string>{};
@@ -82,10 +85,6 @@ GpuStepper::GpuStepper(gpu::Context& context, const World& world, const StepSett
       metrics_(gpu::Program::compute(library_, "sim/reduce_metrics.comp", precision_defines(precision))),
       particle_stats_(gpu::Program::compute(library_, "sim/reduce_particle_stats.comp")),
       grid_(library_) {
-  if (settings.tangential == TangentialModel::Spring) {
-    throw Error(ExitCode::BadInput, "simulation.tangential = \"spring\" (static friction) runs on the CPU reference "
-                                    "only so far: use --cpu, or tangential = \"viscous\"");
-  }
   upload(world);
 }
 
@@ -159,8 +158,8 @@ void GpuStepper::upload(const World& world) {
   particle_position_ = gpu::Buffer(particle_count_ * 16);
   particle_position_exact_ = gpu::Buffer(precision_ == Precision::Double ? particle_count_ * 32 : 16);
   particle_velocity_ = gpu::Buffer(particle_count_ * 4 * real_size);
-  particle_force_ = gpu::Buffer(particle_count_ * 4 * real_size);
-  particle_torque_ = gpu::Buffer(particle_count_ * 4 * real_size);
+  particle_wrench_ = gpu::Buffer(particle_count_ * 8 * real_size);
+  upload_springs(world);
   particle_stats_buffer_ = gpu::Buffer(particle_count_ * 16);
   counters_ = gpu::Buffer(4 * sizeof(std::uint32_t));
   counters_.fill_zero();
@@ -176,7 +175,8 @@ void GpuStepper::upload(const World& world) {
       SimPair pair{};
       pair.coefficients = {static_cast<float>(k.effective_modulus), static_cast<float>(k.friction),
                            static_cast<float>(k.tangential_damping), static_cast<float>(k.damping_strength)};
-      pair.extra = {static_cast<float>(k.thesis_reference_speed), 0.0f, 0.0f, 0.0f};
+      pair.extra = {static_cast<float>(k.thesis_reference_speed), static_cast<float>(k.effective_shear_modulus), 0.0f,
+                    0.0f};
       pairs.push_back(pair);
     }
   }
@@ -213,11 +213,14 @@ void GpuStepper::upload(const World& world) {
   contacts_.set("material_count", material_count_);
   contacts_.set("damping_model", settings_.normal_damping == NormalDamping::Tsuji ? 0 : 1);
   contacts_.set("max_overlap_ratio", static_cast<float>(settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30));
+  contacts_.set("spring_model", settings_.tangential == TangentialModel::Spring ? 1 : 0);
   integrate_.set("body_count", body_count_);
   if (precision_ == Precision::Double) {
+    contacts_.set_double("dt", settings_.dt);
     integrate_.set_double("dt", settings_.dt);
     integrate_.set_double("gravity", gravity_.x(), gravity_.y(), gravity_.z());
   } else {
+    contacts_.set("dt", dt);
     integrate_.set("dt", dt);
     integrate_.set("gravity", static_cast<float>(gravity_.x()), static_cast<float>(gravity_.y()),
                    static_cast<float>(gravity_.z()));
@@ -242,8 +245,8 @@ void GpuStepper::bind_state() const {
   body_omega_.bind(TS_SIM_BODY_OMEGA);
   body_inverse_inertia_.bind(TS_SIM_BODY_INV_INERTIA);
   body_range_.bind(TS_SIM_BODY_RANGE);
-  particle_force_.bind(TS_SIM_PARTICLE_FORCE);
-  particle_torque_.bind(TS_SIM_PARTICLE_TORQUE);
+  particle_wrench_.bind(TS_SIM_PARTICLE_WRENCH);
+  springs_.bind(TS_SIM_SPRINGS);
   pairs_.bind(TS_SIM_PAIRS);
   planes_.bind(TS_SIM_PLANES);
   cylinders_.bind(TS_SIM_CYLINDERS);
@@ -296,6 +299,7 @@ StepStats GpuStepper::statistics() {
   const auto counters = counters_.read<std::uint32_t>(4);
   stats.velocity_clamps = counters[0];
   stats.angular_velocity_clamps = counters[1];
+  stats.spring_overflows = counters[2];
   counters_.fill_zero();
   if (bad > 0.0 || !std::isfinite(stats.energy.total())) {
     throw Error(ExitCode::Unstable, fmt::format("simulation unstable at t = {:.6g} s: {} bodies have a non-finite "
@@ -326,12 +330,69 @@ void GpuStepper::download(World& world) const {
     b.angular_velocity[k] = {omega[4 * k], omega[4 * k + 1], omega[4 * k + 2]};
   }
   world.time = time_;
+  download_springs(world);
+}
+
+// The history slots in the GPU's layout: world.springs as far as it goes (grains appended since
+// have none yet), the rest free.
+template <typename Slots>
+static std::vector<Slots> pack_springs(const World& world, std::size_t particles) {
+  std::vector<Slots> out(particles);
+  constexpr std::size_t K = ContactSprings::kSlots;
+  for (std::size_t i = 0; i < particles; ++i) {
+    for (std::size_t s = 0; s < K; ++s) {
+      const std::size_t slot = i * K + s;
+      const bool known = slot < world.springs.partner.size() && world.springs.partner[slot] != ContactSprings::kNoPartner;
+      const std::int64_t partner = known ? world.springs.partner[slot] : TS_SIM_NO_PARTNER;
+      (&out[i].partner[s / 4].x)[s % 4] = static_cast<std::int32_t>(partner);
+      const Eigen::Vector3d d = known ? world.springs.displacement[slot] : Eigen::Vector3d::Zero();
+      out[i].displacement[s] = {static_cast<decltype(out[i].displacement[s].x)>(d.x()),
+                                static_cast<decltype(out[i].displacement[s].x)>(d.y()),
+                                static_cast<decltype(out[i].displacement[s].x)>(d.z()), 0};
+    }
+  }
+  return out;
+}
+
+template <typename Slots>
+static void unpack_springs(const std::vector<Slots>& slots, World& world) {
+  constexpr std::size_t K = ContactSprings::kSlots;
+  world.springs.partner.assign(slots.size() * K, ContactSprings::kNoPartner);
+  world.springs.displacement.assign(slots.size() * K, Eigen::Vector3d::Zero());
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    for (std::size_t s = 0; s < K; ++s) {
+      const std::int32_t partner = (&slots[i].partner[s / 4].x)[s % 4];
+      if (partner == TS_SIM_NO_PARTNER) continue;
+      world.springs.partner[i * K + s] = partner;
+      const auto& d = slots[i].displacement[s];
+      world.springs.displacement[i * K + s] = {d.x, d.y, d.z};
+    }
+  }
+}
+
+void GpuStepper::upload_springs(const World& world) {
+  const bool on = settings_.tangential == TangentialModel::Spring;
+  const std::size_t n = on ? particle_count_ : 1;  // a placeholder keeps the binding valid
+  if (precision_ == Precision::Double) {
+    springs_ = gpu::Buffer::from<SimSpringSlots64>(pack_springs<SimSpringSlots64>(world, n));
+  } else {
+    springs_ = gpu::Buffer::from<SimSpringSlots>(pack_springs<SimSpringSlots>(world, n));
+  }
+}
+
+void GpuStepper::download_springs(World& world) const {
+  if (settings_.tangential != TangentialModel::Spring) return;
+  if (precision_ == Precision::Double) {
+    unpack_springs(springs_.read<SimSpringSlots64>(particle_count_), world);
+  } else {
+    unpack_springs(springs_.read<SimSpringSlots>(particle_count_), world);
+  }
 }
 
 std::vector<Eigen::Vector3d> GpuStepper::particle_forces() const {
-  const auto values = read_real(particle_force_, 4 * particle_count_);
+  const auto values = read_real(particle_wrench_, 8 * particle_count_);
   std::vector<Eigen::Vector3d> out(particle_count_);
-  for (std::uint32_t i = 0; i < particle_count_; ++i) out[i] = {values[4 * i], values[4 * i + 1], values[4 * i + 2]};
+  for (std::uint32_t i = 0; i < particle_count_; ++i) out[i] = {values[8 * i], values[8 * i + 1], values[8 * i + 2]};
   return out;
 }
 
@@ -339,8 +400,8 @@ std::size_t GpuStepper::gpu_bytes() const {
   std::size_t total = grid_.bytes();
   for (const gpu::Buffer* b : {&particle_position_, &particle_position_exact_, &particle_velocity_, &particle_info_,
                                &particle_local_, &body_position_, &body_orientation_, &body_velocity_, &body_omega_,
-                               &body_inverse_inertia_, &body_range_, &body_momentum_, &particle_force_,
-                               &particle_torque_, &pairs_, &planes_, &cylinders_, &particle_stats_buffer_})
+                               &body_inverse_inertia_, &body_range_, &body_momentum_, &particle_wrench_,
+                               &springs_, &pairs_, &planes_, &cylinders_, &particle_stats_buffer_})
     total += b->bytes();
   return total;
 }

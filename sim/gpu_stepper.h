@@ -31,7 +31,8 @@ class GpuStepper {
   // Statistics of the last step (energies, contacts, overlap, clamp counts since the last call).
   // Throws ts::Error(ExitCode::Unstable) on a non-finite state.
   StepStats statistics();
-  // Bodies' positions, orientations and velocities back into `world` (its time advanced too).
+  // Bodies' positions, orientations and velocities back into `world` (its time advanced too), and
+  // with the spring tangential model the contact springs.
   void download(World& world) const;
   // Per-particle contact force [N] of the last step (for tests against the CPU reference).
   std::vector<Eigen::Vector3d> particle_forces() const;
@@ -44,6 +45,8 @@ class GpuStepper {
   gpu::Buffer real_buffer(const std::vector<T>& values) const;
   std::vector<double> read_real(const gpu::Buffer& buffer, std::size_t count) const;
   void bind_state() const;
+  void upload_springs(const World& world);
+  void download_springs(World& world) const;
 
   gpu::Context& context_;
   StepSettings settings_;
@@ -54,7 +57,7 @@ class GpuStepper {
   gpu::HashGrid grid_;
   gpu::Buffer particle_position_, particle_position_exact_, particle_velocity_, particle_info_, particle_local_;
   gpu::Buffer body_position_, body_orientation_, body_velocity_, body_omega_, body_inverse_inertia_, body_range_;
-  gpu::Buffer body_momentum_, particle_force_, particle_torque_, pairs_, planes_, cylinders_, particle_stats_buffer_;
+  gpu::Buffer body_momentum_, particle_wrench_, springs_, pairs_, planes_, cylinders_, particle_stats_buffer_;
   gpu::Buffer counters_, metric_partials_, stat_partials_;
   std::uint32_t particle_count_ = 0, body_count_ = 0, plane_count_ = 0, cylinder_count_ = 0, material_count_ = 0;
   double cell_size_ = 0.0;  // m: the largest particle diameter, as the CPU reference

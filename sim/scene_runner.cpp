@@ -113,17 +113,17 @@ class OutputWriter {
       : settings_(scene.output), dir_(dir), hooks_(hooks) {
     std::filesystem::create_directories(dir_);
     csv_ = "step,time_s,grains,kinetic_translational_J,kinetic_rotational_J,potential_J,elastic_J,contacts,"
-           "wall_contacts,max_overlap_ratio,velocity_clamps,angular_velocity_clamps,overlap_clamps\n";
+           "wall_contacts,max_overlap_ratio,velocity_clamps,angular_velocity_clamps,overlap_clamps,spring_overflows\n";
   }
 
   void write(const World& world, const StepStats& stats, std::int64_t step, Stepper& stepper) {
     const std::string index = fmt::format("{:06d}", frame_);
     if (settings_.csv) {
-      csv_ += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{},{}\n", step, world.time,
+      csv_ += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{},{},{}\n", step, world.time,
                           dynamic_bodies(world), stats.energy.translational, stats.energy.rotational,
                           stats.energy.potential, stats.elastic_energy, stats.contacts, stats.wall_contacts,
                           stats.max_overlap_ratio, stats.velocity_clamps, stats.angular_velocity_clamps,
-                          stats.overlap_clamps);
+                          stats.overlap_clamps, stats.spring_overflows);
       write_file_atomically(dir_ / "metrics.csv", csv_);  // whole file each time: valid after any interruption
     }
     if (settings_.ply) write_particles_ply(world, dir_ / ("particles_" + index + ".ply"));
@@ -187,7 +187,7 @@ RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir,
   stats.energy = energy(world);
   output.write(world, stats, 0, *stepper);
   std::int64_t step = 0;
-  std::size_t velocity_clamps = 0, angular_clamps = 0, overlap_clamps = 0;  // since the last output
+  std::size_t velocity_clamps = 0, angular_clamps = 0, overlap_clamps = 0, overflows = 0;  // since the last output
   while (step < total) {
     if (step > 0 && pouring() && emit() > 0) stepper->load(world);
     const std::int64_t next_output = std::min(total, (step / scene.output.every + 1) * scene.output.every);
@@ -203,7 +203,10 @@ RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir,
     velocity_clamps += stats.velocity_clamps;
     angular_clamps += stats.angular_velocity_clamps;
     overlap_clamps += stats.overlap_clamps;
+    overflows += stats.spring_overflows;
+    result.spring_overflows += stats.spring_overflows;
     if (step == next_output) {
+      stats.spring_overflows = std::exchange(overflows, 0);
       stats.velocity_clamps = std::exchange(velocity_clamps, 0);
       stats.angular_velocity_clamps = std::exchange(angular_clamps, 0);
       stats.overlap_clamps = std::exchange(overlap_clamps, 0);

@@ -2,7 +2,8 @@
 // Runs a scene from start to finish: builds the world, settles the time step (auto, or the user's
 // with a warning above the bound), releases pour emitters as time passes, steps through a Stepper
 // (the CPU reference here; the GPU pipeline through an adapter) and writes the [output] files:
-//   metrics.csv                one row per output (energies, contacts, overlap, clamp counts)
+//   metrics.csv                one row per output (energies, contacts, overlap, clamp and spring-slot
+//                              overflow counts since the previous row)
 //   particles_NNNNNN.ply       binary little-endian: float x y z radius, uint body
 //   particles_NNNNNN.vtp       VTK XML PolyData (ASCII): points, radius and body per particle
 //   contacts_NNNNNN.csv        one row per contact (CPU reference: recomputed for the output state)
@@ -58,6 +59,9 @@ struct RunResult {
   StepStats last;
   std::size_t grains = 0;        // dynamic bodies at the end
   std::int64_t outputs = 0;
+  // Contacts over the whole run that found no free spring slot (spring tangential model): each ran
+  // without static friction for that step.
+  std::size_t spring_overflows = 0;
 };
 
 // The time step a scene runs with: its own, or the recommended bound for "auto".

@@ -11,6 +11,7 @@ namespace ts::gpu::layout {
 struct alignas(16) vec4 { float x, y, z, w; };
 struct alignas(16) uvec4 { std::uint32_t x, y, z, w; };
 struct alignas(16) ivec4 { std::int32_t x, y, z, w; };
+struct alignas(32) dvec4 { double x, y, z, w; };
 #define TS_LAYOUT(name) struct alignas(16) name
 #else
 #define TS_LAYOUT(name) struct name
@@ -44,7 +45,7 @@ TS_LAYOUT(SamplerGrid) {
 // by material_i * material_count + material_j.
 TS_LAYOUT(SimPair) {
   vec4 coefficients;      // x: E* [Pa], y: friction mu, z: gamma_s [N s/m], w: dimensionless damping strength c
-  vec4 extra;             // x: thesis reference speed [m/s]; yzw unused
+  vec4 extra;             // x: thesis reference speed [m/s]; y: G* [Pa] (tangential spring); zw unused
 };
 
 // ---- sim: an implicit boundary plane (smooth wall): n . x >= offset is the allowed side.
@@ -61,6 +62,21 @@ TS_LAYOUT(SimCylinder) {
   vec4 axis_radius;       // xy: the axis [m]; z unused; w: radius [m]
   vec4 range;             // x: lowest z [m], y: highest z [m]
   uvec4 material;         // x: material index
+};
+
+// ---- sim: the contact history of one particle for the tangential spring model (sim::ContactSprings):
+// TS_SIM_SPRING_SLOTS slots filled from slot 0 in gather order, each a partner (particle id, -1 - wall
+// index with planes first, or TS_SIM_NO_PARTNER) and the particle's elastic tangential displacement.
+// SimSpringSlots64 is the same for the double-precision pipeline (TS_FP64).
+#define TS_SIM_SPRING_SLOTS 12
+#define TS_SIM_NO_PARTNER 0x7fffffff
+TS_LAYOUT(SimSpringSlots) {
+  ivec4 partner[3];       // slot s: partner[s / 4][s % 4]
+  vec4 displacement[12];  // xyz: displacement [m]; w unused
+};
+TS_LAYOUT(SimSpringSlots64) {
+  ivec4 partner[3];
+  dvec4 displacement[12];
 };
 
 #ifdef __cplusplus
@@ -84,14 +100,16 @@ TS_LAYOUT(SimCylinder) {
 #define TS_SIM_BODY_OMEGA 12         // xyz: angular velocity [rad/s] (derived from the momentum)
 #define TS_SIM_BODY_INV_INERTIA 13   // 3 vec4 per body: rows of I0^-1 (body frame) [1/(kg m^2)]; row 0 w: bounding radius [m]
 #define TS_SIM_BODY_RANGE 14         // uvec4: x first particle, y particle count
-#define TS_SIM_PARTICLE_FORCE 15     // xyz: contact force on the particle [N]
-#define TS_SIM_PARTICLE_TORQUE 16    // xyz: its torque about the body's centre of mass [N m]
+// 2 per particle (one buffer, so the contact kernel stays within 16 storage blocks): [2i] xyz contact
+// force on the particle [N]; [2i + 1] xyz its torque about the body's centre of mass [N m].
+#define TS_SIM_PARTICLE_WRENCH 15
 #define TS_SIM_PAIRS 17              // SimPair[material_count^2]
 #define TS_SIM_PLANES 18             // SimPlane[]
 #define TS_SIM_CYLINDERS 19          // SimCylinder[]
 #define TS_SIM_PARTICLE_STATS 20     // x: pair contacts (counted by the lower id), y: wall contacts, z: largest overlap / smaller radius, w: overlap clamps
-#define TS_SIM_COUNTERS 21           // uint[]: 0 velocity clamps, 1 overlap clamps
+#define TS_SIM_COUNTERS 21           // uint[]: 0 velocity clamps, 1 angular velocity clamps, 2 spring slot overflows
 #define TS_SIM_BODY_MOMENTUM 22      // xyz: angular momentum [kg m^2/s] (world frame)
+#define TS_SIM_SPRINGS 16             // SimSpringSlots (SimSpringSlots64 with TS_FP64) per particle
 
 // Motion types (TS_SIM_BODY_VELOCITY.w)
 #define TS_MOTION_DYNAMIC 0

@@ -3,30 +3,34 @@
 // Step 3: contact forces gathered per particle over the 27 surrounding cells in a fixed order (cells
 // in a fixed sweep, ids sorted within cells), so there are no float atomics and results are bitwise
 // reproducible. Only particles of different bodies touch; walls are implicit (no particle storage).
+// With the spring tangential model each dynamic particle keeps its contacts' springs in its own
+// history slots (read at the start, rewritten in gather order), matched by partner id, as
+// CpuStepper::visit_contacts does. At most 16 storage blocks (the per-stage minimum of GL 4.3).
 #include "common/hash_grid.glsl"
 #include "common/layouts.h"
 #include "sim/contact.glsl"
 #include "sim/rigid.glsl"
 layout(local_size_x = 128) in;
 layout(std430, binding = TS_SIM_PARTICLE_POSITION) readonly buffer P { vec4 particle_position[]; };
-layout(std430, binding = 2) readonly buffer CellCount { uint cell_count[]; };
 layout(std430, binding = 4) readonly buffer CellStart { uint cell_start[]; };
 layout(std430, binding = 5) readonly buffer Sorted { uint sorted_ids[]; };
 layout(std430, binding = TS_SIM_PARTICLE_VELOCITY) readonly buffer V { real4 particle_velocity[]; };
 layout(std430, binding = TS_SIM_PARTICLE_INFO) readonly buffer I { uvec4 particle_info[]; };
 layout(std430, binding = TS_SIM_BODY_POSITION) readonly buffer BP { real4 body_position[]; };
 layout(std430, binding = TS_SIM_BODY_OMEGA) readonly buffer BW { real4 body_omega[]; };
-layout(std430, binding = TS_SIM_PARTICLE_FORCE) writeonly buffer F { real4 particle_force[]; };
-layout(std430, binding = TS_SIM_PARTICLE_TORQUE) writeonly buffer T { real4 particle_torque[]; };
+layout(std430, binding = TS_SIM_PARTICLE_WRENCH) writeonly buffer F { real4 particle_wrench[]; };
 layout(std430, binding = TS_SIM_PAIRS) readonly buffer M { SimPair pair_table[]; };
 layout(std430, binding = TS_SIM_PLANES) readonly buffer Planes { SimPlane planes[]; };
 layout(std430, binding = TS_SIM_CYLINDERS) readonly buffer Cylinders { SimCylinder cylinders[]; };
 layout(std430, binding = TS_SIM_PARTICLE_STATS) writeonly buffer S { vec4 particle_stats[]; };
+layout(std430, binding = TS_SIM_COUNTERS) buffer C { uint counters[]; };
 #ifdef TS_FP64
 layout(std430, binding = 23) readonly buffer PX { dvec4 particle_position_exact[]; };
 #define POSITION(k) particle_position_exact[k]
+layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots64 springs[]; };
 #else
 #define POSITION(k) particle_position[k]
+layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots springs[]; };
 #endif
 
 uniform uint particle_count;
@@ -37,7 +41,39 @@ uniform uint cylinder_count;
 uniform int damping_model;
 uniform float max_overlap_ratio;  // overlap clamp (thesis 3.3.1): delta <= ratio * min radius
 uniform uint material_count;
+uniform int spring_model;  // 1: tangential springs (static friction), 0: viscous eq. 3.28
+uniform real dt;           // [s], advances the springs
 
+// This particle's contact history: the old slots, read once, and how many new ones are written.
+int old_partner[TS_SIM_SPRING_SLOTS];
+real3 old_spring[TS_SIM_SPRING_SLOTS];
+uint slots_used = 0u, slot_overflows = 0u;
+
+void load_springs(uint i) {
+  for (uint s = 0u; s < TS_SIM_SPRING_SLOTS; ++s) {
+    old_partner[s] = springs[i].partner[s / 4u][s % 4u];
+    old_spring[s] = real3(springs[i].displacement[s].xyz);
+  }
+}
+
+// The force of one touching contact; with springs, takes the contact's spring from the old slots
+// (zero when new) and keeps it, advanced, in the next free slot (counted when none is left).
+real3 contact_force(uint i, bool with_springs, int partner, real3 n, real delta, real3 vc, real effective_radius,
+                    real effective_mass, SimPair c) {
+  if (!with_springs) return hertz_contact_force(n, delta, vc, effective_radius, effective_mass, c, damping_model);
+  real3 spring = real3(0.0);
+  for (uint s = 0u; s < TS_SIM_SPRING_SLOTS; ++s)
+    if (old_partner[s] == partner) spring = old_spring[s];
+  real3 f = hertz_spring_contact_force(n, delta, vc, effective_radius, effective_mass, c, damping_model, dt, spring);
+  if (slots_used == TS_SIM_SPRING_SLOTS) {
+    ++slot_overflows;
+  } else {
+    springs[i].partner[slots_used / 4u][slots_used % 4u] = partner;
+    springs[i].displacement[slots_used] = real4(spring, 0.0);
+    ++slots_used;
+  }
+  return f;
+}
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -52,6 +88,9 @@ void main() {
   uint pair_row = particle_info[i].y * material_count;
   real3 force = real3(0.0), torque = real3(0.0);
   real3 arm_i = xi - body_position[body_i].xyz;
+  // Static and kinematic particles keep no springs (their partners hold the contact's), as on the CPU.
+  bool with_springs = spring_model != 0 && inv_mass_i > 0.0;
+  if (with_springs) load_springs(i);
 
   ivec3 c = cell_of_position(particle_position[i].xyz, cell_size);
   float pair_contacts = 0.0, walls = 0.0, clamps = 0.0, worst_overlap = 0.0;
@@ -63,7 +102,8 @@ void main() {
       for (int dx = -1; dx <= 1; ++dx) {
         ivec3 cell = c + ivec3(dx, dy, dz);
         uint h = hash_cell(cell, table_size);
-        uint begin = cell_start[h], end = begin + cell_count[h];
+        // A bucket ends where the next begins (the last one at the particle count).
+        uint begin = cell_start[h], end = h + 1u < table_size ? cell_start[h + 1u] : particle_count;
         for (uint k = begin; k < end; ++k) {
           uint j = sorted_ids[k];
           uint body_j = particle_info[j].x;
@@ -81,8 +121,8 @@ void main() {
           real3 arm1 = -(ri - 0.5 * raw) * n;
           real3 arm2 = (xj4.w - 0.5 * raw) * n;
           real3 vc = (vi + cross(wi, arm1)) - (particle_velocity[j].xyz + cross(body_omega[body_j].xyz, arm2));
-          real3 f = hertz_contact_force(n, delta, vc, ri * xj4.w / (ri + xj4.w), 1.0 / (inv_mass_i + inv_mass_j),
-                                        pair_table[pair_row + particle_info[j].y], damping_model);
+          real3 f = contact_force(i, with_springs, int(j), n, delta, vc, ri * xj4.w / (ri + xj4.w),
+                                  1.0 / (inv_mass_i + inv_mass_j), pair_table[pair_row + particle_info[j].y]);
           force += f;
           torque += cross(arm_i + arm1, f);
           if (i < j) {  // each pair is counted once, by its lower id
@@ -107,8 +147,8 @@ void main() {
       }
       real delta = min(raw, overlap_cap * ri);
       real3 arm = -(ri - 0.5 * raw) * n;
-      real3 f = hertz_contact_force(n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i, pair_table[pair_row + plane.material.x],
-                                    damping_model);
+      real3 f = contact_force(i, with_springs, -1 - int(k), n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i,
+                              pair_table[pair_row + plane.material.x]);
       force += f;
       torque += cross(arm_i + arm, f);
       walls += 1.0;
@@ -126,8 +166,8 @@ void main() {
       real3 n = real3(-radial / distance, 0.0);
       real delta = min(raw, overlap_cap * ri);
       real3 arm = -(ri - 0.5 * raw) * n;
-      real3 f = hertz_contact_force(n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i, pair_table[pair_row + cyl.material.x],
-                                    damping_model);
+      real3 f = contact_force(i, with_springs, -1 - int(plane_count + k), n, delta, vi + cross(wi, arm), ri,
+                              1.0 / inv_mass_i, pair_table[pair_row + cyl.material.x]);
       force += f;
       torque += cross(arm_i + arm, f);
       walls += 1.0;
@@ -135,7 +175,11 @@ void main() {
       clamps += raw > delta ? 1.0 : 0.0;
     }
   }
-  particle_force[i] = real4(force, 0.0);
-  particle_torque[i] = real4(torque, 0.0);
+  if (with_springs) {
+    for (uint s = slots_used; s < TS_SIM_SPRING_SLOTS; ++s) springs[i].partner[s / 4u][s % 4u] = TS_SIM_NO_PARTNER;
+    if (slot_overflows > 0u) atomicAdd(counters[2], slot_overflows);  // integer counts: order-free
+  }
+  particle_wrench[2u * i] = real4(force, 0.0);
+  particle_wrench[2u * i + 1u] = real4(torque, 0.0);
   particle_stats[i] = vec4(pair_contacts, walls, worst_overlap, clamps);
 }

@@ -14,8 +14,7 @@ layout(std430, binding = TS_SIM_BODY_VELOCITY) buffer BV { real4 body_velocity[]
 layout(std430, binding = TS_SIM_BODY_OMEGA) buffer BW { real4 body_omega[]; };
 layout(std430, binding = TS_SIM_BODY_INV_INERTIA) readonly buffer BI { real4 body_inverse_inertia[]; };
 layout(std430, binding = TS_SIM_BODY_RANGE) readonly buffer BR { uvec4 body_range[]; };
-layout(std430, binding = TS_SIM_PARTICLE_FORCE) readonly buffer F { real4 particle_force[]; };
-layout(std430, binding = TS_SIM_PARTICLE_TORQUE) readonly buffer T { real4 particle_torque[]; };
+layout(std430, binding = TS_SIM_PARTICLE_WRENCH) readonly buffer F { real4 particle_wrench[]; };
 layout(std430, binding = TS_SIM_COUNTERS) buffer C { uint counters[]; };
 layout(std430, binding = TS_SIM_BODY_MOMENTUM) buffer BL { real4 body_momentum[]; };
 
@@ -42,8 +41,8 @@ void main() {
   real3 force = real3(0.0), torque = real3(0.0);
   uint first = body_range[b].x, count = body_range[b].y;
   for (uint k = first; k < first + count; ++k) {
-    force += particle_force[k].xyz;
-    torque += particle_torque[k].xyz;
+    force += particle_wrench[2u * k].xyz;
+    torque += particle_wrench[2u * k + 1u].xyz;
   }
   real3 row0 = body_inverse_inertia[3u * b].xyz, row1 = body_inverse_inertia[3u * b + 1u].xyz,
         row2 = body_inverse_inertia[3u * b + 2u].xyz;

@@ -70,6 +70,15 @@ TEST_F(GpuLayouts, SimStructsMatchCpp) {
   using layout::SimCylinder;
   EXPECT_EQ(query(probe, "sim_cylinders[0].axis_radius").top_level_stride, static_cast<GLint>(sizeof(SimCylinder)));
   EXPECT_EQ(query(probe, "sim_cylinders[0].material").offset, static_cast<GLint>(offsetof(SimCylinder, material)));
+  using layout::SimSpringSlots;
+  using layout::SimSpringSlots64;
+  EXPECT_EQ(query(probe, "sim_springs[0].partner[0]").top_level_stride, static_cast<GLint>(sizeof(SimSpringSlots)));
+  EXPECT_EQ(query(probe, "sim_springs[0].displacement[0]").offset,
+            static_cast<GLint>(offsetof(SimSpringSlots, displacement)));
+  EXPECT_EQ(query(probe, "sim_springs64[0].partner[0]").top_level_stride,
+            static_cast<GLint>(sizeof(SimSpringSlots64)));
+  EXPECT_EQ(query(probe, "sim_springs64[0].displacement[0]").offset,
+            static_cast<GLint>(offsetof(SimSpringSlots64, displacement)));
 }
 
 }  // namespace
