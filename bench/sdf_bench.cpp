@@ -1,12 +1,16 @@
 // SDF construction three ways on the same mesh, voxel size and band, in one run: tetrasand's GPU scan
 // conversion, the CPU exact SDF (CGAL AABB tree, TBB on all cores) and OpenVDB's meshToLevelSet (all
 // cores), with the error of the GPU path and of OpenVDB against exact distance. Usage:
-//   tetrasand_bench_sdf CASE... [--band 3] [--csv FILE] [--markdown]
+//   tetrasand_bench_sdf CASE... [--band 3] [--csv FILE] [--markdown] [--openvdb-ridges]
+// --openvdb-ridges also runs OpenVDB without its renormalisation pass and prints, per case, both
+// against exact and how many voxels are off by one voxel exactly and sit on a distance ridge (the
+// cause of OpenVDB's max error of exactly 1.000 voxel on armadillo; docs/benchmarks.md, sdf).
 // CASE is MESH@R1,R2,... (a mesh file, or icosphere:S for a generated sphere of 20 * 4^S triangles)
 // with the resolutions (voxels along the longest side) to run it at.
 #include <fmt/format.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -63,8 +67,37 @@ struct Row {
   ts::sdf::GridComparison gpu, vdb;  // against exact
 };
 
+// Voxels where OpenVDB is off by one voxel (to 1e-3), and how many of them lie less than 0.8 voxel
+// outside the surface on a local maximum of the exact distance over their six neighbours.
+void print_ridge_check(const ts::TriangleMesh& mesh, const ts::sdf::GridSpec& spec, const openvdb::FloatGrid& exact,
+                       const openvdb::FloatGrid& vdb, double band, int resolution) {
+  const double h = spec.voxel_size, band_world = band * h;
+  const auto raw = ts::sdf::openvdb_level_set(mesh, h, band, /*renormalize=*/false);
+  const auto with = ts::sdf::compare_grids(vdb, exact, h, band_world);
+  const auto without = ts::sdf::compare_grids(*raw, exact, h, band_world);
+  auto e = exact.getConstAccessor();
+  auto v = vdb.getConstAccessor();
+  std::size_t one_voxel = 0, on_ridge = 0;
+  for (auto it = exact.cbeginValueOn(); it; ++it) {
+    if (!(std::abs(*it) < band_world)) continue;
+    if (std::abs(std::abs(static_cast<double>(v.getValue(it.getCoord())) - *it) / h - 1.0) > 1e-3) continue;
+    ++one_voxel;
+    bool ridge = *it > 0.0f && *it < 0.8 * h;
+    for (const auto& o : {openvdb::Coord(1, 0, 0), openvdb::Coord(-1, 0, 0), openvdb::Coord(0, 1, 0),
+                          openvdb::Coord(0, -1, 0), openvdb::Coord(0, 0, 1), openvdb::Coord(0, 0, -1)})
+      ridge = ridge && e.getValue(it.getCoord() + o) <= *it;
+    on_ridge += ridge ? 1 : 0;
+  }
+  fmt::print("OpenVDB renormalisation at {}: with it mean {:.4f} max {:.4f} voxels, {} wrong signs; without it mean "
+             "{:.4f} max {:.4f}, {} wrong signs; {} voxels off by one voxel, {} of them on a distance ridge within "
+             "0.8 voxel outside\n",
+             resolution, with.mean, with.max, with.sign_disagreements, without.mean, without.max,
+             without.sign_disagreements, one_voxel, on_ridge);
+  std::fflush(stdout);
+}
+
 Row run_case(ts::gpu::Context& context, const ts::TriangleMesh& mesh, const ts::sdf::Pseudonormals& normals,
-             int resolution, double band) {
+             int resolution, double band, bool ridges) {
   ts::sdf::SdfSettings settings;
   settings.resolution = resolution;
   settings.band = band;
@@ -90,6 +123,7 @@ Row run_case(ts::gpu::Context& context, const ts::TriangleMesh& mesh, const ts::
   const double band_world = band * spec.voxel_size;
   row.gpu = ts::sdf::compare_grids(*gpu.grid, *exact, spec.voxel_size, band_world);
   row.vdb = ts::sdf::compare_grids(*vdb, *exact, spec.voxel_size, band_world);
+  if (ridges) print_ridge_check(mesh, spec, *exact, *vdb, band, resolution);
   return row;
 }
 
@@ -114,7 +148,7 @@ int main(int argc, char** argv) {
   try {
     std::vector<Case> cases;
     double band = 3.0;
-    bool markdown = false;
+    bool markdown = false, ridges = false;
     std::string csv_path;
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
@@ -124,13 +158,15 @@ int main(int argc, char** argv) {
         csv_path = argv[++i];
       } else if (arg == "--markdown") {
         markdown = true;
+      } else if (arg == "--openvdb-ridges") {
+        ridges = true;
       } else if (arg.rfind("--", 0) == 0) {
         throw std::runtime_error("unknown option " + arg);
       } else {
         cases.push_back(parse_case(arg));
       }
     }
-    if (cases.empty()) throw std::runtime_error("usage: tetrasand_bench_sdf MESH@64,128... [--band 3] [--csv FILE] [--markdown]");
+    if (cases.empty()) throw std::runtime_error("usage: tetrasand_bench_sdf MESH@64,128... [--band 3] [--csv FILE] [--markdown] [--openvdb-ridges]");
     ts::sdf::ensure_openvdb_initialized();
     ts::gpu::Context context;
     fmt::print(stderr, "renderer: {}\n", context.summary());
@@ -154,7 +190,7 @@ int main(int argc, char** argv) {
                               ts::sdf::make_grid(ts::bounding_box(ts::make_icosphere(0.5, 1)), warm), {});
       }
       for (int resolution : c.resolutions) {
-        Row r = run_case(context, mesh, normals, resolution, band);
+        Row r = run_case(context, mesh, normals, resolution, band, ridges);
         r.mesh = short_name(c.mesh);
         if (markdown) {
           print_markdown_row(r);

@@ -10,7 +10,7 @@
 
 namespace ts::sdf {
 
-openvdb::FloatGrid::Ptr openvdb_level_set(const TriangleMesh& mesh, double h, double band) {
+openvdb::FloatGrid::Ptr openvdb_level_set(const TriangleMesh& mesh, double h, double band, bool renormalize) {
   ensure_openvdb_initialized();
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;
@@ -20,7 +20,14 @@ openvdb::FloatGrid::Ptr openvdb_level_set(const TriangleMesh& mesh, double h, do
   for (const auto& v : mesh.vertices) points.emplace_back(v.x(), v.y(), v.z());
   for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
   const auto transform = openvdb::math::Transform::createLinearTransform(h);
-  return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*transform, points, triangles, static_cast<float>(band));
+  if (renormalize) return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*transform, points, triangles, static_cast<float>(band));
+  // What meshToLevelSet does, with the renormalisation pass switched off: points to index space first.
+  std::vector<openvdb::Vec3s> index_points;
+  index_points.reserve(points.size());
+  for (const auto& p : points) index_points.emplace_back(transform->worldToIndex(openvdb::Vec3d(p)));
+  openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(index_points, triangles);
+  return openvdb::tools::meshToVolume<openvdb::FloatGrid>(adapter, *transform, static_cast<float>(band), static_cast<float>(band),
+                                                          openvdb::tools::DISABLE_RENORMALIZATION);
 }
 
 GridComparison compare_grids(const openvdb::FloatGrid& a, const openvdb::FloatGrid& reference, double voxel_size,

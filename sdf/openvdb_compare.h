@@ -10,8 +10,13 @@
 
 namespace ts::sdf {
 
-// OpenVDB's level set of the mesh at voxel size h [m] and half-width band [voxels].
-openvdb::FloatGrid::Ptr openvdb_level_set(const TriangleMesh& mesh, double h, double band);
+// OpenVDB's level set of the mesh at voxel size h [m] and half-width band [voxels]:
+// tools::meshToLevelSet. renormalize = false runs the same conversion with DISABLE_RENORMALIZATION,
+// for the bench's look at where OpenVDB's error comes from: its renormalisation pass (shift by -0.8
+// voxel, one Godunov step, signed minimum, shift back) lowers by exactly one voxel every voxel within
+// 0.8 voxel outside the surface that is a local maximum of the distance (a ridge between two nearby
+// sheets), which is where its max error of exactly 1.000 voxel comes from (docs/benchmarks.md, sdf).
+openvdb::FloatGrid::Ptr openvdb_level_set(const TriangleMesh& mesh, double h, double band, bool renormalize = true);
 
 struct GridComparison {
   std::size_t voxels = 0;              // compared: |value| < band in either grid
