@@ -9,6 +9,7 @@ time, start-up included, the same for every code) and the physical outcome:
   bed      300 grains settling in a smooth 2 cm box: mean grain-centre height (tolerance 4 %)
   bounce   one spinless, nearly spherical grain dropped 4 mm: rebound apex (tolerance 2 %)
   heap     400 grains poured onto a rough floor: angle of repose (tolerance 3 degrees; CPU and LAMMPS)
+(assets/scenes/reference/{bed,bounce,heap}.toml).
 
 Usage: bench/peers/sim_peers.py BUILD_BIN_DIR WORK_DIR [--markdown FILE] [--no-gpu]
 """
@@ -21,104 +22,8 @@ import time
 
 import numpy as np
 
-BED = """gravity = [0.0, 0.0, -9.81]
-[[material]]
-name = "sand"
-E = 1.0e6
-nu = 0.3
-restitution = 0.5
-mu = 0.5
-gamma_s = 0.1
-density = 2600.0
-[grain]
-radius = 1.0e-3
-material = "sand"
-[[emitter]]
-type = "fill"
-min = [-0.01, -0.01, 0.0]
-max = [0.01, 0.01, 0.1]
-count = 300
-seed = 7
-[[boundary]]
-type = "box"
-min = [-0.01, -0.01, 0.0]
-max = [0.01, 0.01, 0.2]
-material = "sand"
-[simulation]
-duration = 0.4
-dt = "auto"
-[output]
-every = 1000
-ply = true
-"""
-
-BOUNCE = """gravity = [0.0, 0.0, -9.81]
-[[material]]
-name = "sand"
-E = 1.0e7
-nu = 0.3
-restitution = 0.6
-mu = 0.5
-gamma_s = 0.1
-density = 2600.0
-[grain]
-radius = 1.0e-3
-edge = 1.0e-6
-material = "sand"
-[[emitter]]
-type = "fill"
-min = [-0.003, -0.003, 0.004]
-max = [0.003, 0.003, 0.010]
-count = 1
-seed = 3
-[[boundary]]
-type = "plane"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-material = "sand"
-[simulation]
-duration = 0.08
-dt = 2.0e-6
-integrator = "{integrator}"
-[output]
-every = 50
-ply = true
-"""
-
-HEAP = """gravity = [0.0, 0.0, -9.81]
-[[material]]
-name = "sand"
-E = 1.0e6
-nu = 0.3
-restitution = 0.5
-mu = 0.5
-gamma_s = 0.1
-density = 2600.0
-[grain]
-radius = 1.0e-3
-material = "sand"
-[[emitter]]
-type = "pour"
-min = [-0.008, -0.008, 0.03]
-max = [0.008, 0.008, 0.06]
-count = 400
-rate = 1000.0
-seed = 11
-[[boundary]]
-type = "plane"
-rough = true
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-size = [0.12, 0.12]
-particle_radius = 1.0e-3
-material = "sand"
-[simulation]
-duration = 0.8
-dt = "auto"
-[output]
-every = 2000
-ply = true
-"""
+# The scenes, shared with tests/sim/export_lammps_test.cpp and bench/validation.
+REFERENCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "assets", "scenes", "reference")
 
 
 def read_ply_bodies(path):
@@ -229,11 +134,13 @@ def main():
     markdown = args[args.index("--markdown") + 1] if "--markdown" in args else None
     gpu = "--no-gpu" not in args
     os.makedirs(work, exist_ok=True)
-    scenes = {}
-    for name, text in [("bed", BED), ("heap", HEAP), ("bounce", BOUNCE.format(integrator="symplectic")),
-                       ("bounce_euler", BOUNCE.format(integrator="euler"))]:
-        scenes[name] = os.path.join(work, name + ".toml")
-        open(scenes[name], "w").write(text)
+    scenes = {name: os.path.join(REFERENCE, name + ".toml") for name in ("bed", "heap", "bounce")}
+    # The same bounce under forward Euler (the thesis integrator), for information.
+    bounce = open(scenes["bounce"]).read()
+    if 'integrator = "symplectic"' not in bounce:
+        sys.exit(f"sim_peers: {scenes['bounce']}: expected integrator = \"symplectic\"")
+    scenes["bounce_euler"] = os.path.join(work, "bounce_euler.toml")
+    open(scenes["bounce_euler"], "w").write(bounce.replace('integrator = "symplectic"', 'integrator = "euler"'))
 
     rows, physics = [], []
     # Bed: speed and settled height, every code.

@@ -22,81 +22,33 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A smooth-walled box 2 cm wide, 150 grains (r = 1 mm, E = 1 MPa so the CPU reference takes a few
-// seconds) falling from a lattice onto its floor and settling.
-constexpr const char* kBedScene = R"(
-gravity = [0.0, 0.0, -9.81]
-[[material]]
-name = "sand"
-E = 1.0e6
-nu = 0.3
-restitution = 0.5
-mu = 0.5
-gamma_s = 0.1
-density = 2600.0
-[grain]
-radius = 1.0e-3
-material = "sand"
-[[emitter]]
-type = "fill"
-min = [-0.01, -0.01, 0.0]
-max = [0.01, 0.01, 0.06]
-count = 150
-seed = 7
-[[boundary]]
-type = "box"
-min = [-0.01, -0.01, 0.0]
-max = [0.01, 0.01, 0.2]
-material = "sand"
-[simulation]
-duration = 0.35
-dt = "auto"
-[output]
-every = 1000
-csv = false
-)";
-
-// One nearly spherical grain (edge 1 um: four coincident spheres) dropped 5 mm onto a smooth floor
-// without spin: a 1-D bounce whose rebound measures the normal damping of the two codes (symplectic
-// Euler, close to LAMMPS's velocity Verlet).
-constexpr const char* kBounceScene = R"(
-gravity = [0.0, 0.0, -9.81]
-[[material]]
-name = "sand"
-E = 1.0e7
-nu = 0.3
-restitution = 0.6
-mu = 0.5
-gamma_s = 0.1
-density = 2600.0
-[grain]
-radius = 1.0e-3
-edge = 1.0e-6
-material = "sand"
-[[emitter]]
-type = "fill"
-min = [-0.003, -0.003, 0.004]
-max = [0.003, 0.003, 0.010]
-count = 1
-seed = 3
-[[boundary]]
-type = "plane"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-material = "sand"
-[simulation]
-duration = 0.08
-dt = 2.0e-6
-integrator = "symplectic"
-[output]
-every = 50
-csv = false
-)";
-
+// A scene file written into `dir` as scene.toml (the CLI test reads it from there).
 Scene write_scene(const fs::path& dir, const std::string& text) {
   const fs::path file = dir / "scene.toml";
   write_file_atomically(file, text);
   return load_scene(file);
+}
+
+// The bed of assets/scenes/reference/bed.toml (shared with bench/peers) cut to 150 grains filled up to
+// 6 cm and 0.35 s, so the CPU reference settles it in a few seconds: a smooth-walled box 2 cm wide,
+// grains (r = 1 mm, E = 1 MPa) falling from a lattice onto its floor.
+Scene bed_scene(const fs::path& dir) {
+  Scene scene = write_scene(dir, read_file(test::asset("scenes/reference/bed.toml")));
+  scene.emitters.at(0).count = 150;
+  scene.emitters.at(0).max.z() = 0.06;
+  scene.simulation.duration = 0.35;
+  scene.output.ply = false;
+  scene.output.csv = false;
+  return scene;
+}
+
+// One nearly spherical grain dropped without spin onto a smooth floor
+// (assets/scenes/reference/bounce.toml, symplectic Euler): its rebound measures the normal damping.
+Scene bounce_scene(const fs::path& dir) {
+  Scene scene = write_scene(dir, read_file(test::asset("scenes/reference/bounce.toml")));
+  scene.output.ply = false;
+  scene.output.csv = false;
+  return scene;
 }
 
 // Runs the deck with Debian's lmp; fails the test with the log's tail when it does not finish.
@@ -158,7 +110,7 @@ TEST(ExportLammps, TsujiPolynomialInverseRoundTrips) {
 
 TEST(ExportLammps, DeckGivesExplicitBodyMassInertiaAndMatchedContactModel) {
   const fs::path dir = test::temp_dir();
-  const Scene scene = write_scene(dir, kBedScene);
+  const Scene scene = bed_scene(dir);
   const LammpsDeck deck = export_lammps(scene, dir / "deck");
   EXPECT_EQ(deck.dynamic_bodies, 150u);
   EXPECT_EQ(deck.steps, static_cast<std::int64_t>(std::ceil(0.35 / deck.dt - 1e-9)));
@@ -204,9 +156,8 @@ TEST(ExportLammps, DeckGivesExplicitBodyMassInertiaAndMatchedContactModel) {
 // 8 G* (measured: the 150-grain bed then settles 1.1 % apart, 6.51 vs 6.58 mm).
 TEST(ExportLammps, SpringFrictionBecomesMindlinWithTetrasandsStiffness) {
   const fs::path dir = test::temp_dir();
-  std::string text = kBedScene;
-  text.replace(text.find("dt = \"auto\""), 11, "dt = \"auto\"\ntangential = \"spring\"");
-  const Scene scene = write_scene(dir, text);
+  Scene scene = bed_scene(dir);
+  scene.simulation.step.tangential = TangentialModel::Spring;
   const LammpsDeck deck = export_lammps(scene, dir / "deck");
   const PairCoefficients p = make_pair_coefficients(scene.materials[0], scene.materials[0], NormalDamping::Tsuji);
   const std::string in = read_file(deck.input);
@@ -219,9 +170,8 @@ TEST(ExportLammps, SpringFrictionBecomesMindlinWithTetrasandsStiffness) {
 
 TEST(ExportLammps, RefusesThesisDampingNamingTheScene) {
   const fs::path dir = test::temp_dir();
-  std::string text = kBedScene;
-  text.replace(text.find("dt = \"auto\""), 11, "dt = \"auto\"\nnormal_damping = \"thesis\"");
-  const Scene scene = write_scene(dir, text);
+  Scene scene = bed_scene(dir);
+  scene.simulation.step.normal_damping = NormalDamping::Thesis;
   try {
     export_lammps(scene, dir / "deck");
     FAIL() << "exported a scene with thesis damping";
@@ -234,7 +184,7 @@ TEST(ExportLammps, RefusesThesisDampingNamingTheScene) {
 
 TEST(ExportLammps, CommandWritesDeckAndFailsOnBadScene) {
   const fs::path dir = test::temp_dir();
-  write_scene(dir, kBedScene);
+  bed_scene(dir);
   std::string out;
   EXPECT_EQ(test::run_tetrasand("export lammps '" + (dir / "scene.toml").string() + "' -o '" + (dir / "d").string() + "'",
                                 &out),
@@ -254,7 +204,7 @@ TEST(ExportLammps, CommandWritesDeckAndFailsOnBadScene) {
 // gravity, friction or wall would change the packing by more.
 TEST(ExportLammps, LammpsSettlesExportedBedToTetrasandsHeight) {
   const fs::path dir = test::temp_dir();
-  const Scene scene = write_scene(dir, kBedScene);
+  const Scene scene = bed_scene(dir);
   const LammpsDeck deck = export_lammps(scene, dir / "deck");
   run_lammps(deck);
   if (HasFatalFailure()) return;
@@ -280,7 +230,7 @@ TEST(ExportLammps, LammpsSettlesExportedBedToTetrasandsHeight) {
 // gains energy in each contact and rebounds 7 % higher than LAMMPS's velocity Verlet at this dt.
 TEST(ExportLammps, LammpsBouncesExportedGrainToTetrasandsHeight) {
   const fs::path dir = test::temp_dir();
-  const Scene scene = write_scene(dir, kBounceScene);
+  const Scene scene = bounce_scene(dir);
   const LammpsDeck deck = export_lammps(scene, dir / "deck");
   run_lammps(deck);
   if (HasFatalFailure()) return;
