@@ -395,6 +395,7 @@ void CpuStepper::check_stability(const World& world, double mechanical_energy) c
 StepStats CpuStepper::step(World& world) {
   if (world.materials.size() != material_count_) reset_energy_reference(world);
   StepStats stats;
+  apply_tracks(world, world.time);  // keyframed bodies start the step on their track
   compute_forces(world, stats);
   if (settings_.tangential == TangentialModel::Spring) std::swap(world.springs, next_springs_);
   // Kinetic + potential + spring energy at the start of the step: what the contacts may only lose.
@@ -409,6 +410,7 @@ StepStats CpuStepper::step(World& world) {
     reference_pending_ = false;
   }
   integrate(world, stats);
+  apply_tracks(world, world.time + settings_.dt);  // and end it there, with the velocities of that time
   world.time += settings_.dt;
   stats.energy = energy(world);
   check_stability(world, mechanical);

@@ -190,6 +190,9 @@ void check_exportable(const Scene& scene, const World& w) {
     refuse(scene, "simulation.normal_damping = \"thesis\" has no LAMMPS equivalent (use \"tsuji\")");
   }
   if (s.angular_damping_rate > 0) refuse(scene, "simulation.angular_damping_rate has no LAMMPS equivalent");
+  if (!w.tracks.empty()) {
+    refuse(scene, "a keyframed kinematic prop (this export writes LAMMPS fix move linear/rotate, not a path)");
+  }
   for (std::size_t b = 0; b < w.bodies.size(); ++b) {
     if (w.bodies.motion[b] != MotionType::Kinematic) continue;
     if (w.bodies.linear_velocity[b].norm() > 0 && w.bodies.angular_velocity[b].norm() > 0) {

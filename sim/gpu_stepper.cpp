@@ -136,6 +136,17 @@ void GpuStepper::upload(const World& world) {
     append(momentum, l, 0.0);
     range.insert(range.end(), {b.first_particle[k], b.particle_count[k], 0u, 0u});
   }
+  // Keyframed kinematic bodies: their keys, and where they start in body_range's z and w.
+  std::vector<double> keys;
+  for (const KinematicTrack& track : world.tracks) {
+    range[4 * track.body + 2] = static_cast<std::uint32_t>(keys.size() / 8);
+    range[4 * track.body + 3] = static_cast<std::uint32_t>(track.keys.size());
+    for (const Keyframe& key : track.keys) {
+      append(keys, key.position, key.time);
+      keys.insert(keys.end(), {key.orientation.x(), key.orientation.y(), key.orientation.z(), key.orientation.w()});
+    }
+  }
+  if (keys.empty()) keys.assign(8, 0.0);  // a placeholder keeps the binding valid
   std::vector<double> local;
   std::vector<std::uint32_t> info;
   double max_radius = 0.0;
@@ -153,6 +164,7 @@ void GpuStepper::upload(const World& world) {
   body_inverse_inertia_ = real_buffer(inverse_inertia);
   body_momentum_ = real_buffer(momentum);
   body_range_ = gpu::Buffer::from<std::uint32_t>(range);
+  keyframes_ = real_buffer(keys);
   particle_local_ = real_buffer(local);
   particle_info_ = gpu::Buffer::from<std::uint32_t>(info);
   particle_position_ = gpu::Buffer(particle_count_ * 16);
@@ -247,6 +259,7 @@ void GpuStepper::bind_state() const {
   body_range_.bind(TS_SIM_BODY_RANGE);
   particle_wrench_.bind(TS_SIM_PARTICLE_WRENCH);
   springs_.bind(TS_SIM_SPRINGS);
+  keyframes_.bind(TS_SIM_KEYFRAMES);
   pairs_.bind(TS_SIM_PAIRS);
   planes_.bind(TS_SIM_PLANES);
   cylinders_.bind(TS_SIM_CYLINDERS);
@@ -269,6 +282,11 @@ void GpuStepper::step(int steps) {
     grid_.bind();
     contacts_.set("table_size", grid_.table_size());
     queue_.dispatch_items(contacts_, particle_count_);
+    if (precision_ == Precision::Double) {
+      integrate_.set_double("time_after", time_ + settings_.dt);
+    } else {
+      integrate_.set("time_after", static_cast<float>(time_ + settings_.dt));
+    }
     queue_.dispatch_items(integrate_, body_count_);
     time_ += settings_.dt;
   }
@@ -401,7 +419,7 @@ std::size_t GpuStepper::gpu_bytes() const {
   for (const gpu::Buffer* b : {&particle_position_, &particle_position_exact_, &particle_velocity_, &particle_info_,
                                &particle_local_, &body_position_, &body_orientation_, &body_velocity_, &body_omega_,
                                &body_inverse_inertia_, &body_range_, &body_momentum_, &particle_wrench_,
-                               &springs_, &pairs_, &planes_, &cylinders_, &particle_stats_buffer_})
+                               &springs_, &keyframes_, &pairs_, &planes_, &cylinders_, &particle_stats_buffer_})
     total += b->bytes();
   return total;
 }

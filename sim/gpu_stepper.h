@@ -57,7 +57,7 @@ class GpuStepper {
   gpu::HashGrid grid_;
   gpu::Buffer particle_position_, particle_position_exact_, particle_velocity_, particle_info_, particle_local_;
   gpu::Buffer body_position_, body_orientation_, body_velocity_, body_omega_, body_inverse_inertia_, body_range_;
-  gpu::Buffer body_momentum_, particle_wrench_, springs_, pairs_, planes_, cylinders_, particle_stats_buffer_;
+  gpu::Buffer body_momentum_, particle_wrench_, springs_, keyframes_, pairs_, planes_, cylinders_, particle_stats_buffer_;
   gpu::Buffer counters_, metric_partials_, stat_partials_;
   std::uint32_t particle_count_ = 0, body_count_ = 0, plane_count_ = 0, cylinder_count_ = 0, material_count_ = 0;
   double cell_size_ = 0.0;  // m: the largest particle diameter, as the CPU reference

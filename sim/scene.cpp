@@ -260,6 +260,39 @@ void read_emitter(const toml::table& t, const fs::path& file, Scene& scene) {
   scene.emitters.push_back(e);
 }
 
+// [[prop.keyframes]]: time (s), position (m) and orientation ([w, x, y, z]) of the mesh frame.
+void read_keyframes(TableReader& prop, const fs::path& file, Prop& p) {
+  const toml::node* n = prop.node("keyframes");
+  if (!n) return;
+  const toml::array* array = n->as_array();
+  if (!array || !array->is_array_of_tables()) prop.fail("keyframes", "must be [[prop.keyframes]] tables");
+  if (p.motion != MotionType::Kinematic) prop.fail("keyframes", "only a kinematic prop follows keyframes (motion = \"kinematic\")");
+  if (prop.table().contains("velocity") || prop.table().contains("angular_velocity")) {
+    prop.fail("keyframes", "a prop follows either keyframes or velocity/angular_velocity, not both");
+  }
+  if (prop.table().contains("position") || prop.table().contains("orientation")) {
+    prop.fail("keyframes", "a prop with keyframes takes its pose from them: remove position/orientation");
+  }
+  if (array->size() < 2) prop.fail("keyframes", "needs at least two keys (one pose is a static prop)");
+  for (std::size_t i = 0; i < array->size(); ++i) {
+    TableReader r(*array->get(i)->as_table(), fmt::format("prop.keyframes[{}]", i), file);
+    Keyframe k;
+    k.time = r.required_number("time");
+    if (i > 0 && !(k.time > p.keyframes.back().time)) {
+      r.fail("time", fmt::format("{} s is not after the previous key's {} s: keys must be sorted by time, each "
+                                 "time once", k.time, p.keyframes.back().time));
+    }
+    k.position = r.vector<3>("position", std::nullopt);
+    const Eigen::Vector4d q = r.vector<4>("orientation", Eigen::Vector4d(1, 0, 0, 0));
+    if (q.norm() < 1e-12) r.fail("orientation", "quaternion [w, x, y, z] must not be zero");
+    k.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+    r.reject_unknown_keys();
+    p.keyframes.push_back(k);
+  }
+  p.position = p.keyframes.front().position;
+  p.orientation = p.keyframes.front().orientation;
+}
+
 void read_prop(const toml::table& t, const fs::path& file, Scene& scene) {
   TableReader r(t, "prop", file);
   Prop p;
@@ -278,6 +311,7 @@ void read_prop(const toml::table& t, const fs::path& file, Scene& scene) {
     r.fail("velocity", "a static prop cannot move (use motion = \"kinematic\")");
   }
   p.material = material_index(r, scene, "material");
+  read_keyframes(r, file, p);
   r.reject_unknown_keys();
   scene.props.push_back(p);
 }

@@ -56,6 +56,9 @@ struct Prop {
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          // m/s (kinematic: prescribed; dynamic: initial)
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // rad/s, world frame
   std::uint16_t material = 0;
+  // Kinematic props only: poses of the mesh frame over time (instead of velocity); empty = none.
+  // Between keys the centre of mass moves on a straight line and the orientation slerps.
+  std::vector<Keyframe> keyframes;
   int line = 0;
 };
 

@@ -135,7 +135,14 @@ void add_prop(World& world, const Prop& p) {
   desc.motion = p.motion;
   desc.inverse_mass = 1.0 / body.mass;
   desc.inverse_inertia = body.inertia.inverse();
-  add_body(world, desc, offsets, std::vector<double>(offsets.size(), body.particle_radius), p.material);
+  const std::uint32_t index =
+      add_body(world, desc, offsets, std::vector<double>(offsets.size(), body.particle_radius), p.material);
+  if (p.keyframes.empty()) return;
+  // The track follows the centre of mass: each mesh-frame key moved to where it puts the centre.
+  KinematicTrack track{index, p.keyframes};
+  for (Keyframe& k : track.keys) k.position += k.orientation * body.center_of_mass;
+  world.tracks.push_back(track);
+  apply_tracks(world, 0.0);
 }
 
 void add_grains(World& world, const GrainShape& grain, std::uint16_t material, const std::vector<Eigen::Vector3d>& sites,
@@ -289,7 +296,13 @@ TimeStepBound scene_time_step_bound(const Scene& scene, const World& world) {
       z_max = std::max(z_max, e.type == EmitterType::Column ? e.centre.z() : e.max.z());
       launched = std::max(launched, e.velocity.norm());
     }
-    for (const Prop& p : scene.props) launched = std::max(launched, p.velocity.norm());
+    for (const Prop& p : scene.props) {
+      launched = std::max(launched, p.velocity.norm());
+      for (std::size_t k = 1; k < p.keyframes.size(); ++k) {  // keyframed: its fastest segment
+        const double span = p.keyframes[k].time - p.keyframes[k - 1].time;
+        launched = std::max(launched, (p.keyframes[k].position - p.keyframes[k - 1].position).norm() / span);
+      }
+    }
     speed = std::max(0.5, std::sqrt(2 * scene.gravity.norm() * (z_max - z_min)) + launched);
   }
   return time_step_bound(cases, kinds, speed);

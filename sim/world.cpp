@@ -48,6 +48,16 @@ std::uint32_t add_grain(World& world, const GrainShape& grain, std::uint16_t mat
   return add_body(world, desc, offsets, std::vector<double>(4, grain.particle_radius), material);
 }
 
+void apply_tracks(World& world, double time) {
+  for (const KinematicTrack& track : world.tracks) {
+    const KinematicState state = sample_track(track.keys, time);
+    world.bodies.position[track.body] = state.position;
+    world.bodies.orientation[track.body] = state.orientation;
+    world.bodies.linear_velocity[track.body] = state.linear_velocity;
+    world.bodies.angular_velocity[track.body] = state.angular_velocity;
+  }
+}
+
 std::vector<Eigen::Vector3d> particle_positions(const World& world) {
   std::vector<Eigen::Vector3d> out(world.particles.size());
   for (std::size_t i = 0; i < out.size(); ++i) {

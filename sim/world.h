@@ -15,12 +15,14 @@
 
 #include "sim/contact_model.h"
 #include "sim/grain.h"
+#include "sim/keyframes.h"
 
 namespace ts::sim {
 
 enum class MotionType : std::uint8_t {
   Dynamic,    // integrated from forces
-  Kinematic,  // moves with its prescribed velocity and angular velocity; forces do not affect it
+  Kinematic,  // moves with its prescribed velocity and angular velocity, or along a KinematicTrack;
+              // forces do not affect it
   Static,     // never moves (floors, rough walls)
 };
 
@@ -86,6 +88,7 @@ struct World {
   Particles particles;
   ContactSprings springs;
   Walls walls;                               // rough walls are static bodies made of particles
+  std::vector<KinematicTrack> tracks;        // keyframed kinematic bodies
   std::vector<Material> materials;
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2
   double time = 0;                           // s
@@ -111,6 +114,9 @@ std::uint32_t add_grain(World& world, const GrainShape& grain, std::uint16_t mat
                         const Eigen::Vector3d& position, const Eigen::Quaterniond& orientation,
                         const Eigen::Vector3d& linear_velocity = Eigen::Vector3d::Zero(),
                         const Eigen::Vector3d& angular_velocity = Eigen::Vector3d::Zero());
+
+// Sets every tracked body's pose and velocities to its track's at `time` (s).
+void apply_tracks(World& world, double time);
 
 // World position of every particle (m).
 std::vector<Eigen::Vector3d> particle_positions(const World& world);

@@ -99,7 +99,7 @@ TS_LAYOUT(SimSpringSlots64) {
 #define TS_SIM_BODY_VELOCITY 11      // xyz: [m/s]; w: motion type (0 dynamic, 1 kinematic, 2 static)
 #define TS_SIM_BODY_OMEGA 12         // xyz: angular velocity [rad/s] (derived from the momentum)
 #define TS_SIM_BODY_INV_INERTIA 13   // 3 vec4 per body: rows of I0^-1 (body frame) [1/(kg m^2)]; row 0 w: bounding radius [m]
-#define TS_SIM_BODY_RANGE 14         // uvec4: x first particle, y particle count
+#define TS_SIM_BODY_RANGE 14         // uvec4: x first particle, y particle count, z first keyframe, w keyframe count (0: none)
 // 2 per particle (one buffer, so the contact kernel stays within 16 storage blocks): [2i] xyz contact
 // force on the particle [N]; [2i + 1] xyz its torque about the body's centre of mass [N m].
 #define TS_SIM_PARTICLE_WRENCH 15
@@ -110,6 +110,7 @@ TS_LAYOUT(SimSpringSlots64) {
 #define TS_SIM_COUNTERS 21           // uint[]: 0 velocity clamps, 1 angular velocity clamps, 2 spring slot overflows
 #define TS_SIM_BODY_MOMENTUM 22      // xyz: angular momentum [kg m^2/s] (world frame)
 #define TS_SIM_SPRINGS 16             // SimSpringSlots (SimSpringSlots64 with TS_FP64) per particle
+#define TS_SIM_KEYFRAMES 26           // 2 real4 per key of a kinematic track (sim::Keyframe): xyz centre of mass [m], w time [s]; quaternion (x, y, z, w)
 
 // Motion types (TS_SIM_BODY_VELOCITY.w)
 #define TS_MOTION_DYNAMIC 0

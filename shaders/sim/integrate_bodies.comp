@@ -4,7 +4,8 @@
 // then integrate, mirroring CpuStepper::integrate (sim/cpu_reference.cpp). Rotation first (thesis eqs.
 // 3.47-3.50) through the angular momentum L, omega = R I0^-1 R^T L; forward Euler moves with the old
 // velocities, semi-implicit Euler with the new ones. Static bodies are skipped; kinematic bodies
-// follow their prescribed velocities. Velocity clamps (thesis 3.3.1) are counted, never silent.
+// follow their prescribed velocities or
+// their keyframes (sim/keyframes.glsl). Velocity clamps (thesis 3.3.1) are counted, never silent.
 #include "common/layouts.h"
 #include "sim/rigid.glsl"
 layout(local_size_x = 64) in;
@@ -17,6 +18,8 @@ layout(std430, binding = TS_SIM_BODY_RANGE) readonly buffer BR { uvec4 body_rang
 layout(std430, binding = TS_SIM_PARTICLE_WRENCH) readonly buffer F { real4 particle_wrench[]; };
 layout(std430, binding = TS_SIM_COUNTERS) buffer C { uint counters[]; };
 layout(std430, binding = TS_SIM_BODY_MOMENTUM) buffer BL { real4 body_momentum[]; };
+layout(std430, binding = TS_SIM_KEYFRAMES) readonly buffer K { real4 keyframes[]; };
+#include "sim/keyframes.glsl"
 
 uniform uint body_count;
 uniform real dt;                       // [s]
@@ -25,6 +28,7 @@ uniform int semi_implicit;             // 0: forward Euler (thesis), 1: semi-imp
 uniform float max_speed;               // CFL clamp: cfl * cell / dt [m/s]
 uniform float angular_damping_rate;    // [1/s], 0 = off (thesis pseudocode 4.4)
 uniform float angular_damping_speed;   // [m/s]: damp when |v| + |w| reach is below it
+uniform real time_after;               // [s]: the time this step ends at (keyframed bodies)
 
 void main() {
   uint b = gl_GlobalInvocationID.x;
@@ -33,6 +37,14 @@ void main() {
   if (motion == TS_MOTION_STATIC) return;
   real h = dt;
   real4 q = body_orientation[b];
+  if (motion == TS_MOTION_KINEMATIC && body_range[b].w > 0u) {
+    KinematicState state = sample_track(body_range[b].z, body_range[b].w, time_after);
+    body_position[b].xyz = state.position;
+    body_orientation[b] = state.orientation;
+    body_velocity[b].xyz = state.velocity;
+    body_omega[b].xyz = state.omega;
+    return;
+  }
   if (motion == TS_MOTION_KINEMATIC) {
     body_position[b].xyz += h * body_velocity[b].xyz;
     body_orientation[b] = integrate_orientation(q, body_omega[b].xyz, h);
