@@ -37,7 +37,7 @@ struct Options {
   std::uint64_t seed = 1;
   int rounds = 12, max_iterations = 2000;
   std::string sign = "pseudonormal";
-  bool json = false, timings = false, allow_open = false;
+  bool json = false, timings = false, allow_open = false, fill = false;
 };
 
 struct BatchRow {
@@ -168,6 +168,9 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::IsMember({"pseudonormal", "winding"}))
       ->capture_default_str();
   cmd->add_flag("--allow-open", o->allow_open, "Same as --sign winding (the older name)");
+  cmd->add_flag("--fill", o->fill,
+                "Also fill the inside: particles on a face-centred cubic lattice of spacing 2r wherever phi <= -r "
+                "(after the surface ones in the PLY, with normal 0 0 0)");
   cmd->add_flag("--json", o->json, "Print the body.json summary on stdout");
   cmd->add_flag("--timings", o->timings, "Per-kernel GPU times");
   auto write_preview = std::make_shared<bool>(false);
@@ -247,6 +250,7 @@ int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& 
     settings.probes = o->probes;
     settings.timings = o->timings;
     settings.relax.max_iterations = o->max_iterations;
+    settings.fill = o->fill;
 
     const bool terminal = ::isatty(STDERR_FILENO) != 0;
     const auto progress = [&](const sampler::SampleProgress& p) {
@@ -271,9 +275,14 @@ int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& 
       fmt::print("{}\n", nlohmann::json::parse(in).dump(o->batch ? -1 : 2));  // a batch prints JSON Lines
     } else {
       fmt::print("{} -> {}\n", o->mesh, json.string());
-      fmt::print("  particles        {} of radius {:.6g} m (area estimate {}, {:+.1f} %)\n", body.positions.size(),
+      const std::size_t surface = body.positions.size() - body.interior_count;
+      fmt::print("  particles        {} of radius {:.6g} m on the surface (area estimate {}, {:+.1f} %)\n", surface,
                  body.particle_radius, result.estimated_count,
-                 100.0 * (static_cast<double>(body.positions.size()) / static_cast<double>(result.estimated_count) - 1.0));
+                 100.0 * (static_cast<double>(surface) / static_cast<double>(result.estimated_count) - 1.0));
+      if (o->fill) {
+        fmt::print("  interior         {} on an FCC lattice of spacing 2r (estimate from V - A r: {:.0f}); {} in all\n",
+                   body.interior_count, result.estimated_interior, body.positions.size());
+      }
       fmt::print("  evenness         relative radius {:.3f}, CV of nearest-neighbour distances {:.3f}\n",
                  q.relative_radius, q.cv);
       fmt::print("  coverage         covering radius {:.6g} m = {:.3f} r{}\n", q.covering_radius, q.covering_over_r,

@@ -249,6 +249,7 @@ Json body_json(const ParticleBody& body, const std::string& ply_name) {
   j["source"] = {{"path", body.source_path}, {"sha256", body.source_sha256}};
   j["particle_radius"] = body.particle_radius;
   j["particle_count"] = body.positions.size();
+  j["interior_particle_count"] = body.interior_count;
   j["particles"] = ply_name;
   j["density"] = body.density;
   j["mass"] = body.mass;
@@ -412,6 +413,18 @@ void check_particles(const Fields& f, const ParticleBody& b) {
   if (!b.normals.empty() && b.normals.size() != b.positions.size()) {
     f.fail("particles", fmt::format("{} normals for {} particles", b.normals.size(), b.positions.size()));
   }
+  if (b.interior_count > b.positions.size()) {
+    f.fail("interior_particle_count", fmt::format("{} for {} particles", b.interior_count, b.positions.size()));
+  }
+  // Interior particles are the last ones and carry the zero normal, surface ones a non-zero one.
+  for (std::size_t i = 0; i < b.normals.size(); ++i) {
+    const bool interior = i >= b.positions.size() - b.interior_count;
+    if (interior != (b.normals[i] == Eigen::Vector3f::Zero())) {
+      f.fail("interior_particle_count",
+             fmt::format("{} interior particles, but particle {} has {} normal", b.interior_count, i,
+                         interior ? "a non-zero" : "a zero"));
+    }
+  }
 }
 
 void validate_for_writing(const fs::path& json_path, const ParticleBody& b) {
@@ -518,7 +531,10 @@ ParticleBody read_body(const fs::path& json_path) {
   std::vector<std::string> keys = {"format_version", "units", "source", "particle_radius", "particle_count",
                                    "particles", "density", "mass", "volume", "center_of_mass", "inertia",
                                    "principal_moments", "principal_axes", "sdf_voxel_size", "quality"};
-  if (version >= 2) keys.insert(keys.end() - 2, {"mass_properties_method", "mass_properties_cell"});
+  if (version >= 2) {
+    keys.insert(keys.begin() + 5, "interior_particle_count");
+    keys.insert(keys.end() - 2, {"mass_properties_method", "mass_properties_cell"});
+  }
   const Fields f(json_path, j, "", keys);
   f.count("format_version");
   read_units(json_path, f.at("units"));
@@ -529,6 +545,7 @@ ParticleBody read_body(const fs::path& json_path) {
   if (!is_sha256(b.source_sha256)) source.fail("sha256", "must be 64 lowercase hex digits");
   b.particle_radius = f.positive("particle_radius");
   const std::int64_t count = f.count("particle_count");
+  const std::int64_t interior = version >= 2 ? f.count("interior_particle_count") : 0;
   const fs::path ply = f.string("particles");
   if (ply.empty() || ply.is_absolute()) f.fail("particles", "must be a PLY file name relative to the body file");
   b.density = f.positive("density");
@@ -556,6 +573,8 @@ ParticleBody read_body(const fs::path& json_path) {
   ParticlesPly particles = read_particles_ply(json_path.parent_path() / ply);
   b.positions = std::move(particles.positions);
   b.normals = std::move(particles.normals);
+  if (interior > count) f.fail("interior_particle_count", fmt::format("{} is more than particle_count {}", interior, count));
+  b.interior_count = static_cast<std::size_t>(interior);
   if (static_cast<std::uint64_t>(count) != b.positions.size()) {
     f.fail("particle_count", fmt::format("{} but {} holds {} particles", count, ply.string(), b.positions.size()));
   }

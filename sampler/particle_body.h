@@ -12,8 +12,8 @@
 
 namespace ts::sampler {
 
-// Version 2 added mass_properties_method and mass_properties_cell; version 1 files are still read
-// (their mass properties came from the closed mesh).
+// Version 2 added interior_particle_count, mass_properties_method and mass_properties_cell; version
+// 1 files are still read (surface particles only, mass properties from the closed mesh).
 inline constexpr int kBodyFormatVersion = 2;
 
 // Where a body's mass properties come from (body.json `mass_properties_method`).
@@ -26,6 +26,7 @@ const char* mass_method_name(MassMethod method);
 struct ParticleBody {
   std::vector<Eigen::Vector3f> positions;  // m, mesh coordinates (they overlay the mesh)
   std::vector<Eigen::Vector3f> normals;    // unit outward surface normals, one per particle, or none
+  std::size_t interior_count = 0;          // the last ones are interior particles (--fill), normal (0, 0, 0)
   double particle_radius = 0.0;            // m
   double density = 0.0;                    // kg/m^3, of the solid the mesh encloses
   double mass = 0.0;                       // kg

@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mass_properties.h"
+#include "sampler/interior_fill.h"
 #include "sampler/point_grid.h"
 #include "sampler/sampling_quality.h"
 #include "sampler/surface_points.h"
@@ -72,6 +73,21 @@ void check_sizes(const Sizing& z, const SampleSettings& s, double area) {
                                  "fits is {:.4g} m",
                                  z.radius, z.count, s.max_particles, s.max_particles, s.max_particles, smallest));
   }
+}
+
+// With --fill the interior lattice grows as r^-3 against the surface's r^-2: the cap names the
+// smallest radius whose filled body fits (found by bisection on the scale of r). The interior is
+// counted as the whole volume's lattice points, an upper bound.
+void check_filled_size(const Sizing& z, const MassProperties& mass, std::size_t cap) {
+  const double interior = mass.volume * interior_lattice_density(z.radius);
+  const auto total = [&](double scale) { return static_cast<double>(z.count) / (scale * scale) + interior / (scale * scale * scale); };
+  if (total(1.0) <= static_cast<double>(cap)) return;
+  double lo = 1.0, hi = 2.0;
+  while (total(hi) > static_cast<double>(cap)) hi *= 2.0;
+  for (int i = 0; i < 60; ++i) (total(0.5 * (lo + hi)) > static_cast<double>(cap) ? lo : hi) = 0.5 * (lo + hi);
+  throw InputError(fmt::format("--fill at radius {:.4g} m adds about {:.0f} interior particles to {} on the surface, "
+                               "above the cap of {}; the smallest radius whose filled body fits is {:.4g} m",
+                               z.radius, interior, z.count, cap, z.radius * hi));
 }
 
 // The SDF grid: voxel r / 2 unless the user set one; grown while the dense texture would exceed the
@@ -216,6 +232,7 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   if (settings.mass_method == MassMethod::ClosedMesh) mass = compute_mass_properties(mesh, settings.density);
   const Sizing z = size_particles(area, settings);
   check_sizes(z, settings, area);
+  if (settings.fill && mass) check_filled_size(z, *mass, settings.max_particles);
   result.estimated_count = z.count;
 
   // 1. SDF, kept on the GPU as a dense texture.
@@ -233,6 +250,10 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
     const WindingSolid solid = winding_mass_properties(mesh, exact, settings.density, settings.mass_cell);
     mass = solid.mass;
     mass_cell = solid.cell;
+  }
+  if (settings.fill && settings.mass_method == MassMethod::WindingCells) check_filled_size(z, *mass, settings.max_particles);
+  if (settings.fill) {
+    result.estimated_interior = std::max(mass->volume - area * z.radius, 0.0) * interior_lattice_density(z.radius);
   }
 
   // 2. Seeds.
@@ -322,6 +343,16 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   for (std::size_t i = 0; i < particles.size(); ++i) {
     body.positions.push_back(particles[i].cast<float>());
     body.normals.push_back(particle_normals[i].cast<float>());
+  }
+  if (settings.fill) {
+    // Surface quality figures above are of the surface layer alone.
+    const std::vector<Eigen::Vector3d> interior = fill_interior(exact, bounding_box(mesh), mass->center_of_mass, z.radius,
+                                                               settings.sign);
+    for (const auto& p : interior) {
+      body.positions.push_back(p.cast<float>());
+      body.normals.push_back(Eigen::Vector3f::Zero());
+    }
+    body.interior_count = interior.size();
   }
   body.particle_radius = z.radius;
   set_mass_properties(body, *mass);

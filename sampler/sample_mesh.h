@@ -41,6 +41,9 @@ struct SampleSettings {
   // winding-number solid (octree, sampler/winding_solid.h) when the mesh encloses no volume by itself.
   MassMethod mass_method = MassMethod::ClosedMesh;
   double mass_cell = 0.0;              // finest octree cell of MassMethod::WindingCells [m]; 0: longest side / 128
+  // Also interior particles on a lattice (sampler/interior_fill.h: FCC, spacing 2 r, centres at
+  // phi <= -r), appended after the surface ones with zero normals. Default: surface only.
+  bool fill = false;
   bool timings = false;
   RelaxSettings relax;                 // spacing and band are filled in from the radius
 };
@@ -60,7 +63,8 @@ struct ThinFeatures {
 struct SampleResult {
   ParticleBody body;
   ThinFeatures thin;
-  std::size_t estimated_count = 0;  // from the area and the coverage target
+  std::size_t estimated_count = 0;  // surface particles, from the area and the coverage target
+  double estimated_interior = 0.0;  // with `fill`: lattice points in V(phi <= -r) ~ V - A r, / (4 sqrt(2) r^3)
   std::vector<std::string> warnings;
   std::string timing_report;
 };

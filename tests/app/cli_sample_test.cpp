@@ -45,6 +45,11 @@ std::vector<std::vector<std::string>> read_csv(const std::filesystem::path& path
   return rows;
 }
 
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 std::set<std::string> files_in(const std::filesystem::path& dir) {
   std::set<std::string> names;
   for (const auto& e : std::filesystem::directory_iterator(dir)) names.insert(e.path().filename().string());
@@ -87,6 +92,20 @@ TEST(CliSample, JsonPrintsTheBodyAndOnlyFinishedFilesRemain) {
   EXPECT_GE(json.at("particle_count").get<int>(), 140);
   EXPECT_TRUE(json.at("quality").contains("covering_over_r"));
   EXPECT_EQ(files_in(dir), (std::set<std::string>{"sphere.body.json", "sphere.particles.ply"}));
+}
+
+TEST(CliSample, FillCountsTheInteriorParticlesInTheJsonAndThePly) {
+  const auto dir = test::temp_dir();
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("-q sample " + quoted(test::asset("sphere.obj")) + " -o " + quoted(dir) + kFast + "--fill --json", &out),
+            0)
+      << out;
+  const auto json = nlohmann::json::parse(out.substr(out.find('{')));
+  const int interior = json.at("interior_particle_count").get<int>();
+  EXPECT_GT(interior, 10);  // 19 measured for 150 surface particles (r about 7.6 mm in a 5 cm ball)
+  const std::string ply = read_text(dir / "sphere.particles.ply");
+  EXPECT_NE(ply.find("element vertex " + std::to_string(json.at("particle_count").get<int>()) + "\n"), std::string::npos);
+  EXPECT_GE(json.at("particle_count").get<int>(), interior + 140);
 }
 
 TEST(CliSample, BatchWritesASummaryAndAFailureDoesNotStopIt) {

@@ -201,6 +201,20 @@ TEST(ParticleBody, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(read_body(json3).mass_method, MassMethod::WindingCells);
   EXPECT_EQ(read_body(json3).mass_cell, 0.004);
 
+  // Interior particles (--fill): the last ones, with zero normals, counted in the JSON.
+  ParticleBody filled = body;
+  for (int i = 0; i < 7; ++i) {
+    filled.positions.emplace_back(0.1f * static_cast<float>(i), 0.5f, 0.25f);
+    filled.normals.push_back(Eigen::Vector3f::Zero());
+  }
+  filled.interior_count = 7;
+  const fs::path json4 = write_body(dir, "filled", filled);
+  EXPECT_EQ(nlohmann::json::parse(read_file(json4))["interior_particle_count"], 7);
+  EXPECT_EQ(nlohmann::json::parse(read_file(json4))["particle_count"], 307);
+  const ParticleBody filled_back = read_body(json4);
+  EXPECT_EQ(filled_back.interior_count, 7u);
+  EXPECT_EQ(filled_back.positions, filled.positions);
+
   // Without a grain radius the grain-relative covering ratio is null, and reads back as absent.
   ParticleBody no_grain = body;
   no_grain.quality.covering_over_r_plus_grain.reset();
@@ -216,7 +230,7 @@ TEST(ParticleBody, JsonHasExactlyTheDocumentedKeys) {
   for (const auto& item : j.items()) keys.push_back(item.key());
   for (const auto& item : j["quality"].items()) quality_keys.push_back(item.key());
   EXPECT_EQ(keys, (std::vector<std::string>{"format_version", "units", "source", "particle_radius", "particle_count",
-                                            "particles", "density", "mass", "volume", "center_of_mass", "inertia",
+                                            "interior_particle_count", "particles", "density", "mass", "volume", "center_of_mass", "inertia",
                                             "principal_moments", "principal_axes", "mass_properties_method",
                                             "mass_properties_cell", "sdf_voxel_size", "quality"}));
   EXPECT_EQ(quality_keys, (std::vector<std::string>{"relative_radius", "cv", "covering_radius", "covering_over_r",
@@ -254,8 +268,12 @@ TEST(ParticleBody, ValidationErrorsNameTheFileAndTheKey) {
             std::string::npos);
   EXPECT_NE(error_after([](auto& j) { j["mass_properties_cell"] = 0.1; }).find(prefix + "mass_properties_cell: must be null"),
             std::string::npos);
-  // Version 1 has no mass_properties_* keys.
-  EXPECT_NE(error_after([](auto& j) { j["format_version"] = 1; }).find(prefix + "mass_properties_method: unknown key"),
+  EXPECT_NE(error_after([](auto& j) { j["interior_particle_count"] = 3; }).find(prefix + "interior_particle_count: 3 interior particles, but particle 297 has a non-zero normal"),
+            std::string::npos);
+  EXPECT_NE(error_after([](auto& j) { j["interior_particle_count"] = 301; }).find(prefix + "interior_particle_count: 301 is more than"),
+            std::string::npos);
+  // Version 1 has no interior_particle_count or mass_properties_* keys.
+  EXPECT_NE(error_after([](auto& j) { j["format_version"] = 1; }).find(prefix + "interior_particle_count: unknown key"),
             std::string::npos);
   EXPECT_NE(error_after([](auto& j) { j["units"]["length"] = "mm"; }).find(prefix + "units.length: must be \"m\""),
             std::string::npos);
@@ -279,6 +297,7 @@ TEST(ParticleBody, VersionOneFilesAreStillRead) {
   const fs::path json = write_body(dir, "box", box_body());
   auto j = nlohmann::ordered_json::parse(read_file(json));
   j["format_version"] = 1;
+  j.erase("interior_particle_count");
   j.erase("mass_properties_method");
   j.erase("mass_properties_cell");
   write_text(json, j.dump(2));

@@ -8,11 +8,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "core/error.h"
 #include "core/mass_properties.h"
 #include "core/mesh_io.h"
+#include "sampler/point_grid.h"
 #include "sampler/sampling_quality.h"
 #include "sdf/exact_sdf.h"
 #include "tests/test_support.h"
@@ -140,6 +142,77 @@ TEST(SampleMesh, OpenMeshWithWindingSignsStaysOnTheSurfaceWithTheClosedMassPrope
   EXPECT_DOUBLE_EQ(body.mass, settings.density * body.volume);
 }
 
+// --fill: interior particles on the FCC lattice of spacing 2 r (sampler/interior_fill.h), kept where
+// phi <= -r. Checked independently: none outside or closer than r to the surface, none closer than
+// r to a surface particle, none closer than 2 r to each other, zero normals, and the count.
+void expect_a_valid_fill(const TriangleMesh& mesh, const SampleResult& result) {
+  const ParticleBody& body = result.body;
+  const double r = body.particle_radius;
+  const std::size_t surface = body.positions.size() - body.interior_count;
+  ASSERT_GT(body.interior_count, 0u);
+  std::vector<Eigen::Vector3d> outer, inner;
+  for (std::size_t i = 0; i < body.positions.size(); ++i) {
+    (i < surface ? outer : inner).push_back(body.positions[i].cast<double>());
+    if (i < surface) {
+      EXPECT_NEAR(body.normals[i].norm(), 1.0f, 1e-4f) << i;
+    } else {
+      EXPECT_EQ(body.normals[i], Eigen::Vector3f::Zero()) << i;
+    }
+  }
+  const sdf::ExactDistance exact(mesh);
+  const PointGrid surface_grid(outer, r), inner_grid(inner, 2.0 * r);
+  double deepest_shallow = -1e300, nearest_surface = 1e300, nearest_inner = 1e300;
+  for (std::size_t i = 0; i < inner.size(); ++i) {
+    deepest_shallow = std::max(deepest_shallow, exact.signed_distance(inner[i], sdf::SignMethod::Pseudonormal) / r);
+    nearest_surface = std::min(nearest_surface, surface_grid.nearest(inner[i]).distance / r);
+    nearest_inner = std::min(nearest_inner, inner_grid.nearest(inner[i], i).distance / r);
+  }
+  EXPECT_LE(deepest_shallow, -1.0 + 1e-6);  // float positions: phi <= -r up to rounding
+  EXPECT_GE(nearest_surface, 1.0 - 1e-5);
+  EXPECT_NEAR(nearest_inner, 2.0, 1e-5);
+}
+
+TEST(SampleMesh, FillPutsInteriorParticlesOnALatticeInsideTheSphere) {
+  const TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));
+  SampleSettings settings;
+  settings.count = 600;
+  settings.probes = 200'000;
+  settings.fill = true;
+  const SampleResult result = sample_mesh(shared_context(), mesh, settings);
+  expect_a_valid_fill(mesh, result);
+  // Lattice estimate of the inner ball of radius R - r (R from the mesh's volume).
+  const double r = result.body.particle_radius;
+  const double big = std::cbrt(3.0 * compute_mass_properties(mesh, 1.0).volume / (4.0 * M_PI));
+  const double estimate = 4.0 / 3.0 * M_PI * std::pow(big - r, 3) / (4.0 * std::sqrt(2.0) * r * r * r);
+  std::printf("sphere: %zu interior particles, ball estimate %.1f, V - A r estimate %.1f\n", result.body.interior_count,
+              estimate, result.estimated_interior);
+  EXPECT_NEAR(static_cast<double>(result.body.interior_count), estimate, 0.05 * estimate);
+  EXPECT_NEAR(result.estimated_interior, estimate, 0.15 * estimate);
+  // The quality figures are of the surface layer alone.
+  EXPECT_GE(result.body.quality.relative_radius, 0.7);
+}
+
+TEST(SampleMesh, FillOfTheCubeHoldsExactlyTheLatticePointsOfTheInnerCube) {
+  const TriangleMesh mesh = load_mesh(test::asset("cube.obj"));  // side 0.1 m, centred at 0
+  SampleSettings settings;
+  settings.count = 1500;
+  settings.probes = 200'000;
+  settings.fill = true;
+  const SampleResult result = sample_mesh(shared_context(), mesh, settings);
+  expect_a_valid_fill(mesh, result);
+  // FCC points (i, j, k) * a / 2 with i + j + k even, a = 2 sqrt(2) r, origin at the centre: those in
+  // the inner cube of half-side 0.05 - r.
+  const double r = result.body.particle_radius, half_step = std::sqrt(2.0) * r;
+  const int m = static_cast<int>(std::floor((0.05 - r) / half_step));
+  std::size_t expected = 0;
+  for (int i = -m; i <= m; ++i)
+    for (int j = -m; j <= m; ++j)
+      for (int k = -m; k <= m; ++k) expected += (i + j + k) % 2 == 0 ? 1 : 0;
+  std::printf("cube: %zu interior particles, %zu lattice points in the inner cube, V - A r estimate %.1f\n",
+              result.body.interior_count, expected, result.estimated_interior);
+  EXPECT_EQ(result.body.interior_count, expected);
+}
+
 TEST(SampleMesh, IsDeterministicForAFixedSeed) {
   const TriangleMesh mesh = load_mesh(test::asset("torus.obj"));
   SampleSettings settings;
@@ -196,6 +269,22 @@ TEST(SampleMesh, CountOverTheMemoryCapNamesTheLargestThatFits) {
     const std::string what = e.what();
     EXPECT_NE(what.find("cap of 1000"), std::string::npos) << what;
     EXPECT_NE(what.find("smallest radius that fits"), std::string::npos) << what;
+  }
+}
+
+TEST(SampleMesh, FillOverTheMemoryCapNamesTheSmallestRadiusThatFits) {
+  const TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));
+  SampleSettings settings;
+  settings.count = 300;
+  settings.max_particles = 400;  // the surface fits, the filled body (about 470) does not
+  settings.fill = true;
+  try {
+    sample_mesh(shared_context(), mesh, settings);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cap of 400"), std::string::npos) << what;
+    EXPECT_NE(what.find("smallest radius whose filled body fits"), std::string::npos) << what;
   }
 }
 
