@@ -1,5 +1,7 @@
 #include "bench/bench_scenes.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -37,6 +39,16 @@ sim::World settling_box(std::uint32_t grains, std::uint64_t seed) {
                         {Eigen::Vector3d(width, 0, 0), -Eigen::Vector3d::UnitX(), 0},
                         {Eigen::Vector3d(0, width, 0), -Eigen::Vector3d::UnitY(), 0}};
   return world;
+}
+
+std::string grain_centres_csv(const sim::World& world) {
+  std::string csv = "x_m,y_m,z_m\n";
+  for (std::size_t b = 0; b < world.bodies.size(); ++b) {
+    if (world.bodies.motion[b] != sim::MotionType::Dynamic) continue;
+    const Eigen::Vector3d& x = world.bodies.position[b];
+    csv += fmt::format("{:.6e},{:.6e},{:.6e}\n", x.x(), x.y(), x.z());
+  }
+  return csv;
 }
 
 BenchWorld settle(const sim::Scene& scene) {

@@ -19,6 +19,9 @@ std::filesystem::path reference_scene(const std::string& name);
 // walls, falling under gravity: the workload of a pour that is settling.
 sim::World settling_box(std::uint32_t grains, std::uint64_t seed);
 
+// The dynamic bodies' centres as CSV "x_m,y_m,z_m" (the heap files that the Python reports measure).
+std::string grain_centres_csv(const sim::World& world);
+
 // A world with the step settings it runs with (dt resolved from the scene).
 struct BenchWorld {
   sim::World world;

@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
-# Usage: scripts/bench.sh [sim|peers-sim|validation|sdf|all] [--build-dir DIR] [--no-build] [--grains LIST] [--cases 'MESH@R1,R2 ...']
+# Usage: scripts/bench.sh [sim|sim-accuracy|peers-sim|validation|sdf|all] [--build-dir DIR] [--no-build] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #   sim         Cundall number (grain-steps/s) of the GPU pipeline and the CPU reference on the same
 #               settled beds, 1k to 1M grains (--grains 1000,8000 for fewer), memory per grain
 #               -> the Cundall table and plot in section sim of docs/benchmarks.md      (~8 min, 2 cores)
+#   sim-accuracy  E, dt and precision (CPU reference, GPU float, GPU double) against largest overlap,
+#               energy drift (no-dissipation box) and angle of repose (150-grain heap)
+#               -> the accuracy table and plots in section sim of docs/benchmarks.md   (~15 min, 2 cores)
 #   peers-sim   tetrasand (CPU reference, GPU pipeline) against LAMMPS on the same scenes, one run:
 #               grain-steps/s as ratios, settled bed height, rebound, angle of repose
 #               -> section peers-sim of docs/benchmarks.md                              (~5 min, 2 cores)
@@ -34,7 +37,7 @@ while [ $# -gt 0 ]; do
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in sim|peers-sim|validation|sdf|all) ;; *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;; esac
+case "$what" in sim|sim-accuracy|peers-sim|validation|sdf|all) ;; *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;; esac
 
 # The bench's own packages (not needed to build or test): LAMMPS, numpy, matplotlib.
 bench_packages=(lammps openmpi-bin python3-numpy python3-matplotlib)
@@ -64,6 +67,11 @@ if [ "$what" = sim ] || [ "$what" = all ]; then
   "$bin/tetrasand_bench_sim" --grains "$grains" --csv "$work/sim.csv"
   "$py" "$root/bench/plot_sim.py" "$work/sim.csv" "$root/docs" "scripts/bench.sh sim --grains $grains"
   echo "bench: wrote the Cundall table of docs/benchmarks.md and docs/benchmarks/sim_cundall.png"
+fi
+if [ "$what" = sim-accuracy ] || [ "$what" = all ]; then
+  "$bin/tetrasand_bench_sim_accuracy" "$work/sim-accuracy" all
+  "$py" "$root/bench/plot_sim_accuracy.py" "$work/sim-accuracy" "$root/docs"
+  echo "bench: wrote the accuracy table of docs/benchmarks.md and docs/benchmarks/sim_accuracy_*.png"
 fi
 if [ "$what" = peers-sim ] || [ "$what" = all ]; then
   "$py" "$root/bench/peers/sim_peers.py" "$bin" "$work/peers-sim" --markdown "$root/docs/benchmarks.md" || status=1
