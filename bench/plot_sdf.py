@@ -32,7 +32,7 @@ def main(csv_path, png_path):
         ax.set_xlabel("time [s]")
         ax.set_ylabel(f"{stat} |d - exact| [voxels]")
         ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=7, loc="center right")
+    axes[0].legend(fontsize=7, loc="center left")
     fig.suptitle("SDF construction: error against exact distance versus time")
     fig.tight_layout()
     fig.savefig(png_path, dpi=120)
