@@ -10,8 +10,9 @@
 #   peers-sim   tetrasand (CPU reference, GPU pipeline) against LAMMPS on the same scenes, one run:
 #               grain-steps/s as ratios, settled bed height, rebound, angle of repose
 #               -> section peers-sim of docs/benchmarks.md                              (~5 min, 2 cores)
-#   validation  restitution, angle of repose, silo discharge (Beverloo), contact-force distribution
-#               -> docs/validation.md and docs/validation/*.png                         (~8 min, 2 cores)
+#   validation  restitution, angle of repose, silo discharge (Beverloo), contact-force distribution,
+#               column collapse, GPU pipeline against CPU reference (heap, silo, bed)
+#               -> docs/validation.md and docs/validation/*.png   (~15 min CPU runs + ~30 min GPU runs on llvmpipe)
 #   sdf         SDF construction three ways per mesh and grid in one run: GPU scan conversion, CPU exact
 #               (CGAL, all cores), OpenVDB meshToLevelSet (all cores), errors against exact; default
 #               knot1, armadillo (libcgal-demo) and a 1.3M-triangle icosphere:8 at 64^3..1024^3
