@@ -46,6 +46,10 @@ struct StepSettings {
   // spring energy then + M |g| d_max) while no work is done on the system.
   bool check_energy = true;
   double energy_growth_tolerance = 0.5;
+  // GPU pipeline only: every this many steps the bodies are re-sorted by the cell of their centre
+  // (Morton order), so neighbours sit near each other in memory; 0 = never. Results stay
+  // deterministic; forces change only by the order of float sums.
+  std::int64_t resort_every = 100;
 };
 
 struct StepStats {

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "core/error.h"
@@ -84,7 +85,15 @@ GpuStepper::GpuStepper(gpu::Context& context, const World& world, const StepSett
       integrate_(gpu::Program::compute(library_, "sim/integrate_bodies.comp", precision_defines(precision))),
       metrics_(gpu::Program::compute(library_, "sim/reduce_metrics.comp", precision_defines(precision))),
       particle_stats_(gpu::Program::compute(library_, "sim/reduce_particle_stats.comp")),
-      grid_(library_) {
+      grid_(library_),
+      resort_keys_(gpu::Program::compute(library_, "sim/resort_keys.comp", precision_defines(precision))),
+      resort_ranges_(gpu::Program::compute(library_, "sim/resort_ranges.comp")),
+      resort_particles_(gpu::Program::compute(library_, "sim/resort_particles.comp")),
+      resort_fixup_(gpu::Program::compute(library_, "sim/resort_fixup.comp", precision_defines(precision))),
+      gather_rows_(gpu::Program::compute(library_, "sim/gather_rows.comp")),
+      bucket_scatter_(gpu::Program::compute(library_, "common/grid_scatter.comp")),
+      bucket_sort_(gpu::Program::compute(library_, "common/grid_sort_cells.comp")),
+      resort_scan_(library_) {
   upload(world);
 }
 
@@ -172,6 +181,7 @@ void GpuStepper::upload(const World& world) {
   particle_velocity_ = gpu::Buffer(particle_count_ * 4 * real_size);
   particle_wrench_ = gpu::Buffer(particle_count_ * 8 * real_size);
   upload_springs(world);
+  allocate_resort(body_count_, particle_count_);
   particle_stats_buffer_ = gpu::Buffer(particle_count_ * 16);
   counters_ = gpu::Buffer(4 * sizeof(std::uint32_t));
   counters_.fill_zero();
@@ -275,6 +285,8 @@ void GpuStepper::step(int steps) {
     return;
   }
   for (int s = 0; s < steps; ++s) {
+    if (settings_.resort_every > 0 && steps_since_resort_ >= settings_.resort_every) resort();
+    ++steps_since_resort_;
     bind_state();
     queue_.dispatch_items(update_, particle_count_);
     grid_.build(queue_, particle_position_, particle_count_, static_cast<float>(cell_size_));
@@ -340,12 +352,14 @@ void GpuStepper::download(World& world) const {
   const auto orientation = read_real(body_orientation_, 4 * body_count_);
   const auto velocity = read_real(body_velocity_, 4 * body_count_);
   const auto omega = read_real(body_omega_, 4 * body_count_);
+  const std::vector<std::uint32_t> original = original_ids(original_body_, body_count_);
   for (std::uint32_t k = 0; k < body_count_; ++k) {
-    b.position[k] = {position[4 * k], position[4 * k + 1], position[4 * k + 2]};
-    b.orientation[k] = Eigen::Quaterniond(orientation[4 * k + 3], orientation[4 * k], orientation[4 * k + 1],
+    const std::uint32_t w = original[k];
+    b.position[w] = {position[4 * k], position[4 * k + 1], position[4 * k + 2]};
+    b.orientation[w] = Eigen::Quaterniond(orientation[4 * k + 3], orientation[4 * k], orientation[4 * k + 1],
                                           orientation[4 * k + 2]);
-    b.linear_velocity[k] = {velocity[4 * k], velocity[4 * k + 1], velocity[4 * k + 2]};
-    b.angular_velocity[k] = {omega[4 * k], omega[4 * k + 1], omega[4 * k + 2]};
+    b.linear_velocity[w] = {velocity[4 * k], velocity[4 * k + 1], velocity[4 * k + 2]};
+    b.angular_velocity[w] = {omega[4 * k], omega[4 * k + 1], omega[4 * k + 2]};
   }
   world.time = time_;
   download_springs(world);
@@ -372,18 +386,23 @@ static std::vector<Slots> pack_springs(const World& world, std::size_t particles
   return out;
 }
 
+// GPU slots back into world order: `original` maps GPU particle ids (slot owners and partners) to the
+// world's.
 template <typename Slots>
-static void unpack_springs(const std::vector<Slots>& slots, World& world) {
+static void unpack_springs(const std::vector<Slots>& slots, const std::vector<std::uint32_t>& original,
+                           World& world) {
   constexpr std::size_t K = ContactSprings::kSlots;
   world.springs.partner.assign(slots.size() * K, ContactSprings::kNoPartner);
   world.springs.displacement.assign(slots.size() * K, Eigen::Vector3d::Zero());
   for (std::size_t i = 0; i < slots.size(); ++i) {
+    const std::size_t owner = original[i];
     for (std::size_t s = 0; s < K; ++s) {
       const std::int32_t partner = (&slots[i].partner[s / 4].x)[s % 4];
       if (partner == TS_SIM_NO_PARTNER) continue;
-      world.springs.partner[i * K + s] = partner;
+      world.springs.partner[owner * K + s] = partner >= 0 ? std::int64_t{original[static_cast<std::size_t>(partner)]}
+                                                          : std::int64_t{partner};
       const auto& d = slots[i].displacement[s];
-      world.springs.displacement[i * K + s] = {d.x, d.y, d.z};
+      world.springs.displacement[owner * K + s] = {d.x, d.y, d.z};
     }
   }
 }
@@ -400,18 +419,134 @@ void GpuStepper::upload_springs(const World& world) {
 
 void GpuStepper::download_springs(World& world) const {
   if (settings_.tangential != TangentialModel::Spring) return;
+  const std::vector<std::uint32_t> original = original_ids(original_particle_, particle_count_);
   if (precision_ == Precision::Double) {
-    unpack_springs(springs_.read<SimSpringSlots64>(particle_count_), world);
+    unpack_springs(springs_.read<SimSpringSlots64>(particle_count_), original, world);
   } else {
-    unpack_springs(springs_.read<SimSpringSlots>(particle_count_), world);
+    unpack_springs(springs_.read<SimSpringSlots>(particle_count_), original, world);
   }
 }
 
 std::vector<Eigen::Vector3d> GpuStepper::particle_forces() const {
   const auto values = read_real(particle_wrench_, 8 * particle_count_);
   std::vector<Eigen::Vector3d> out(particle_count_);
-  for (std::uint32_t i = 0; i < particle_count_; ++i) out[i] = {values[8 * i], values[8 * i + 1], values[8 * i + 2]};
+  const std::vector<std::uint32_t> original = original_ids(original_particle_, particle_count_);
+  for (std::uint32_t i = 0; i < particle_count_; ++i) {
+    out[original[i]] = {values[8 * i], values[8 * i + 1], values[8 * i + 2]};
+  }
   return out;
+}
+
+// ---- Re-sorting bodies by cell (memory locality of the neighbour gathers).
+
+void GpuStepper::allocate_resort(std::uint32_t body_count, std::uint32_t particle_count) {
+  const std::uint32_t bodies = std::max(body_count, 1u), particles = std::max(particle_count, 1u);
+  bucket_table_ = std::bit_ceil(std::max(2u * bodies, 64u));
+  const std::size_t word = sizeof(std::uint32_t);
+  sort_key_ = gpu::Buffer(bodies * word);
+  sort_slot_ = gpu::Buffer(bodies * word);
+  order_ = gpu::Buffer(bodies * word);
+  new_first_ = gpu::Buffer(bodies * word);
+  new_range_ = gpu::Buffer(bodies * 4 * word);
+  bucket_count_ = gpu::Buffer(bucket_table_ * word);
+  bucket_start_ = gpu::Buffer(bucket_table_ * word);
+  source_particle_ = gpu::Buffer(particles * word);
+  new_of_old_ = gpu::Buffer(particles * word);
+  owner_ = gpu::Buffer(particles * word);
+  // The world order, as uvec4 rows (x) so gather() moves them like every other array.
+  auto identity = [](std::uint32_t n) {
+    std::vector<std::uint32_t> ids(4 * std::size_t{n}, 0u);
+    for (std::uint32_t i = 0; i < n; ++i) ids[4 * i] = i;
+    return gpu::Buffer::from<std::uint32_t>(ids);
+  };
+  original_body_ = identity(bodies);
+  original_particle_ = identity(particles);
+  steps_since_resort_ = 0;
+}
+
+std::vector<std::uint32_t> GpuStepper::original_ids(const gpu::Buffer& ids, std::uint32_t count) const {
+  const auto rows = ids.read<std::uint32_t>(4 * std::size_t{count});
+  std::vector<std::uint32_t> out(count);
+  for (std::uint32_t i = 0; i < count; ++i) out[i] = rows[4 * i];
+  return out;
+}
+
+void GpuStepper::gather(gpu::Buffer& buffer, const gpu::Buffer& index, std::uint32_t rows, std::uint32_t width) {
+  gpu::Buffer reordered(buffer.bytes());
+  buffer.bind(1);
+  reordered.bind(2);
+  index.bind(3);
+  gather_rows_.set("rows", rows);
+  gather_rows_.set("width", width);
+  queue_.dispatch_items(gather_rows_, rows);
+  buffer = std::move(reordered);
+}
+
+void GpuStepper::resort() {
+  steps_since_resort_ = 0;
+  if (body_count_ < 2) return;
+  // The new body order: counting sort by Morton key, ids ascending within a key (deterministic).
+  bucket_count_.fill_zero();
+  body_position_.bind(TS_SIM_BODY_POSITION);
+  sort_key_.bind(1);
+  bucket_count_.bind(2);
+  sort_slot_.bind(3);
+  resort_keys_.set("body_count", body_count_);
+  resort_keys_.set("cell_size", static_cast<float>(cell_size_));
+  resort_keys_.set("table_size", bucket_table_);
+  queue_.dispatch_items(resort_keys_, body_count_);
+  glCopyNamedBufferSubData(bucket_count_.id(), bucket_start_.id(), 0, 0,
+                           static_cast<GLsizeiptr>(bucket_table_ * sizeof(std::uint32_t)));
+  resort_scan_.run(queue_, bucket_start_, bucket_table_);
+  sort_key_.bind(1);
+  bucket_count_.bind(2);
+  sort_slot_.bind(3);
+  bucket_start_.bind(4);
+  order_.bind(5);
+  bucket_scatter_.set("count", body_count_);
+  queue_.dispatch_items(bucket_scatter_, body_count_);
+  bucket_sort_.set("table_size", bucket_table_);
+  queue_.dispatch_items(bucket_sort_, bucket_table_);
+
+  // New particle ranges (a scan of the counts in the new order) and the particle maps.
+  order_.bind(5);
+  body_range_.bind(TS_SIM_BODY_RANGE);
+  new_first_.bind(6);
+  resort_ranges_.set("body_count", body_count_);
+  queue_.dispatch_items(resort_ranges_, body_count_);
+  resort_scan_.run(queue_, new_first_, body_count_);
+  order_.bind(5);
+  new_first_.bind(6);
+  body_range_.bind(TS_SIM_BODY_RANGE);
+  new_range_.bind(1);
+  source_particle_.bind(2);
+  new_of_old_.bind(3);
+  owner_.bind(4);
+  resort_particles_.set("body_count", body_count_);
+  queue_.dispatch_items(resort_particles_, body_count_);
+  std::swap(body_range_, new_range_);
+
+  // Every persistent array follows (per-step scratch such as forces is recomputed anyway).
+  const std::uint32_t r4 = precision_ == Precision::Double ? 2 : 1;  // 16-byte words per real4
+  for (gpu::Buffer* b : {&body_position_, &body_orientation_, &body_velocity_, &body_omega_, &body_momentum_})
+    gather(*b, order_, body_count_, r4);
+  gather(body_inverse_inertia_, order_, body_count_, 3 * r4);
+  gather(original_body_, order_, body_count_, 1);
+  gather(particle_info_, source_particle_, particle_count_, 1);
+  gather(particle_local_, source_particle_, particle_count_, r4);
+  gather(original_particle_, source_particle_, particle_count_, 1);
+  const bool springs = settings_.tangential == TangentialModel::Spring;
+  if (springs) {
+    const std::uint32_t words = precision_ == Precision::Double ? sizeof(SimSpringSlots64) / 16 : sizeof(SimSpringSlots) / 16;
+    gather(springs_, source_particle_, particle_count_, words);
+  }
+  particle_info_.bind(TS_SIM_PARTICLE_INFO);
+  new_of_old_.bind(3);
+  owner_.bind(4);
+  springs_.bind(TS_SIM_SPRINGS);
+  resort_fixup_.set("particle_count", particle_count_);
+  resort_fixup_.set("spring_model", springs ? 1 : 0);
+  queue_.dispatch_items(resort_fixup_, particle_count_);
 }
 
 std::size_t GpuStepper::gpu_bytes() const {

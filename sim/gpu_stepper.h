@@ -34,11 +34,14 @@ class GpuStepper {
   // Bodies' positions, orientations and velocities back into `world` (its time advanced too), and
   // with the spring tangential model the contact springs.
   void download(World& world) const;
-  // Per-particle contact force [N] of the last step (for tests against the CPU reference).
+  // Per-particle contact force [N] of the last step, in world particle order (for tests against the
+  // CPU reference).
   std::vector<Eigen::Vector3d> particle_forces() const;
   double time() const { return time_; }
   std::string timing_report() { return queue_.timing_report(); }
   std::size_t gpu_bytes() const;
+  // The world index of each body in GPU memory order (identity until the first re-sort).
+  std::vector<std::uint32_t> body_order() const { return original_ids(original_body_, body_count_); }
 
  private:
   template <typename T>
@@ -47,6 +50,13 @@ class GpuStepper {
   void bind_state() const;
   void upload_springs(const World& world);
   void download_springs(World& world) const;
+  void allocate_resort(std::uint32_t body_count, std::uint32_t particle_count);
+  // Re-sorts bodies (and their particles, springs renamed) by the cell of their centre.
+  void resort();
+  // buffer = its rows reordered: row r takes old row index[r]; rows of `width` 16-byte words.
+  void gather(gpu::Buffer& buffer, const gpu::Buffer& index, std::uint32_t rows, std::uint32_t width);
+  // World index of each GPU body and particle (identity until the first re-sort).
+  std::vector<std::uint32_t> original_ids(const gpu::Buffer& ids, std::uint32_t count) const;
 
   gpu::Context& context_;
   StepSettings settings_;
@@ -59,6 +69,14 @@ class GpuStepper {
   gpu::Buffer body_position_, body_orientation_, body_velocity_, body_omega_, body_inverse_inertia_, body_range_;
   gpu::Buffer body_momentum_, particle_wrench_, springs_, keyframes_, pairs_, planes_, cylinders_, particle_stats_buffer_;
   gpu::Buffer counters_, metric_partials_, stat_partials_;
+  // Re-sorting (see StepSettings::resort_every).
+  gpu::Program resort_keys_, resort_ranges_, resort_particles_, resort_fixup_, gather_rows_, bucket_scatter_,
+      bucket_sort_;
+  gpu::PrefixScan resort_scan_;
+  gpu::Buffer sort_key_, sort_slot_, bucket_count_, bucket_start_, order_, new_first_, new_range_;
+  gpu::Buffer source_particle_, new_of_old_, owner_, original_body_, original_particle_;
+  std::uint32_t bucket_table_ = 0;
+  std::int64_t steps_since_resort_ = 0;
   std::uint32_t particle_count_ = 0, body_count_ = 0, plane_count_ = 0, cylinder_count_ = 0, material_count_ = 0;
   double cell_size_ = 0.0;  // m: the largest particle diameter, as the CPU reference
   double time_ = 0.0;

@@ -378,6 +378,7 @@ void read_simulation(TableReader& root, const fs::path& file, Scene& scene) {
   s.step.thesis_reference_speed = r.positive("thesis_reference_speed", s.step.thesis_reference_speed);
   s.step.integrator = static_cast<Integrator>(r.choice("integrator", {"euler", "symplectic"}, 0));
   s.step.tangential = static_cast<TangentialModel>(r.choice("tangential", {"viscous", "spring"}, 0));
+  s.step.resort_every = r.integer("resort_every", s.step.resort_every, 0);
   s.step.cfl = r.non_negative("cfl", s.step.cfl);
   s.step.max_overlap_ratio = r.non_negative("max_overlap_ratio", s.step.max_overlap_ratio);
   s.step.angular_damping_rate = r.non_negative("angular_damping_rate", 0.0);

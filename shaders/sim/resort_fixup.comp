@@ -1,0 +1,27 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Re-sort, pass 5, per new particle: its owner is the body's new index, and its springs name their
+// partner particles by their new ids (walls and free slots unchanged).
+#include "common/layouts.h"
+#include "sim/precision.glsl"
+layout(local_size_x = 128) in;
+layout(std430, binding = TS_SIM_PARTICLE_INFO) buffer I { uvec4 particle_info[]; };
+layout(std430, binding = 3) readonly buffer Destination { uint new_of_old[]; };
+layout(std430, binding = 4) readonly buffer Owner { uint owner[]; };
+#ifdef TS_FP64
+layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots64 springs[]; };
+#else
+layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots springs[]; };
+#endif
+uniform uint particle_count;
+uniform int spring_model;
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= particle_count) return;
+  particle_info[i].x = owner[i];
+  if (spring_model == 0) return;
+  for (uint s = 0u; s < TS_SIM_SPRING_SLOTS; ++s) {
+    int partner = springs[i].partner[s / 4u][s % 4u];
+    if (partner >= 0 && partner != TS_SIM_NO_PARTNER) springs[i].partner[s / 4u][s % 4u] = int(new_of_old[partner]);
+  }
+}
