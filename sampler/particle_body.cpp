@@ -508,8 +508,18 @@ fs::path write_body(const fs::path& dir, const std::string& name, const Particle
   const std::string ply_name = name + ".particles.ply";
   const fs::path json_path = dir / (name + ".body.json");
   validate_for_writing(json_path, body);
-  write_particles_ply(dir / ply_name, body.positions, body.normals);
-  write_file_atomically(json_path, body_json(body, ply_name).dump(2) + "\n");
+  // Replaced only as a whole: the JSON is written to its temporary file first, then the PLY is
+  // written and renamed into place, then the JSON. Any failure before that last rename (disk full, a
+  // directory in the way, an interrupted write) leaves the previous pair as it was and removes the
+  // temporary files; and a reader that finds the new JSON finds the PLY it names.
+  const std::string json_text = body_json(body, ply_name).dump(2) + "\n";
+  write_atomically(json_path, [&](const fs::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(json_text.data(), static_cast<std::streamsize>(json_text.size()));
+    out.close();
+    if (!out) throw InputError(json_path, "cannot write file (disk full or no permission?)");
+    write_particles_ply(dir / ply_name, body.positions, body.normals);
+  });
   return json_path;
 }
 

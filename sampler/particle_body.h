@@ -74,8 +74,9 @@ void write_particles_ply(const std::filesystem::path& path, const std::vector<Ei
 // truncated data, non-finite values.
 ParticlesPly read_particles_ply(const std::filesystem::path& path);
 
-// Writes DIR/NAME.particles.ply, then DIR/NAME.body.json, each atomically: a reader that finds the
-// JSON always finds the PLY it names. Creates DIR. Returns the JSON's path.
+// Writes DIR/NAME.particles.ply, then DIR/NAME.body.json, each atomically, the JSON staged in its
+// temporary file before the PLY is replaced: a failure leaves a previous pair whole, and a reader
+// that finds the JSON always finds the PLY it names. Creates DIR. Returns the JSON's path.
 std::filesystem::path write_body(const std::filesystem::path& dir, const std::string& name, const ParticleBody& body);
 
 // Reads and validates NAME.body.json and the PLY it names. Errors are ts::InputError

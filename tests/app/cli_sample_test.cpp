@@ -3,7 +3,13 @@
 // failures that do not stop the batch). Small counts and probe sets: the quality figures themselves
 // are checked in tests/sampler/sample_mesh_test.cpp.
 #include <gtest/gtest.h>
+#include <pty.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -54,6 +60,119 @@ std::set<std::string> files_in(const std::filesystem::path& dir) {
   std::set<std::string> names;
   for (const auto& e : std::filesystem::directory_iterator(dir)) names.insert(e.path().filename().string());
   return names;
+}
+
+// Runs `tetrasand ARGS` with stdout and stderr on a pseudo-terminal; returns the exit code and
+// what the terminal showed.
+int run_on_a_terminal(const std::vector<std::string>& args, std::string* shown) {
+  int master = -1;
+  const pid_t pid = ::forkpty(&master, nullptr, nullptr, nullptr);
+  if (pid < 0) throw std::runtime_error("forkpty failed");
+  if (pid == 0) {
+    std::vector<char*> argv{const_cast<char*>(TETRASAND_BINARY)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(TETRASAND_BINARY, argv.data());
+    ::_exit(127);
+  }
+  char buffer[4096];
+  for (;;) {
+    const ssize_t n = ::read(master, buffer, sizeof buffer);
+    if (n > 0) shown->append(buffer, static_cast<std::size_t>(n));
+    else if (n < 0 && errno == EINTR) continue;
+    else break;  // EIO once the child has closed the terminal
+  }
+  ::close(master);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+// Runs a shell command whose files may grow to `max_bytes` at most; writing past that fails with
+// EFBIG (SIGXFSZ is ignored), as on a full disk.
+int run_with_file_size_limit(const std::string& command, rlim_t max_bytes, const std::filesystem::path& log,
+                             std::string* output) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{max_bytes, max_bytes};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on chains of + with literals.
+    std::string line = command;
+    line.append(" >'");
+    line.append(log.string());
+    line.append("' 2>&1");
+    ::execl("/bin/sh", "sh", "-c", line.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  *output = read_text(log);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+TEST(CliSample, ProgressBarShowsOnATerminalAndNotInAPipe) {
+  const auto dir = test::temp_dir();
+  const std::vector<std::string> args = {"sample", test::asset("sphere.obj").string(), "-o", dir.string(), "--count",
+                                         "150", "--probes", "20000", "--rounds", "2"};
+  std::string shown;
+  ASSERT_EQ(run_on_a_terminal(args, &shown), 0) << shown;
+  // A line redrawn in place (carriage returns) with the iteration, particle count and residual.
+  const std::size_t bar = shown.find("\rround 0  iteration ");
+  ASSERT_NE(bar, std::string::npos) << shown;
+  const std::string line = shown.substr(bar + 1, shown.find('\r', bar + 1) - bar - 1);
+  EXPECT_NE(line.find("  particles "), std::string::npos) << line;
+  EXPECT_NE(line.find("  residual "), std::string::npos) << line;
+  EXPECT_NE(shown.find("evenness"), std::string::npos) << shown;  // and the summary after it
+
+  std::string piped;
+  std::string command = "sample";
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    command.push_back(' ');
+    command.append(quoted(std::filesystem::path(args[i])));
+  }
+  ASSERT_EQ(test::run_tetrasand(command, &piped), 0) << piped;
+  EXPECT_EQ(piped.find('\r'), std::string::npos) << piped;
+  EXPECT_EQ(piped.find("residual"), std::string::npos) << piped;
+  EXPECT_NE(piped.find("evenness"), std::string::npos) << piped;
+}
+
+// "An existing output is replaced only as a whole": runs that fail (bad options; the disk filling
+// up while the JSON is written) leave the previous PLY and JSON byte for byte and no temporary file;
+// a successful rerun replaces both.
+TEST(CliSample, AFailedRunLeavesThePreviousBodyWholeAndARerunReplacesIt) {
+  const auto dir = test::temp_dir();
+  // A long mesh path makes the JSON (which records it) larger than the PLY, so a file size limit
+  // between the two lets the PLY through and stops the JSON.
+  std::filesystem::path deep = dir;
+  for (int i = 0; i < 15; ++i) deep /= std::string(240, static_cast<char>('a' + i));
+  std::filesystem::create_directories(deep);
+  const auto mesh = deep / "sphere.obj";
+  std::filesystem::copy_file(test::asset("sphere.obj"), mesh);
+  const auto out = dir / "out";
+  const std::string base = "sample " + quoted(mesh) + " -o " + quoted(out) + kFast;
+  std::string log;
+  ASSERT_EQ(test::run_tetrasand(base, &log), 0) << log;
+  const std::string ply = read_text(out / "sphere.particles.ply"), json = read_text(out / "sphere.body.json");
+  ASSERT_GT(json.size(), ply.size() + 1000) << "the JSON must be the larger file";
+  const std::set<std::string> pair = {"sphere.body.json", "sphere.particles.ply"};
+
+  EXPECT_NE(test::run_tetrasand(base + "--radius 1", &log), 0) << log;  // refused: radius too large
+  EXPECT_EQ(read_text(out / "sphere.particles.ply"), ply);
+  EXPECT_EQ(read_text(out / "sphere.body.json"), json);
+
+  const rlim_t limit = (ply.size() + json.size()) / 2;
+  const std::string command = "MESA_SHADER_CACHE_DISABLE=true '" + std::string(TETRASAND_BINARY) + "' " + base + "--seed 5";
+  EXPECT_NE(run_with_file_size_limit(command, limit, dir / "limited.log", &log), 0) << log;
+  EXPECT_NE(log.find("cannot write"), std::string::npos) << log;
+  EXPECT_EQ(read_text(out / "sphere.particles.ply"), ply) << "the PLY was replaced without its JSON";
+  EXPECT_EQ(read_text(out / "sphere.body.json"), json);
+  EXPECT_EQ(files_in(out), pair) << "temporary files left behind";
+
+  ASSERT_EQ(test::run_tetrasand(base + "--seed 5", &log), 0) << log;
+  EXPECT_NE(read_text(out / "sphere.particles.ply"), ply);
+  EXPECT_NE(read_text(out / "sphere.body.json"), json);
+  EXPECT_EQ(files_in(out), pair);
 }
 
 TEST(CliSample, OpenMeshIsRefusedWithTheInfoReport) {
