@@ -14,6 +14,22 @@
 #include "sim/scene_runner.h"
 
 namespace ts::app {
+namespace {
+
+// Hands run_scene a stepper it may destroy while the GPU stepper itself (and its kernel timings)
+// lives on in the command for the report at the end.
+class BorrowedStepper : public sim::Stepper {
+ public:
+  explicit BorrowedStepper(sim::Stepper& stepper) : stepper_(stepper) {}
+  void load(const sim::World& world) override { stepper_.load(world); }
+  sim::StepStats advance(sim::World& world, std::int64_t steps) override { return stepper_.advance(world, steps); }
+  std::vector<sim::ContactRecord> contacts(const sim::World& world) override { return stepper_.contacts(world); }
+
+ private:
+  sim::Stepper& stepper_;
+};
+
+}  // namespace
 
 Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
   auto* cmd = app.add_subcommand("sim", "Run a tetrahedral-grain DEM scene (TOML) on the GPU");
@@ -38,7 +54,7 @@ Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
     sim::Scene scene = sim::load_scene(o->scene);
     if (o->duration > 0) scene.simulation.duration = o->duration;
     std::unique_ptr<gpu::Context> context;
-    sim::GpuPipelineStepper* gpu_stepper = nullptr;
+    std::unique_ptr<sim::GpuPipelineStepper> gpu_stepper;
     std::function<std::unique_ptr<sim::Stepper>(const sim::StepSettings&)> make_stepper;
     if (!o->cpu) {
       gpu::ContextOptions options;
@@ -46,10 +62,9 @@ Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
       options.debug = global.gl_debug;
       context = std::make_unique<gpu::Context>(options);
       make_stepper = [&](const sim::StepSettings& settings) -> std::unique_ptr<sim::Stepper> {
-        auto stepper = std::make_unique<sim::GpuPipelineStepper>(
+        gpu_stepper = std::make_unique<sim::GpuPipelineStepper>(
             *context, settings, o->precision == "double" ? sim::Precision::Double : sim::Precision::Float, o->timings);
-        gpu_stepper = stepper.get();
-        return stepper;
+        return std::make_unique<BorrowedStepper>(*gpu_stepper);
       };
     }
     const bool terminal = ::isatty(STDERR_FILENO) != 0;
