@@ -125,3 +125,33 @@ every = 10
 
 }  // namespace
 }  // namespace ts::sim
+
+namespace ts::sim {
+namespace {
+
+// `tetrasand sim --timings` on the GPU with the spring model: the run finishes (the kernel report
+// used to read a destroyed stepper), reports the spring slots, and metrics.csv has their column.
+TEST(SimCommand, GpuRunWithSpringsAndTimingsReportsBoth) {
+  std::ifstream in(test::asset("scenes/two_grain_collision.toml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string scene = text.str();
+  const std::size_t at = scene.find("[simulation]");
+  ASSERT_NE(at, std::string::npos);
+  scene.insert(at + std::string("[simulation]").size(), "\ntangential = \"spring\"");
+  const std::filesystem::path dir = test::temp_dir();
+  write_file_atomically(dir / "springs.toml", scene);
+  std::string output;
+  const int code = test::run_tetrasand(
+      fmt::format("sim '{}' -o '{}' --timings", (dir / "springs.toml").string(), (dir / "out").string()), &output);
+  EXPECT_EQ(code, 0) << output;
+  EXPECT_NE(output.find("sim/contact_forces.comp"), std::string::npos) << output;
+  EXPECT_NE(output.find("spring slots: 0 overflows"), std::string::npos) << output;
+  std::ifstream csv(dir / "out" / "metrics.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find(",spring_overflows"), std::string::npos) << header;
+}
+
+}  // namespace
+}  // namespace ts::sim
