@@ -9,9 +9,29 @@ with r the radius tetrasand chose for that count (so c / r <= 1 means the sphere
 the surface), and the largest distance of a sample from the mesh (Open3D unsigned distance).
 
 Usage: bench/sample_bench.py --tetrasand build-test/bin/tetrasand [--counts 1000 10000] [--meshes ...]
+       [--csv OUT.csv] [--no-trade | --no-compare] [--trade trefoil cube --trade-count 1000
+       --trade-rounds 0 1 3 12 --trade-iterations 100 2000]
+--csv writes every row (kind = compare or trade) for bench/plot_sample.py.
 Installs Debian's python3-open3d when it is missing (root only), as the peers note says.
 """
-import argparse, json, os, platform, shutil, subprocess, sys, tarfile, tempfile, time
+import argparse, csv, json, os, platform, shutil, subprocess, sys, tarfile, tempfile, time
+
+CSV_FIELDS = ["kind", "mesh", "requested", "n", "tool", "rounds", "max_iterations", "iterations", "injection_rounds",
+              "seconds", "rho", "cv", "c_over_r", "c_over_dhex", "phi_over_r"]
+
+
+class CsvOut:
+    """Rows appended and flushed as they come, so a long run that is stopped keeps what it measured."""
+    def __init__(self, path):
+        self.file = open(path, "w", newline="") if path else None
+        self.writer = csv.DictWriter(self.file, CSV_FIELDS, extrasaction="ignore") if path else None
+        if self.writer:
+            self.writer.writeheader()
+
+    def row(self, **values):
+        if self.writer:
+            self.writer.writerow(values)
+            self.file.flush()
 
 
 def ensure_open3d():
@@ -77,6 +97,8 @@ def renderer(exe):
 def resolve_mesh(name, tmp):
     if os.path.exists(name):
         return name
+    if os.path.exists(f"assets/{name}.obj"):
+        return f"assets/{name}.obj"
     member = f"data/meshes/{name}.off"
     with tarfile.open("/usr/share/doc/libcgal-dev/data.tar.gz") as tar:
         tar.extract(member, tmp)
@@ -91,8 +113,16 @@ def main():
     ap.add_argument("--large", nargs="*", default=["assets/bunny.obj", "knot1"], help="meshes also run at --large-count")
     ap.add_argument("--large-count", type=int, default=10000)
     ap.add_argument("--probes", type=int, default=1_000_000)
-    ap.add_argument("--trade", default="knot1", help="mesh for the rounds-vs-quality trade")
+    ap.add_argument("--trade", nargs="*", default=["trefoil"], help="meshes for the sampler's own trade")
+    ap.add_argument("--trade-count", type=int, default=1000)
+    ap.add_argument("--trade-rounds", nargs="+", type=int, default=[0, 1, 3, 12])
+    ap.add_argument("--trade-iterations", nargs="+", type=int, default=[2000],
+                    help="--max-iterations of the relaxation (needs a tetrasand that has the option)")
+    ap.add_argument("--no-compare", action="store_true", help="only the trade")
+    ap.add_argument("--no-trade", action="store_true", help="only the comparison with Open3D")
+    ap.add_argument("--csv", help="also write every row to this CSV")
     args = ap.parse_args()
+    out = CsvOut(args.csv)
     ensure_open3d()
     import numpy as np
     import open3d as o3d
@@ -100,10 +130,11 @@ def main():
     tmp = tempfile.mkdtemp(prefix="sample_bench_")
     print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores; GL: {renderer(args.tetrasand)}")
     print(f"Open3D {o3d.__version__}; probes per figure: {args.probes}\n")
-    print("| mesh | N | tool | time s | ratio | rho | CV | c / r | c / d_hex | max phi / r |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
-    jobs = [(m, n) for m in args.meshes for n in args.counts]
-    jobs += [(m, args.large_count) for m in args.large]
+    jobs = [] if args.no_compare else [(m, n) for m in args.meshes for n in args.counts]
+    jobs += [] if args.no_compare else [(m, args.large_count) for m in args.large]
+    if jobs:
+        print("| mesh | N | tool | time s | ratio | rho | CV | c / r | c / d_hex | max phi / r |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
     for name, count in jobs:
         path = resolve_mesh(name, tmp)
         mesh = o3d.io.read_triangle_mesh(path)
@@ -118,19 +149,31 @@ def main():
             q = quality(pts, mesh, probes, r)
             print(f"| {label} | {q['n']} | {tool} | {secs:.2f} | {secs / t_theirs:.2f} | {q['rho']:.3f} | {q['cv']:.3f} | "
                   f"{q['c_over_r']:.3f} | {q['c_over_dhex']:.3f} | {q['phi_over_r']:.1e} |", flush=True)
+            out.row(kind="compare", mesh=label, requested=count, tool=tool, seconds=secs, **q,
+                    iterations=body["quality"]["iterations"] if tool == "tetrasand" else "",
+                    injection_rounds=body["quality"]["injection_rounds"] if tool == "tetrasand" else "")
 
-    path = resolve_mesh(args.trade, tmp)
-    mesh = o3d.io.read_triangle_mesh(path)
-    probes = np.asarray(mesh.sample_points_uniformly(args.probes).points)
-    print(f"\nSampler trade on {os.path.basename(path)}, {args.counts[0]} particles requested:\n")
-    print("| rounds | N | iterations | time s | rho | CV | c / r |")
-    print("|---|---|---|---|---|---|---|")
-    for rounds in (0, 1, 3, 12):
-        body, ours, secs = run_tetrasand(args.tetrasand, path, args.counts[0], os.path.join(tmp, "trade"),
-                                         ["--rounds", str(rounds)])
-        q = quality(ours, mesh, probes, body["particle_radius"])
-        print(f"| {rounds} | {q['n']} | {body['quality']['iterations']} | {secs:.2f} | {q['rho']:.3f} | {q['cv']:.3f} | "
-              f"{q['c_over_r']:.3f} |", flush=True)
+    for name in [] if args.no_trade else args.trade:
+        path = resolve_mesh(name, tmp)
+        mesh = o3d.io.read_triangle_mesh(path)
+        probes = np.asarray(mesh.sample_points_uniformly(args.probes).points)
+        label = os.path.splitext(os.path.basename(path))[0]
+        print(f"\nSampler trade on {label}, {args.trade_count} particles requested:\n")
+        print("| rounds | max iterations | N | iterations | injection rounds | time s | rho | CV | c / r |")
+        print("|---|---|---|---|---|---|---|---|---|")
+        for iterations in args.trade_iterations:
+            for rounds in args.trade_rounds:
+                extra = ["--rounds", str(rounds)]
+                if iterations != 2000:
+                    extra += ["--max-iterations", str(iterations)]
+                body, ours, secs = run_tetrasand(args.tetrasand, path, args.trade_count, os.path.join(tmp, "trade"), extra)
+                q = quality(ours, mesh, probes, body["particle_radius"])
+                bq = body["quality"]
+                print(f"| {rounds} | {iterations} | {q['n']} | {bq['iterations']} | {bq['injection_rounds']} | {secs:.2f} | "
+                      f"{q['rho']:.3f} | {q['cv']:.3f} | {q['c_over_r']:.3f} |", flush=True)
+                out.row(kind="trade", mesh=label, requested=args.trade_count, tool="tetrasand", rounds=rounds,
+                        max_iterations=iterations, iterations=bq["iterations"], injection_rounds=bq["injection_rounds"],
+                        seconds=secs, **q)
     shutil.rmtree(tmp, ignore_errors=True)
 
 
