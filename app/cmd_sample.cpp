@@ -36,6 +36,7 @@ struct Options {
   std::size_t count = 0, probes = 1'000'000;
   std::uint64_t seed = 1;
   int rounds = 12, max_iterations = 2000;
+  std::size_t sdf_budget_mib = 1024;
   std::string sign = "pseudonormal";
   bool json = false, timings = false, allow_open = false, fill = false;
 };
@@ -161,6 +162,11 @@ Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--max-iterations", o->max_iterations, "Most relaxation steps of the first relaxation (later rounds: 200)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_option("--sdf-budget-mib", o->sdf_budget_mib,
+                  "GPU memory for the dense SDF texture [MiB]; past it the voxel grows beyond r / 2 (with a warning), "
+                  "which coarsens very large counts: raise it on GPUs with more memory")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_option("--sign", o->sign,
                   "Inside/outside by pseudonormals (closed meshes only) or by the generalised winding number "
                   "(also open or non-manifold meshes: they are sampled with a warning, their mass properties "
@@ -251,6 +257,7 @@ int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& 
     settings.timings = o->timings;
     settings.relax.max_iterations = o->max_iterations;
     settings.fill = o->fill;
+    settings.max_sdf_bytes = o->sdf_budget_mib << 20;
 
     const bool terminal = ::isatty(STDERR_FILENO) != 0;
     const auto progress = [&](const sampler::SampleProgress& p) {

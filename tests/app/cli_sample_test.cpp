@@ -227,6 +227,29 @@ TEST(CliSample, FillCountsTheInteriorParticlesInTheJsonAndThePly) {
   EXPECT_GE(json.at("particle_count").get<int>(), interior + 140);
 }
 
+TEST(CliSample, SdfBudgetBoundsTheTextureAndAnExplicitVoxelPastItIsRefused) {
+  const std::string sphere = quoted(test::asset("sphere.obj"));
+  {  // a fine voxel on a 10 cm sphere needs about 200^3 voxels x 16 B = 120 MiB: refused under 8 MiB
+    const auto dir = test::temp_dir();
+    std::string out;
+    EXPECT_EQ(test::run_tetrasand("sample " + sphere + " -o " + quoted(dir) + kFast + "--voxel 0.0005 --sdf-budget-mib 8", &out),
+              1)
+        << out;
+    EXPECT_NE(out.find("above the budget of 8 MiB"), std::string::npos) << out;
+    EXPECT_TRUE(files_in(dir).empty());
+  }
+  {  // the automatic voxel grows to fit instead, and says so
+    const auto dir = test::temp_dir();
+    std::string out;
+    ASSERT_EQ(test::run_tetrasand("sample " + sphere + " -o " + quoted(dir) + " --count 600 --probes 20000 --rounds 2 --sdf-budget-mib 1 --json", &out),
+              0)
+        << out;
+    EXPECT_NE(out.find("to fit the 1 MiB texture budget"), std::string::npos) << out;
+    const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
+    EXPECT_GT(json.at("sdf_voxel_size").get<double>(), json.at("particle_radius").get<double>() / 2.0);
+  }
+}
+
 TEST(CliSample, BatchWritesASummaryAndAFailureDoesNotStopIt) {
   const auto dir = test::temp_dir();
   const auto list = dir / "meshes.txt";
