@@ -266,3 +266,18 @@ material = "sand"
 
 }  // namespace
 }  // namespace ts::sim
+
+namespace ts::sim {
+namespace {
+
+TEST(Scene, ResortPeriodIsReadAndMustNotBeNegative) {
+  const std::string base = std::string(kMinimal) + "\n[simulation]\n";
+  EXPECT_EQ(parse_scene(base + "resort_every = 25\n", "scene.toml").simulation.step.resort_every, 25);
+  EXPECT_EQ(parse_scene(base, "scene.toml").simulation.step.resort_every, 100);  // the default
+  EXPECT_NE(parse_error(base + "resort_every = -1\n").find("scene.toml:15: simulation.resort_every: must be >= 0"),
+            std::string::npos)
+      << parse_error(base + "resort_every = -1\n");
+}
+
+}  // namespace
+}  // namespace ts::sim
