@@ -43,6 +43,14 @@ double resolve_time_step(const Scene& scene, const World& world, std::string* wa
               "integrator = \"symplectic\" is accurate at the automatic step",
               scene.file.string(), bound.contact_duration / dt);
   }
+  // The tangential spring is undamped but for gamma_s, so forward Euler pumps it the same way: a
+  // 300-grain pile poured with springs came out at 6.3 degrees, 14.7 with symplectic Euler.
+  if (scene.simulation.step.integrator == Integrator::ForwardEuler &&
+      scene.simulation.step.tangential == TangentialModel::Spring) {
+    log::warn("{}: tangential = \"spring\" with forward Euler gains energy in every tangential oscillation "
+              "(poured piles come out far too flat); use integrator = \"symplectic\"",
+              scene.file.string());
+  }
   if (scene.simulation.dt <= 0) return bound.recommended;
   const std::string message = check_time_step(scene.simulation.dt, bound);
   if (warning) *warning = message;

@@ -155,8 +155,10 @@ TEST(GranularPhysics, PouredPileAngleOfReposeRisesWithFriction) {
 struct Creep {
   double largest = 0, mean = 0, angle_before = 0, angle_after = 0;
 };
-Creep creep_of_settled_pile(TangentialModel tangential, double seconds) {
-  const Scene scene = pile_scene(0.5, 300, 1.6, tangential);
+Creep creep_of_settled_pile(TangentialModel tangential, double seconds,
+                            Integrator integrator = Integrator::ForwardEuler) {
+  Scene scene = pile_scene(0.5, 300, 1.6, tangential);
+  scene.simulation.step.integrator = integrator;
   World w = run_to_end(scene).world;
   const World settled = w;
   StepSettings settings = scene.simulation.step;
@@ -179,15 +181,17 @@ Creep creep_of_settled_pile(TangentialModel tangential, double seconds) {
 // the settled pile's grains move less than 2 % of a radius on average over a further second, and the
 // slope keeps its angle. (The thesis's viscous friction, eq. 3.28, cannot: measured on this pile,
 // the grains creep 0.4 radii per second and the slope falls from 19.5 to 16 degrees in a second.)
+// Symplectic Euler: forward Euler gains energy in every oscillation of the undamped tangential spring
+// as it does in the normal one, and the pile it pours is a pancake (6.3 degrees measured, against
+// 14.7 with symplectic Euler on the same pour; the run warns about that pairing).
 TEST(GranularPhysics, SettledPileWithStaticFrictionStaysAtRest) {
-  const Creep c = creep_of_settled_pile(TangentialModel::Spring, 1.0);
+  const Creep c = creep_of_settled_pile(TangentialModel::Spring, 1.0, Integrator::SemiImplicitEuler);
   EXPECT_LT(c.mean, 0.02);
   EXPECT_LT(c.largest, 0.5);
   EXPECT_NEAR(c.angle_after, c.angle_before, 0.5);
-  // A heap, not a pancake: measured 6.3 degrees since the contact springs survive the pour emitter's
-  // additions (14.2 degrees while every addition reset them, so the grains poured with almost no
-  // springs); flatter than the viscous heap's 19.5, which is not understood yet.
-  EXPECT_GT(c.angle_before, 5.0);
+  // A heap, not a pancake. Still flatter than the viscous heap (19.5 degrees forward, 22.6 symplectic
+  // measured on this pour): the springs' elastic rebound during the pour is the suspect, not settled.
+  EXPECT_GT(c.angle_before, 10.0);
 }
 
 // A flat-bottomed slot silo (quasi-2D, 3 volume-equivalent grain diameters d thick): 20 cm (12.5 d)
