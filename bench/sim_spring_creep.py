@@ -21,44 +21,10 @@ DT = 1.5e-4    # s, below the automatic bound of this scene
 SETTLE = 1.6   # s
 WATCH = 1.0    # s
 
-SCENE = """
-[[material]]
-name = "sand"
-E = 1.0e6
-nu = 0.3
-restitution = 0.5
-mu = 0.5
-gamma_s = 2.0
-density = 2600.0
-
-[grain]
-radius = 5.0e-3
-material = "sand"
-
-[[emitter]]
-type = "pour"
-min = [-0.04, -0.04, 0.05]
-max = [0.04, 0.04, 0.22]
-count = 300
-rate = 400.0
-velocity = [0.0, 0.0, -0.5]
-seed = 11
-
-[[boundary]]
-type = "plane"
-rough = true
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-size = [0.3, 0.3]
-particle_radius = 5.0e-3
-material = "sand"
-
-[[boundary]]
-type = "plane"
-point = [0.0, 0.0, -0.01]
-normal = [0.0, 0.0, 1.0]
-material = "sand"
-
+# The coarse pile shared with tests/sim/granular_physics_test.cpp; this script sets its own
+# [simulation] and [output] (a longer run at a fixed dt, symplectic Euler, one friction model).
+REFERENCE = pathlib.Path(__file__).resolve().parents[1] / "assets" / "scenes" / "reference" / "coarse_pile.toml"
+RUN = """
 [simulation]
 duration = {duration}
 dt = {dt}
@@ -69,6 +35,12 @@ tangential = "{tangential}"
 every = {every}
 ply = true
 """
+
+
+def pile_scene(duration: float, tangential: str, every: int) -> str:
+    text = REFERENCE.read_text()
+    return text[: text.index("[simulation]")] + RUN.format(duration=duration, dt=DT, tangential=tangential,
+                                                            every=every)
 
 
 def grain_centres(ply: pathlib.Path):
@@ -86,7 +58,7 @@ def grain_centres(ply: pathlib.Path):
 def creep(tetrasand: str, tangential: str, cpu: bool, out: pathlib.Path):
     every = round(SETTLE / DT)
     scene = out / f"pile_{tangential}.toml"
-    scene.write_text(SCENE.format(duration=SETTLE + WATCH, dt=DT, tangential=tangential, every=every))
+    scene.write_text(pile_scene(SETTLE + WATCH, tangential, every))
     command = [tetrasand, "sim", str(scene), "-o", str(out / tangential)] + (["--cpu"] if cpu else [])
     run = subprocess.run(command, capture_output=True, text=True)
     if run.returncode != 0:

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/atomic_file.h"
 #include "sim/scene.h"
 #include "sim/scene_runner.h"
 #include "tests/test_support.h"
@@ -39,42 +40,16 @@ material = "sand"
                      mu, kGammaS, kRadius);
 }
 
-// Grains poured from a small box 5-22 cm above a rough floor of fixed 5 mm spheres.
+// Grains poured from a small box 5-22 cm above a rough floor of fixed 5 mm spheres: the shared coarse
+// pile of assets/scenes/reference/coarse_pile.toml (bench/sim_spring_creep.py pours the same one).
 Scene pile_scene(double mu, std::size_t count, double duration,
                  TangentialModel tangential = TangentialModel::Viscous) {
-  const std::string text = materials(mu) + fmt::format(R"(
-[[emitter]]
-type = "pour"
-min = [-0.04, -0.04, 0.05]
-max = [0.04, 0.04, 0.22]
-count = {}
-rate = 400.0
-velocity = [0.0, 0.0, -0.5]
-seed = 11
-
-[[boundary]]
-type = "plane"
-rough = true
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-size = [0.3, 0.3]
-particle_radius = 5.0e-3
-material = "sand"
-
-[[boundary]]
-type = "plane"
-point = [0.0, 0.0, -0.01]
-normal = [0.0, 0.0, 1.0]
-material = "sand"
-
-[simulation]
-duration = {}
-
-[output]
-every = 500
-)",
-                                                       count, duration);
-  Scene scene = parse_scene(text, "pile.toml");
+  const std::filesystem::path file = test::asset("scenes/reference/coarse_pile.toml");
+  Scene scene = parse_scene(read_file(file), file.string());
+  EXPECT_EQ(scene.grain.radius, kRadius);
+  scene.materials.at(0).friction = mu;
+  scene.emitters.at(0).count = count;
+  scene.simulation.duration = duration;
   scene.simulation.step.tangential = tangential;
   return scene;
 }
