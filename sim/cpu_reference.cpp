@@ -7,15 +7,15 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 
 #include "core/error.h"
 
 namespace ts::sim {
 
 std::uint32_t hash_cell(const Eigen::Vector3i& c, std::uint32_t table_size) {
-  const std::uint32_t h = (static_cast<std::uint32_t>(c.x()) * 73856093u) ^
-                          (static_cast<std::uint32_t>(c.y()) * 19349663u) ^
-                          (static_cast<std::uint32_t>(c.z()) * 83492791u);
+  const std::uint32_t h = static_cast<std::uint32_t>(c.x()) + static_cast<std::uint32_t>(c.y()) * 19349663u +
+                          static_cast<std::uint32_t>(c.z()) * 83492791u;
   return h & (table_size - 1u);
 }
 
@@ -111,6 +111,8 @@ void CpuStepper::visit_contacts(const World& world, std::uint32_t i, Fn&& fn, Sp
   const double overlap_ratio_cap = settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30;
   const std::uint32_t bi = p.body[i];
   const double ri = p.radius[i];
+  const double inverse_mass_i = b.inverse_mass[bi];
+  const Eigen::Vector3d& xi = position_[i];
   const Eigen::Vector3d& wi = b.angular_velocity[bi];
   const double dt = settings_.dt;
   // The contact's spring (zero for a new contact), or null without springs.
@@ -133,31 +135,43 @@ void CpuStepper::visit_contacts(const World& world, std::uint32_t i, Fn&& fn, Sp
     springs->new_displacement[springs->used] = spring;
     ++springs->used;
   };
-  // Other bodies' particles in the 27 cells around, each bucket in increasing id.
+  // Other bodies' particles in the 27 cells around, row by row (dz, dy), each row's three cells in
+  // increasing x and each bucket in increasing id. A row is three consecutive buckets (see
+  // hash_cell), so it is one contiguous scan unless it wraps around the table's end.
+  const Eigen::Vector3i& own_cell = grid_.cell[i];
+  const std::uint32_t last_bucket = grid_.table_size - 1;
+  auto visit_bucket_range = [&](std::uint32_t first, std::uint32_t end, int y, int z) {
+    for (std::uint32_t s = first; s < end; ++s) {
+      const Candidate& other = candidates_[s];
+      // A cell of another row hashed here, or a partner that cannot receive a force.
+      if (other.cell.y() != y || other.cell.z() != z || std::abs(other.cell.x() - own_cell.x()) > 1) continue;
+      if (other.body == bi || (inverse_mass_i == 0 && other.inverse_mass == 0)) continue;
+      const double rj = other.radius;
+      // Only touching pairs go on (the force repeats this test with the distance itself).
+      if ((xi - other.position).squaredNorm() >= (ri + rj) * (ri + rj)) continue;
+      const std::uint32_t j = other.particle;
+      const std::uint32_t bj = other.body;
+      const auto& coefficients = pairs_[p.material[i] * material_count_ + p.material[j]];
+      const double smaller = std::min(ri, rj);
+      const auto partner = static_cast<std::int64_t>(j);
+      const ContactForce<double> f = sphere_sphere_contact(
+          xi, velocity_[i], wi, ri, inverse_mass_i, position_[j], velocity_[j], b.angular_velocity[bj], rj,
+          b.inverse_mass[bj], overlap_ratio_cap * smaller, coefficients, dt, find_spring(partner));
+      if (!f.touching) continue;
+      keep_spring(partner);
+      fn(f, partner, smaller);
+    }
+  };
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const Eigen::Vector3i c = grid_.cell[i] + Eigen::Vector3i(dx, dy, dz);
-        const std::uint32_t h = hash_cell(c, grid_.table_size);
-        for (std::uint32_t s = grid_.bucket_start[h]; s < grid_.bucket_start[h + 1]; ++s) {
-          const std::uint32_t j = grid_.sorted[s];
-          const std::uint32_t bj = p.body[j];
-          // Another cell hashed to this bucket, or a partner that cannot receive a force.
-          if (grid_.cell[j] != c || bj == bi) continue;
-          if (b.inverse_mass[bi] == 0 && b.inverse_mass[bj] == 0) continue;
-          const double rj = p.radius[j];
-          const auto& coefficients = pairs_[p.material[i] * material_count_ + p.material[j]];
-          const double smaller = std::min(ri, rj);
-          // With springs, only touching pairs look theirs up (the force repeats this test).
-          if (springs && (position_[i] - position_[j]).squaredNorm() >= (ri + rj) * (ri + rj)) continue;
-          const auto partner = static_cast<std::int64_t>(j);
-          const ContactForce<double> f = sphere_sphere_contact(
-              position_[i], velocity_[i], wi, ri, b.inverse_mass[bi], position_[j], velocity_[j],
-              b.angular_velocity[bj], rj, b.inverse_mass[bj], overlap_ratio_cap * smaller, coefficients, dt,
-              find_spring(partner));
-          if (!f.touching) continue;
-          keep_spring(partner);
-          fn(f, partner, smaller);
+      const int y = own_cell.y() + dy, z = own_cell.z() + dz;
+      const std::uint32_t h = hash_cell(Eigen::Vector3i(own_cell.x() - 1, y, z), grid_.table_size);
+      if (h + 2 <= last_bucket) {
+        visit_bucket_range(grid_.bucket_start[h], grid_.bucket_start[h + 3], y, z);
+      } else {
+        for (std::uint32_t k = 0; k < 3; ++k) {
+          const std::uint32_t hk = (h + k) & last_bucket;
+          visit_bucket_range(grid_.bucket_start[hk], grid_.bucket_start[hk + 1], y, z);
         }
       }
     }
@@ -215,6 +229,11 @@ void CpuStepper::prepare_particles(const World& world) {
   });
   const double cell = n > 0 ? 2 * max_radius(world) : 1.0;  // m
   build_neighbour_grid(position_, cell, grid_);
+  candidates_.resize(n);
+  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t s) {
+    const std::uint32_t j = grid_.sorted[s];
+    candidates_[s] = {position_[j], p.radius[j], b.inverse_mass[p.body[j]], grid_.cell[j], p.body[j], j};
+  });
 }
 
 std::vector<ContactRecord> CpuStepper::contacts(const World& world) {
