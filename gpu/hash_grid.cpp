@@ -34,11 +34,28 @@ void PrefixScan::run(Queue& queue, Buffer& values, std::uint32_t count) {
   }
 }
 
-HashGrid::HashGrid(const ShaderLibrary& library)
-    : count_(Program::compute(library, "common/grid_count.comp")),
-      scatter_(Program::compute(library, "common/grid_scatter.comp")),
-      sort_cells_(Program::compute(library, "common/grid_sort_cells.comp")),
+BucketSort::BucketSort(const ShaderLibrary& library)
+    : scatter_(Program::compute(library, "common/grid_scatter.comp")),
+      sort_buckets_(Program::compute(library, "common/grid_sort_cells.comp")),
       scan_(library) {}
+
+void BucketSort::finish(Queue& queue, const Buffer& keys, const Buffer& counts, const Buffer& slots, Buffer& starts,
+                        Buffer& sorted, std::uint32_t count, std::uint32_t table_size) {
+  glCopyNamedBufferSubData(counts.id(), starts.id(), 0, 0, static_cast<GLsizeiptr>(table_size * sizeof(std::uint32_t)));
+  scan_.run(queue, starts, table_size);
+  keys.bind(1);
+  counts.bind(2);
+  slots.bind(3);
+  starts.bind(4);
+  sorted.bind(5);
+  scatter_.set("count", count);
+  queue.dispatch_items(scatter_, count);
+  sort_buckets_.set("table_size", table_size);
+  queue.dispatch_items(sort_buckets_, table_size);
+}
+
+HashGrid::HashGrid(const ShaderLibrary& library)
+    : count_(Program::compute(library, "common/grid_count.comp")), sort_(library) {}
 
 void HashGrid::reserve(std::uint32_t count) {
   if (count <= capacity_ && table_size_ != 0) return;
@@ -64,18 +81,7 @@ void HashGrid::build(Queue& queue, const Buffer& positions, std::uint32_t count,
   count_.set("cell_size", cell_size);
   count_.set("table_size", table_size_);
   queue.dispatch_items(count_, count);
-  glCopyNamedBufferSubData(cell_count_.id(), cell_start_.id(), 0, 0,
-                           static_cast<GLsizeiptr>(table_size_ * sizeof(std::uint32_t)));
-  scan_.run(queue, cell_start_, table_size_);
-  cell_of_.bind(1);
-  cell_count_.bind(2);
-  slot_.bind(3);
-  cell_start_.bind(4);
-  sorted_.bind(5);
-  scatter_.set("count", count);
-  queue.dispatch_items(scatter_, count);
-  sort_cells_.set("table_size", table_size_);
-  queue.dispatch_items(sort_cells_, table_size_);
+  sort_.finish(queue, cell_of_, cell_count_, slot_, cell_start_, sorted_, count, table_size_);
 }
 
 void HashGrid::bind() const {

@@ -23,6 +23,22 @@ class PrefixScan {
   std::vector<Buffer> levels_;  // levels_[l]: block sums of level l (level 0 = the values), grown on demand
 };
 
+// Counting sort of `count` ids by keys below `table_size`, finished here once a key kernel has
+// written each id's key (`keys`, binding 1), its bucket's size (`counts`, 2, zeroed before) and its
+// slot in the bucket (`slots`, 3): bucket starts by exclusive scan (`starts`, 4), ids scattered to
+// start + slot (`sorted`, 5), then sorted within each bucket, so the order does not depend on the
+// atomics that handed out the slots. Shared by the hash grid and the simulator's Morton re-sort.
+class BucketSort {
+ public:
+  explicit BucketSort(const ShaderLibrary& library);
+  void finish(Queue& queue, const Buffer& keys, const Buffer& counts, const Buffer& slots, Buffer& starts,
+              Buffer& sorted, std::uint32_t count, std::uint32_t table_size);
+
+ private:
+  Program scatter_, sort_buckets_;
+  PrefixScan scan_;
+};
+
 class HashGrid {
  public:
   explicit HashGrid(const ShaderLibrary& library);
@@ -36,8 +52,8 @@ class HashGrid {
 
  private:
   void reserve(std::uint32_t count);
-  Program count_, scatter_, sort_cells_;
-  PrefixScan scan_;
+  Program count_;
+  BucketSort sort_;
   Buffer cell_of_, slot_, cell_count_, cell_start_, sorted_;
   std::uint32_t capacity_ = 0, table_size_ = 0;
   float cell_size_ = 0.0f;

@@ -91,8 +91,7 @@ GpuStepper::GpuStepper(gpu::Context& context, const World& world, const StepSett
       resort_particles_(gpu::Program::compute(library_, "sim/resort_particles.comp")),
       resort_fixup_(gpu::Program::compute(library_, "sim/resort_fixup.comp", precision_defines(precision))),
       gather_rows_(gpu::Program::compute(library_, "sim/gather_rows.comp")),
-      bucket_scatter_(gpu::Program::compute(library_, "common/grid_scatter.comp")),
-      bucket_sort_(gpu::Program::compute(library_, "common/grid_sort_cells.comp")),
+      bucket_sort_(library_),
       resort_scan_(library_) {
   upload(world);
 }
@@ -495,18 +494,7 @@ void GpuStepper::resort() {
   resort_keys_.set("cell_size", static_cast<float>(cell_size_));
   resort_keys_.set("table_size", bucket_table_);
   queue_.dispatch_items(resort_keys_, body_count_);
-  glCopyNamedBufferSubData(bucket_count_.id(), bucket_start_.id(), 0, 0,
-                           static_cast<GLsizeiptr>(bucket_table_ * sizeof(std::uint32_t)));
-  resort_scan_.run(queue_, bucket_start_, bucket_table_);
-  sort_key_.bind(1);
-  bucket_count_.bind(2);
-  sort_slot_.bind(3);
-  bucket_start_.bind(4);
-  order_.bind(5);
-  bucket_scatter_.set("count", body_count_);
-  queue_.dispatch_items(bucket_scatter_, body_count_);
-  bucket_sort_.set("table_size", bucket_table_);
-  queue_.dispatch_items(bucket_sort_, bucket_table_);
+  bucket_sort_.finish(queue_, sort_key_, bucket_count_, sort_slot_, bucket_start_, order_, body_count_, bucket_table_);
 
   // New particle ranges (a scan of the counts in the new order) and the particle maps.
   order_.bind(5);

@@ -70,9 +70,9 @@ class GpuStepper {
   gpu::Buffer body_momentum_, particle_wrench_, springs_, keyframes_, pairs_, planes_, cylinders_, particle_stats_buffer_;
   gpu::Buffer counters_, metric_partials_, stat_partials_;
   // Re-sorting (see StepSettings::resort_every).
-  gpu::Program resort_keys_, resort_ranges_, resort_particles_, resort_fixup_, gather_rows_, bucket_scatter_,
-      bucket_sort_;
-  gpu::PrefixScan resort_scan_;
+  gpu::Program resort_keys_, resort_ranges_, resort_particles_, resort_fixup_, gather_rows_;
+  gpu::BucketSort bucket_sort_;  // the body order by Morton key
+  gpu::PrefixScan resort_scan_;  // the new particle ranges
   gpu::Buffer sort_key_, sort_slot_, bucket_count_, bucket_start_, order_, new_first_, new_range_;
   gpu::Buffer source_particle_, new_of_old_, owner_, original_body_, original_particle_;
   std::uint32_t bucket_table_ = 0;
