@@ -12,6 +12,9 @@ Usage: bench/sample_bench.py --tetrasand build-test/bin/tetrasand [--counts 1000
        [--csv OUT.csv] [--no-trade | --no-compare] [--trade trefoil cube --trade-count 1000
        --trade-rounds 0 1 3 12 --trade-iterations 100 2000]
 --csv writes every row (kind = compare or trade) for bench/plot_sample.py.
+--markdown docs/benchmarks.md rewrites its section sampler (between `<!-- section: sampler -->` and
+`<!-- end: sampler -->`) with this run's tables, its plots (docs/benchmarks/sample_*.png) and the
+reading in bench/sample_notes.md; scripts/bench.sh sample does that.
 Installs Debian's python3-open3d when it is missing (root only), as the peers note says.
 """
 import argparse, csv, json, os, platform, shutil, subprocess, sys, tarfile, tempfile, time
@@ -27,6 +30,10 @@ class CsvOut:
         self.writer = csv.DictWriter(self.file, CSV_FIELDS, extrasaction="ignore") if path else None
         if self.writer:
             self.writer.writeheader()
+
+    def close(self):
+        if self.file:
+            self.file.close()
 
     def row(self, **values):
         if self.writer:
@@ -121,20 +128,33 @@ def main():
     ap.add_argument("--no-compare", action="store_true", help="only the trade")
     ap.add_argument("--no-trade", action="store_true", help="only the comparison with Open3D")
     ap.add_argument("--csv", help="also write every row to this CSV")
+    ap.add_argument("--markdown", help="rewrite the sampler section of this markdown file (docs/benchmarks.md)")
+    ap.add_argument("--command", default="", help="the command line to quote in the markdown section")
     args = ap.parse_args()
+    if args.markdown and not args.csv:
+        args.csv = os.path.join(tempfile.mkdtemp(prefix="sample_bench_csv_"), "sample.csv")
     out = CsvOut(args.csv)
+    report = []  # the markdown lines of this run, in order
+
+    def say(line=""):
+        print(line, flush=True)
+        report.append(line)
+
     ensure_open3d()
     import numpy as np
     import open3d as o3d
     o3d.utility.random.seed(7)  # Open3D 0.16's samplers draw from this global generator
     tmp = tempfile.mkdtemp(prefix="sample_bench_")
-    print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores; GL: {renderer(args.tetrasand)}")
+    started = time.strftime("%Y-%m-%d")
+    load_start = open("/proc/loadavg").read().split()[:3]
+    gl = renderer(args.tetrasand)
+    print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores; GL: {gl}")
     print(f"Open3D {o3d.__version__}; probes per figure: {args.probes}\n")
     jobs = [] if args.no_compare else [(m, n) for m in args.meshes for n in args.counts]
     jobs += [] if args.no_compare else [(m, args.large_count) for m in args.large]
     if jobs:
-        print("| mesh | N | tool | time s | ratio | rho | CV | c / r | c / d_hex | max phi / r |")
-        print("|---|---|---|---|---|---|---|---|---|---|")
+        say("| mesh | N | tool | time s | ratio | rho | CV | c / r | c / d_hex | max phi / r |")
+        say("|---|---|---|---|---|---|---|---|---|---|")
     for name, count in jobs:
         path = resolve_mesh(name, tmp)
         mesh = o3d.io.read_triangle_mesh(path)
@@ -147,8 +167,8 @@ def main():
         label = os.path.splitext(os.path.basename(path))[0]
         for tool, pts, secs in (("tetrasand", ours, t_ours), ("Open3D", theirs, t_theirs)):
             q = quality(pts, mesh, probes, r)
-            print(f"| {label} | {q['n']} | {tool} | {secs:.2f} | {secs / t_theirs:.2f} | {q['rho']:.3f} | {q['cv']:.3f} | "
-                  f"{q['c_over_r']:.3f} | {q['c_over_dhex']:.3f} | {q['phi_over_r']:.1e} |", flush=True)
+            say(f"| {label} | {q['n']} | {tool} | {secs:.2f} | {secs / t_theirs:.2f} | {q['rho']:.3f} | {q['cv']:.3f} | "
+                f"{q['c_over_r']:.3f} | {q['c_over_dhex']:.3f} | {q['phi_over_r']:.1e} |")
             out.row(kind="compare", mesh=label, requested=count, tool=tool, seconds=secs, **q,
                     iterations=body["quality"]["iterations"] if tool == "tetrasand" else "",
                     injection_rounds=body["quality"]["injection_rounds"] if tool == "tetrasand" else "")
@@ -158,9 +178,11 @@ def main():
         mesh = o3d.io.read_triangle_mesh(path)
         probes = np.asarray(mesh.sample_points_uniformly(args.probes).points)
         label = os.path.splitext(os.path.basename(path))[0]
-        print(f"\nSampler trade on {label}, {args.trade_count} particles requested:\n")
-        print("| rounds | max iterations | N | iterations | injection rounds | time s | rho | CV | c / r |")
-        print("|---|---|---|---|---|---|---|---|---|")
+        say()
+        say(f"Sampler trade on {label}, {args.trade_count} particles requested, `--rounds` against `--max-iterations`:")
+        say()
+        say("| rounds | max iterations | N | iterations | injection rounds | time s | rho | CV | c / r |")
+        say("|---|---|---|---|---|---|---|---|---|")
         for iterations in args.trade_iterations:
             for rounds in args.trade_rounds:
                 extra = ["--rounds", str(rounds)]
@@ -169,12 +191,52 @@ def main():
                 body, ours, secs = run_tetrasand(args.tetrasand, path, args.trade_count, os.path.join(tmp, "trade"), extra)
                 q = quality(ours, mesh, probes, body["particle_radius"])
                 bq = body["quality"]
-                print(f"| {rounds} | {iterations} | {q['n']} | {bq['iterations']} | {bq['injection_rounds']} | {secs:.2f} | "
-                      f"{q['rho']:.3f} | {q['cv']:.3f} | {q['c_over_r']:.3f} |", flush=True)
+                say(f"| {rounds} | {iterations} | {q['n']} | {bq['iterations']} | {bq['injection_rounds']} | {secs:.2f} | "
+                    f"{q['rho']:.3f} | {q['cv']:.3f} | {q['c_over_r']:.3f} |")
                 out.row(kind="trade", mesh=label, requested=args.trade_count, tool="tetrasand", rounds=rounds,
                         max_iterations=iterations, iterations=bq["iterations"], injection_rounds=bq["injection_rounds"],
                         seconds=secs, **q)
     shutil.rmtree(tmp, ignore_errors=True)
+    if args.markdown:
+        out.close()
+        write_markdown(args, report, started, load_start, gl, o3d.__version__)
+
+
+def write_markdown(args, report, started, load_start, gl, open3d_version):
+    """The sampler section of docs/benchmarks.md from this run: how it ran, its tables, plots, notes."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    sys.path.insert(0, here)
+    from docs_section import replace_between
+    figures = os.path.join(os.path.dirname(os.path.abspath(args.markdown)), "benchmarks")
+    os.makedirs(figures, exist_ok=True)
+    subprocess.run(["/usr/bin/python3", os.path.join(here, "plot_sample.py"), figures, args.csv], check=True)
+    plots = []
+    if not args.no_compare:
+        plots.append("![tetrasand and Open3D against the particle count](benchmarks/sample_vs_open3d.png)")
+    if not args.no_trade and args.trade:
+        plots.append("![sampler trade: covering radius and rho against relaxation steps](benchmarks/sample_trade.png)")
+    load_end = open("/proc/loadavg").read().split()[:3]
+    notes = os.path.join(here, "sample_notes.md")
+    gpu_note = ("**No NVIDIA GPU was used**: tetrasand's GPU work ran on Mesa's llvmpipe, on the same CPU cores as "
+                "Open3D, so read the ratios, not the seconds.\n" if "llvmpipe" in gl else "")
+    text = f"""## Sampling
+
+`{args.command or 'bench/sample_bench.py'}` ({started}; bench/sample_bench.py): `tetrasand sample --count N`
+against Open3D {open3d_version} `sample_points_poisson_disk(N, init_factor=5)` (sample elimination, Yuksel
+2015) on the same mesh at the count tetrasand produced, in one run. Machine {platform.node()}
+({platform.machine()}, {os.cpu_count()} cores), GL renderer of tetrasand's GPU work: {gl}; load average
+{' '.join(load_start)} (1/5/15 min) at the start, {' '.join(load_end)} at the end. Both point sets are
+measured by the script the same way: rho = min NN / d_hex, CV of NN distances, covering radius c over
+one shared set of {args.probes:,} area-uniform probes, c / r with r the radius tetrasand chose for that
+count (c / r <= 1: spheres of that radius cover the whole surface), and the largest distance from the
+mesh (Open3D's float32 unsigned distance). Ratio = time / Open3D's time; tetrasand's time is the whole
+command (mesh load, validation, SDF scan conversion, relaxation, projection, coverage passes, outputs).
+{gpu_note}
+""" + "\n".join(report) + "\n\n" + "\n\n".join(plots) + "\n"
+    if os.path.exists(notes):
+        text += "\n" + open(notes).read()
+    replace_between(args.markdown, "<!-- section: sampler -->\n", "<!-- end: sampler -->\n", text)
+    print(f"wrote the sampler section of {args.markdown}")
 
 
 if __name__ == "__main__":
