@@ -176,25 +176,31 @@ double speed_p99(const World& world) {
   return v.empty() ? 0.0 : percentile(v, 0.99);
 }
 
-// Steps until 99 % of the grains move slower than `rest_speed` (checked every 5 ms), after at least
-// `min_time` and at most `max_time` of simulated time; `each` is called every step. Returns the
-// simulated time it ran. Progress goes to stderr: these runs take minutes.
+// Steps until the grains are at rest or what is measured of them has stopped changing, after at
+// least `min_time` and at most `max_time` of simulated time: every 10 ms it checks whether 99 % of
+// the grains move slower than `rest_speed`, or whether `measure` (a height or a radius, m) moved by
+// less than 0.3 % over the last 0.1 s (a deposit's creeping edge keeps a few grains moving long after
+// its extent has settled). Returns the simulated time it ran. Progress goes to stderr: minutes each.
 double run_until_rest(CpuStepper& stepper, World& world, double min_time, double max_time, double rest_speed,
-                      const std::string& label, const std::function<void()>& each = {}) {
+                      const std::string& label, const std::function<double()>& measure) {
   const double dt = stepper.settings().dt, t0 = world.time;
-  const auto check_every = std::max<std::int64_t>(1, std::llround(5e-3 / dt));
+  const auto check_every = std::max<std::int64_t>(1, std::llround(1e-2 / dt));
   const auto wall = std::chrono::steady_clock::now();
+  std::vector<double> history;  // `measure` at each check
   for (std::int64_t s = 1;; ++s) {
     stepper.step(world);
-    if (each) each();
     const double t = world.time - t0;
     if (s % check_every != 0) continue;
     const double speed = speed_p99(world);
-    if (s % (20 * check_every) == 0) {
-      std::fprintf(stderr, "  %s: t = %.2f s, 99 %% of grains below %.3f m/s, %.0f s wall\n", label.c_str(), t, speed,
+    history.push_back(measure());
+    const bool settled = history.size() > 10 &&
+                         std::abs(history.back() - history[history.size() - 11]) < 3e-3 * std::abs(history.back());
+    if (history.size() % 10 == 0) {
+      std::fprintf(stderr, "  %s: t = %.2f s, 99 %% of grains below %.3f m/s, extent %.4f m, %.0f s wall\n",
+                   label.c_str(), t, speed, history.back(),
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - wall).count());
     }
-    if ((t >= min_time && speed < rest_speed) || t >= max_time) return t;
+    if ((t >= min_time && (speed < rest_speed || settled)) || t >= max_time) return t;
   }
 }
 
@@ -222,12 +228,16 @@ void silo(const fs::path& out) {
   const std::size_t grains = scene.emitters.at(0).count;
   std::fprintf(stderr, "silo: %zu grains, dt = %.3g s, settling\n", grains, dt);
   const auto wall = std::chrono::steady_clock::now();
-  const double settle_time = run_until_rest(settle, settled, 0.8, scene.simulation.duration, 0.02, "silo settle");
-  std::vector<double> tops;
-  for (std::size_t b = 0; b < settled.bodies.size(); ++b) {
-    if (settled.bodies.motion[b] == MotionType::Dynamic) tops.push_back(settled.bodies.position[b].z());
-  }
-  const double fill = percentile(tops, 0.95);  // m, height of the settled fill
+  auto fill_height = [&] {  // m, the 95th percentile of the grain centres' heights
+    std::vector<double> tops;
+    for (std::size_t b = 0; b < settled.bodies.size(); ++b) {
+      if (settled.bodies.motion[b] == MotionType::Dynamic) tops.push_back(settled.bodies.position[b].z());
+    }
+    return percentile(tops, 0.95);
+  };
+  const double settle_time =
+      run_until_rest(settle, settled, 0.8, scene.simulation.duration, 0.02, "silo settle", fill_height);
+  const double fill = fill_height();
   std::string info = fmt::format("grains,settle_s,fill_m,width_m,dt_s,settle_wall_s\n{},{:.3f},{:.4f},{:.4f},{:.4g},{:.0f}\n",
                                  grains, settle_time, fill, 2 * scene.boundaries.at(0).radius, dt,
                                  std::chrono::duration<double>(std::chrono::steady_clock::now() - wall).count());
@@ -311,11 +321,11 @@ Collapse collapse_column(double r0, std::size_t count) {
   };
   const std::string label = fmt::format("column r0 = {:.3f} m", r0);
   Collapse c;
-  c.settle_time = run_until_rest(stepper, world, 0.5, 2.5, 0.02, label + " settle");
+  c.settle_time = run_until_rest(stepper, world, 0.5, 2.5, 0.02, label + " settle", [&] { return extent(true); });
   c.r0 = r0;
   c.h0 = extent(true);
   world.walls.cylinders.clear();  // released
-  c.spread_time = run_until_rest(stepper, world, 0.5, 2.5, 0.02, label + " spread");
+  c.spread_time = run_until_rest(stepper, world, 0.5, 2.5, 0.02, label + " spread", [&] { return extent(false); });
   c.runout = extent(false);
   c.grains = count;
   c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -388,8 +398,8 @@ int main(int argc, char** argv) {
     fs::create_directories(out);
     if (what == "restitution" || what == "all") restitution(out);
     if (what == "repose" || what == "all") repose(out);
-    if (what == "column" || what == "all") column(out);
     if (what == "silo" || what == "all") silo(out);
+    if (what == "column" || what == "all") column(out);
     if (what == "agreement") agreement(out, "all");
     if (what.rfind("agreement-", 0) == 0) agreement(out, what.substr(10));
     return 0;
