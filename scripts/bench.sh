@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
-# Usage: scripts/bench.sh [sim|sim-accuracy|peers-sim|validation|sdf|all] [--build-dir DIR] [--no-build] [--grains LIST] [--cases 'MESH@R1,R2 ...']
+# Usage: scripts/bench.sh [peers|sdf|sample|peers-sim|sim|sim-accuracy|validation|agreement|all]
+#                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
+#   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
+#               its section of docs/benchmarks.md (--quick: knot1 and armadillo at 64^3 and 128^3, 1,000
+#               particles on three meshes, no sampler trade: ~15 min on 2 cores; default: hours on llvmpipe)
 #   sim         Cundall number (grain-steps/s) of the GPU pipeline and the CPU reference on the same
 #               settled beds, 1k to 1M grains (--grains 1000,8000 for fewer), memory per grain
 #               -> the Cundall table and plot in section sim of docs/benchmarks.md      (~8 min, 2 cores)
@@ -10,38 +14,50 @@
 #   peers-sim   tetrasand (CPU reference, GPU pipeline) against LAMMPS on the same scenes, one run:
 #               grain-steps/s as ratios, settled bed height, rebound, angle of repose
 #               -> section peers-sim of docs/benchmarks.md                              (~5 min, 2 cores)
-#   validation  restitution, angle of repose, silo discharge (Beverloo), contact-force distribution,
-#               column collapse, GPU pipeline against CPU reference (heap, silo, bed)
-#               -> docs/validation.md and docs/validation/*.png   (~15 min CPU runs + ~30 min GPU runs on llvmpipe)
+#   sample      tetrasand sample against Open3D's sample_points_poisson_disk at equal counts, plus the
+#               sampler's rounds x iterations trade -> section sampler of docs/benchmarks.md (~10 min)
+#   validation  restitution, angle of repose, contact-force distribution, column collapse (4 x 15,000
+#               grains), Mankoc-sized silo discharge (46,000 grains) with a Beverloo fit, on the CPU reference
+#               -> docs/validation.md and docs/validation/*.png                          (~1 h, 2 cores)
+#   agreement   GPU pipeline against the CPU reference on the heap, the small silo and the bed
+#               -> its section of docs/validation.md                    (~30 min on llvmpipe, 2 cores)
 #   sdf         SDF construction three ways per mesh and grid in one run: GPU scan conversion, CPU exact
 #               (CGAL, all cores), OpenVDB meshToLevelSet (all cores), errors against exact; default
 #               knot1, armadillo (libcgal-demo) and a 1.3M-triangle icosphere:8 at 64^3..1024^3
 #               (--cases 'knot1@64,128 icosphere:8@64' for fewer; NAME = libcgal-demo mesh, or a path)
 #               -> section sdf of docs/benchmarks.md, docs/benchmarks/sdf_error_vs_time.png
-#               (not in `all`: over an hour on llvmpipe, 2 cores)
+#               (over an hour on llvmpipe, 2 cores)
+#   all         every one of the above, in one run
 # Exit status: 0 when every physical comparison is within its stated tolerance, 1 otherwise.
-# Other benchmarks (sampling) have their own bench programs; see docs/benchmarks.md.
+# The preview bench (tetrasand_bench_preview) has no peer; see docs/benchmarks.md.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 what=${1:-all}
 [ $# -gt 0 ] && shift
 build="$root/build-release"
 do_build=1
+quick=0
 sdf_cases="knot1@64,128,256,512,1024 armadillo@64,128,256,512,1024 icosphere:8@64,128,256,512,1024"
 grains=1000,8000,64000,512000,1000000
 while [ $# -gt 0 ]; do
   case "$1" in
     --build-dir) build=$2; shift 2 ;;
     --no-build) do_build=0; shift ;;
+    --quick) quick=1; shift ;;
     --cases) sdf_cases=$2; shift 2 ;;
     --grains) grains=$2; shift 2 ;;
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in sim|sim-accuracy|peers-sim|validation|sdf|all) ;; *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;; esac
+case "$what" in peers|sdf|sample|peers-sim|sim|sim-accuracy|validation|agreement|all) ;;
+  *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;;
+esac
+[ "$quick" -eq 1 ] && sdf_cases="knot1@64,128 armadillo@64,128"
+# runs NAME: whether this invocation includes benchmark NAME
+runs() { [ "$what" = "$1" ] || [ "$what" = all ] || { [ "$what" = peers ] && case "$1" in sdf|sample|peers-sim) true ;; *) false ;; esac; }; }
 
 # The bench's own packages (not needed to build or test): LAMMPS, numpy, matplotlib.
-bench_packages=(lammps openmpi-bin python3-numpy python3-matplotlib)
+bench_packages=(lammps openmpi-bin python3-numpy python3-matplotlib python3-open3d python3-scipy)
 missing=()
 for p in "${bench_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -64,25 +80,36 @@ status=0
 # numpy and matplotlib are Debian's: run the system interpreter, not a pyenv one.
 py=/usr/bin/python3
 
-if [ "$what" = sim ] || [ "$what" = all ]; then
+if runs sim; then
   "$bin/tetrasand_bench_sim" --grains "$grains" --csv "$work/sim.csv"
   "$py" "$root/bench/plot_sim.py" "$work/sim.csv" "$root/docs" "scripts/bench.sh sim --grains $grains"
   echo "bench: wrote the Cundall table of docs/benchmarks.md and docs/benchmarks/sim_cundall.png"
 fi
-if [ "$what" = sim-accuracy ] || [ "$what" = all ]; then
+if runs sim-accuracy; then
   "$bin/tetrasand_bench_sim_accuracy" "$work/sim-accuracy" all
   "$py" "$root/bench/plot_sim_accuracy.py" "$work/sim-accuracy" "$root/docs"
   echo "bench: wrote the accuracy table of docs/benchmarks.md and docs/benchmarks/sim_accuracy_*.png"
 fi
-if [ "$what" = peers-sim ] || [ "$what" = all ]; then
+if runs peers-sim; then
   "$py" "$root/bench/peers/sim_peers.py" "$bin" "$work/peers-sim" --markdown "$root/docs/benchmarks.md" || status=1
 fi
-if [ "$what" = validation ] || [ "$what" = all ]; then
+if runs sample; then
+  sample_args=()
+  [ "$quick" -eq 1 ] && sample_args=(--large --no-trade)
+  (cd "$root" && "$py" bench/sample_bench.py --tetrasand "$bin/tetrasand" "${sample_args[@]}" --csv "$work/sample.csv" \
+    --markdown docs/benchmarks.md --command "scripts/bench.sh sample${sample_args:+ (--quick: ${sample_args[*]})}") || status=1
+fi
+if runs validation; then
   "$bin/tetrasand_validation_runs" "$work/validation" all
   "$py" "$root/bench/validation/report.py" "$work/validation" "$root/docs" >/dev/null
   echo "bench: wrote docs/validation.md"
 fi
-if [ "$what" = sdf ]; then
+if runs agreement; then
+  "$bin/tetrasand_validation_runs" "$work/agreement" agreement
+  "$py" "$root/bench/validation/report.py" "$work/agreement" "$root/docs" >/dev/null
+  echo "bench: wrote the agreement section of docs/validation.md"
+fi
+if runs sdf; then
   # libcgal-demo's meshes: where the tests unpacked them, else unpacked here.
   meshes="$build/test-data/cgal/data/meshes"
   if [ ! -d "$meshes" ]; then
