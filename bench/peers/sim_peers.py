@@ -107,19 +107,19 @@ def rebound_apex(z, radius=1e-3):
     return float(np.max(z[low:low + 400]) - radius), float(z[0] - radius)
 
 
-def repose_angle(xyz):
-    """Slope of a heap's flank: the highest grain centre per 2 mm ring, fitted from the last ring above
-    80 % of the heap's height outwards to the first ring below 20 % (not the flat top, not the
-    scattered grains around it)."""
+def repose_angle(xyz, ring_width=2e-3):
+    """Slope of a heap's flank: the highest grain centre per ring (2 mm wide for the 1 mm grains; about a
+    grain radius), fitted from the last ring above 80 % of the heap's height outwards to the first ring
+    below 20 % (not the flat top, not the scattered grains around it)."""
     r = np.hypot(xyz[:, 0], xyz[:, 1])
-    ring = (r / 2e-3).astype(int)
+    ring = (r / ring_width).astype(int)
     top = np.zeros(ring.max() + 1)
     np.maximum.at(top, ring, xyz[:, 2])
     h = top.max()
     first = int(np.nonzero(top > 0.8 * h)[0].max())
     below = np.nonzero(top[first:] < 0.2 * h)[0]
     last = first + (int(below[0]) if len(below) else len(top) - first)
-    x = (np.arange(len(top)) + 0.5) * 2e-3
+    x = (np.arange(len(top)) + 0.5) * ring_width
     if last - first < 2:
         return float("nan")
     slope = np.polyfit(x[first:last], top[first:last], 1)[0]

@@ -117,31 +117,25 @@ Run run(Scene scene, const fs::path& dir, const std::string& name, bool record_h
   return r;
 }
 
-// Grains poured from a 1.6 cm x 1.6 cm box 3-6 cm above a rough floor with no side walls pile up
-// into a heap (reference/heap.toml); its surface slope is the angle of repose. Also writes the
-// resting pile's contact forces.
+// 3,000 coarse grains (r = 5 mm) poured at 1,000 grains/s from a box 5-30 cm above a rough floor with
+// no side walls pile up into a heap (reference/coarse_pile.toml, scaled up from its 300 grains); its
+// surface slope is the angle of repose.
 void repose(const fs::path& out) {
   std::string csv = "mu,grains,seconds\n";
   for (double mu : {0.1, 0.3, 0.5, 0.8}) {
-    Scene scene = reference("heap.toml");
+    Scene scene = reference("coarse_pile.toml");
     set_friction(scene, mu);
+    scene.emitters.at(0).count = 3000;
+    scene.emitters.at(0).rate = 1000;
+    // A 16 cm x 16 cm box 5-30 cm up: 360 release sites, enough to keep up with 1,000 grains/s.
+    scene.emitters.at(0).min = Eigen::Vector3d(-0.08, -0.08, 0.05);
+    scene.emitters.at(0).max = Eigen::Vector3d(0.08, 0.08, 0.30);
+    scene.boundaries.at(0).size = Eigen::Vector2d(0.8, 0.8);  // the heap spreads to ~0.25 m
+    scene.simulation.duration = 4.0;                          // s: a 3 s pour, then 1 s at rest
+    scene.simulation.step.integrator = Integrator::SemiImplicitEuler;
     const Run r = run(scene, out / "runs", fmt::format("repose_mu{}", mu), false);
     ts::write_file_atomically(out / fmt::format("heap_mu{}.csv", mu), ts::bench::grain_centres_csv(r.last));
     csv += fmt::format("{},{},{:.1f}\n", mu, r.grains, r.seconds);
-    if (mu == 0.5) {
-      // Normal contact forces of the resting heap (grain-grain and grain-floor particle contacts).
-      StepSettings settings;
-      settings.dt = 1e-5;
-      CpuStepper stepper(r.last, settings);
-      const std::vector<Eigen::Vector3d> x = particle_positions(r.last);
-      std::string forces = "normal_force_N\n";
-      for (const ContactRecord& c : stepper.contacts(r.last)) {
-        if (c.partner < 0) continue;
-        const Eigen::Vector3d normal = (x[c.particle] - x[static_cast<std::size_t>(c.partner)]).normalized();
-        forces += fmt::format("{:.6e}\n", std::abs(c.force.dot(normal)));
-      }
-      ts::write_file_atomically(out / "contact_forces.csv", forces);
-    }
   }
   ts::write_file_atomically(out / "repose.csv", csv);
 }
@@ -215,10 +209,28 @@ CpuStepper tall_scene_stepper(Scene& scene, const World& world) {
   return CpuStepper(world, settings);
 }
 
+// The normal contact forces of a state at rest, one row per contact between particles of different
+// bodies (smooth walls left out): "normal_force_N,z_m,r_m,base", z and r the contact point's height
+// and distance from the axis, base = 1 where the partner is a static particle (the rough floor).
+void write_contact_forces(const World& world, const StepSettings& settings, const fs::path& file) {
+  CpuStepper stepper(world, settings);
+  const std::vector<Eigen::Vector3d> x = particle_positions(world);
+  std::string csv = "normal_force_N,z_m,r_m,base\n";
+  for (const ContactRecord& c : stepper.contacts(world)) {
+    if (c.partner < 0) continue;
+    const auto j = static_cast<std::size_t>(c.partner);
+    const Eigen::Vector3d normal = (x[c.particle] - x[j]).normalized();
+    const bool base = world.bodies.motion[world.particles.body[j]] == MotionType::Static;
+    csv += fmt::format("{:.6e},{:.5f},{:.5f},{}\n", std::abs(c.force.dot(normal)), c.point.z(), c.point.head<2>().norm(),
+                       base ? 1 : 0);
+  }
+  ts::write_file_atomically(file, csv);
+}
+
 // A large flat-bottomed silo within the size conditions of Mankoc et al. 2007
 // (reference/silo_mankoc.toml): filled and settled once on a closed rough plate; then, for each
 // orifice diameter, a copy of the settled silo has the plate's particles within D/2 of the axis
-// taken away and discharges for 0.4 s. Discharged grains (5 cm below the plate) are parked far below
+// taken away and discharges for 0.4 s. The settled fill's contact forces are written too. Discharged grains (5 cm below the plate) are parked far below
 // as static bodies, so they cost nothing and pile up nowhere.
 void silo(const fs::path& out) {
   Scene scene = reference("silo_mankoc.toml");
@@ -242,6 +254,9 @@ void silo(const fs::path& out) {
                                  grains, settle_time, fill, 2 * scene.boundaries.at(0).radius, dt,
                                  std::chrono::duration<double>(std::chrono::steady_clock::now() - wall).count());
   ts::write_file_atomically(out / "silo_fill.csv", info);
+  // The settled fill is a sand pile at rest in a cylinder, where the thesis (table 7.1) and Mueth et
+  // al. 1998 measure the normal contact-force distribution.
+  write_contact_forces(settled, settle.settings(), out / "contact_forces.csv");
 
   const double d = 2 * scene.grain.radius * std::cbrt(4.0);  // m, volume-equivalent diameter
   std::string csv = "orifice_m,time_s,discharged\n";
