@@ -423,10 +423,10 @@ Produced by `scripts/bench.sh validation` ({time.strftime('%Y-%m-%d')}, {os.cpu_
 every section below except the last comes from it. All of them ran on the CPU reference (double
 precision; no NVIDIA GPU was lent to this project's sessions, and on Mesa's llvmpipe the GPU pipeline
 is slower than the CPU reference). Tetrahedral grains of four touching spheres, quartz density,
-E = 1 MPa. The restitution, repose and contact-force runs use r = 1 mm grains and hundreds of grains
-(minutes); the column collapse (4 columns of 15,000 grains) and the silo (46,000 grains, sized to the
-conditions of Mankoc et al. 2007) use coarse r = 5 mm grains, which take a longer time step over the
-same number of grain diameters.
+E = 1 MPa in the scene runs. The restitution run is one r = 1 mm sphere; the angle of repose (4 heaps of
+3,000 grains), the column collapse (4 columns of 15,000 grains), the silo (46,000 grains, sized to the
+conditions of Mankoc et al. 2007) and the contact forces (that silo's settled fill) use coarse r = 5 mm
+grains, whose longer time step covers the same number of grain diameters in fewer steps.
 
 The same contact law run by LAMMPS (through `tetrasand export lammps`) settles beds, rebounds grains and
 builds heaps like tetrasand does: see the section "Simulation against LAMMPS" of docs/benchmarks.md,
