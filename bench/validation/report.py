@@ -417,6 +417,7 @@ def main():
     kept = (old[old.index(AGREEMENT_START) + len(AGREEMENT_START):old.index(AGREEMENT_END)]
             if AGREEMENT_START in old and AGREEMENT_END in old else "(not run yet: `scripts/bench.sh agreement`)\n")
     parts = [restitution(run, docs), repose(run, docs), column(run, docs), silo(run, docs), forces(run, docs)]
+    silo_grains = int(np.genfromtxt(os.path.join(run, "silo_fill.csv"), delimiter=",", names=True)["grains"])
     header = f"""# Physical validation
 
 Produced by `scripts/bench.sh validation` ({time.strftime('%Y-%m-%d')}, {os.cpu_count()} CPU cores) in one run:
@@ -424,7 +425,7 @@ every section below except the last comes from it. All of them ran on the CPU re
 precision; no NVIDIA GPU was lent to this project's sessions, and on Mesa's llvmpipe the GPU pipeline
 is slower than the CPU reference). Tetrahedral grains of four touching spheres, quartz density,
 E = 1 MPa in the scene runs. The restitution run is one r = 1 mm sphere; the angle of repose (4 heaps of
-3,000 grains), the column collapse (4 columns of 15,000 grains), the silo (46,000 grains, sized to the
+3,000 grains), the column collapse (4 columns of 15,000 grains), the silo ({silo_grains:,} grains, sized to the
 conditions of Mankoc et al. 2007) and the contact forces (that silo's settled fill) use coarse r = 5 mm
 grains, whose longer time step covers the same number of grain diameters in fewer steps.
 

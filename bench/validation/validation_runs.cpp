@@ -3,7 +3,7 @@
 // the literature. Usage:
 //   tetrasand_validation_runs OUT_DIR [restitution|repose|silo|column|all|agreement[-heap|-silo|-bed]]
 // `all` is the physical report: restitution and repose take minutes, the column collapse (4 x 15,000
-// grains) and the Mankoc-sized silo (46,000 grains) tens of minutes each on two cores. `agreement`
+// grains) and the Mankoc-sized silo (58,000 grains) tens of minutes each on two cores. `agreement`
 // (GPU pipeline against the CPU reference) is separate: on llvmpipe it is the slow part.
 #include <fmt/format.h>
 
