@@ -22,7 +22,8 @@ std::uint32_t hash_cell(const Eigen::Vector3i& c, std::uint32_t table_size) {
 void build_neighbour_grid(const std::vector<Eigen::Vector3d>& positions, double cell_size, NeighbourGrid& grid) {
   const auto n = static_cast<std::uint32_t>(positions.size());
   grid.cell_size = cell_size;
-  grid.table_size = std::bit_ceil(std::max<std::uint32_t>(2 * n, 2));
+  // At least 4 buckets, so the three buckets of a row (visit_contacts) are always distinct.
+  grid.table_size = std::bit_ceil(std::max<std::uint32_t>(2 * n, 4));
   grid.cell.resize(n);
   std::vector<std::uint32_t> bucket(n);
   tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {

@@ -64,7 +64,7 @@ struct StepStats {
   std::size_t spring_overflows = 0;       // contacts beyond a particle's spring slots (no spring: viscous only)
 };
 
-// The hashed uniform grid: cell = largest particle diameter; a table of next_pow2(2 N) buckets
+// The hashed uniform grid: cell = largest particle diameter; a table of next_pow2(max(2 N, 4)) buckets
 // filled by counting sort in particle order, so a bucket lists its particles by increasing id.
 struct NeighbourGrid {
   double cell_size = 0;                        // m

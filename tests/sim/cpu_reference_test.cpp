@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <set>
+#include <utility>
 
 #include "core/error.h"
 #include "sim/time_step.h"
@@ -366,6 +368,33 @@ TEST(CpuReference, StepsAreBitwiseDeterministicAcrossThreadCounts) {
   for (std::size_t i = 0; i < a.bodies.size(); ++i) {
     ASSERT_EQ(a.bodies.position[i], b.bodies.position[i]);
     ASSERT_EQ(a.bodies.angular_velocity[i], b.bodies.angular_velocity[i]);
+  }
+}
+
+TEST(CpuReference, ContactsAreEveryTouchingPairOnceForAnyTableSize) {
+  // From 2 particles (a 4-bucket table, where rows of three buckets wrap around its end) to 400,
+  // against all pairs: the row-wise search must find each touching pair exactly once.
+  std::mt19937 rng(5);
+  for (const std::size_t n : {2u, 3u, 5u, 9u, 40u, 400u}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      World w = empty_world(0.5);
+      std::uniform_real_distribution<double> u(0.0, 4 * kRadius * std::cbrt(static_cast<double>(n)));
+      for (std::size_t k = 0; k < n; ++k) add_sphere(w, Eigen::Vector3d(u(rng), u(rng), u(rng)), Eigen::Vector3d::Zero());
+      std::size_t brute = 0;
+      const std::vector<Eigen::Vector3d> x = particle_positions(w);
+      for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = i + 1; j < n; ++j) brute += (x[i] - x[j]).norm() < 2 * kRadius ? 1 : 0;
+      }
+      StepSettings settings;
+      settings.dt = 1e-6;
+      CpuStepper stepper(w, settings);
+      std::set<std::pair<std::uint32_t, std::int64_t>> seen;
+      for (const ContactRecord& c : stepper.contacts(w)) {
+        ASSERT_GE(c.partner, 0);
+        EXPECT_TRUE(seen.insert({c.particle, c.partner}).second) << "pair found twice, n = " << n;
+      }
+      EXPECT_EQ(seen.size(), brute) << "n = " << n << ", trial " << trial;
+    }
   }
 }
 
