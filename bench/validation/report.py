@@ -317,8 +317,9 @@ def column(run, docs):
 An axisymmetric column (`assets/scenes/reference/column.toml` scaled up: {grains} coarse grains per
 column, r = 5 mm, E = 1 MPa, mu = 0.5, symplectic Euler) settles inside a smooth cylinder of radius R0
 on a rough floor; the cylinder is then removed and the column spreads. Each phase runs until 99 % of
-the grains move slower than 2 cm/s or the height (settling) or radius (spreading) measured below moved
-less than 0.3 % in 0.1 s (at least 0.5 s, at most 2.5 s). H0 and R_inf are the 95th percentiles of the
+the grains move slower than 2 cm/s, or slower than 20 cm/s with the height (settling) or radius
+(spreading) measured below staying within 0.3 % for 0.1 s (at least 0.5 s, at most 2.5 s). H0 and
+R_inf are the 95th percentiles of the
 grains' outer extent (height; horizontal distance from the axis) before and after; the cylinder's
 radius sets the aspect ratio a = H0 / R0. The narrowest column is {across:.0f} grain diameters across.
 
