@@ -16,8 +16,8 @@
 #               -> section peers-sim of docs/benchmarks.md                              (~5 min, 2 cores)
 #   sample      tetrasand sample against Open3D's sample_points_poisson_disk at equal counts, plus the
 #               sampler's rounds x iterations trade -> section sampler of docs/benchmarks.md (~10 min)
-#   validation  restitution, angle of repose, contact-force distribution, column collapse (4 x 15,000
-#               grains), Mankoc-sized silo discharge (58,000 grains) with a Beverloo fit, on the CPU reference
+#   validation  restitution, angle of repose, contact-force distribution, column collapse (4 x 20,000
+#               grains), Mankoc-sized silo discharge (80,000 grains) with a Beverloo fit, on the CPU reference
 #               -> docs/validation.md and docs/validation/*.png                        (~1.5 h, 2 cores)
 #   agreement   GPU pipeline against the CPU reference on the heap, the small silo and the bed
 #               -> its section of docs/validation.md                    (~30 min on llvmpipe, 2 cores)

@@ -1,9 +1,9 @@
 // The runs behind docs/validation.md, through the library (CPU reference; the agreement run also on
 // the GPU pipeline), written as CSV files that bench/validation/report.py plots and compares with
 // the literature. Usage:
-//   tetrasand_validation_runs OUT_DIR [restitution|repose|silo|column|all|agreement[-heap|-silo|-bed]]
-// `all` is the physical report: restitution and repose take minutes, the column collapse (4 x 15,000
-// grains) and the Mankoc-sized silo (58,000 grains) tens of minutes each on two cores. `agreement`
+//   tetrasand_validation_runs OUT_DIR [restitution|repose|silo [SCENE]|column|all|agreement[-heap|-silo|-bed]]
+// `all` is the physical report: restitution and repose take minutes, the column collapse (4 x 20,000
+// grains) and the Mankoc-sized silo (80,000 grains) tens of minutes each on two cores. `agreement`
 // (GPU pipeline against the CPU reference) is separate: on llvmpipe it is the slow part.
 #include <fmt/format.h>
 
@@ -170,6 +170,36 @@ double speed_p99(const World& world) {
   return v.empty() ? 0.0 : percentile(v, 0.99);
 }
 
+// Preparation only (filling a silo or a column, never a measured phase): from `from_time` on, every
+// dynamic body's velocities decay as exp(-t / time_constant) on top of the contact forces, like
+// Yade's global damping, so a fill that landed as a block stops rebounding in a few time constants.
+// The state at rest is the same (damping removes only motion); reaching it is seconds shorter.
+struct SettleDamping {
+  double from_time = 1e300;      // s after the phase starts
+  double time_constant = 0.05;   // s
+};
+
+void damp_velocities(World& world, double factor) {
+  Bodies& b = world.bodies;
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    if (b.motion[k] != MotionType::Dynamic) continue;
+    b.linear_velocity[k] *= factor;
+    b.angular_velocity[k] *= factor;
+  }
+}
+
+// Damping for a lattice that falls from its top onto the floor: from the moment its top grain
+// would land in free fall.
+SettleDamping damping_after_fall(const Scene& scene, const World& world) {
+  double top = 0;
+  for (std::size_t b = 0; b < world.bodies.size(); ++b) {
+    if (world.bodies.motion[b] == MotionType::Dynamic) top = std::max(top, world.bodies.position[b].z());
+  }
+  SettleDamping damping;
+  damping.from_time = std::sqrt(2 * top / scene.gravity.norm());
+  return damping;
+}
+
 // Steps until the grains are at rest or what is measured of them has stopped changing, after at
 // least `min_time` and at most `max_time` of simulated time. Every 10 ms it checks whether 99 % of
 // the grains move slower than `rest_speed`, or whether they move slower than 10 x `rest_speed` and
@@ -177,14 +207,17 @@ double speed_p99(const World& world) {
 // edge keeps a few grains moving long after its extent has settled; a fill still bouncing after its
 // fall fails both). Returns the simulated time it ran. Progress goes to stderr: minutes each.
 double run_until_rest(CpuStepper& stepper, World& world, double min_time, double max_time, double rest_speed,
-                      const std::string& label, const std::function<double()>& measure) {
+                      const std::string& label, const std::function<double()>& measure,
+                      const SettleDamping& damping = {}) {
   const double dt = stepper.settings().dt, t0 = world.time;
   const auto check_every = std::max<std::int64_t>(1, std::llround(1e-2 / dt));
   const auto wall = std::chrono::steady_clock::now();
+  const double damping_factor = std::exp(-dt / damping.time_constant);
   std::vector<double> history;  // `measure` at each check
   for (std::int64_t s = 1;; ++s) {
     stepper.step(world);
     const double t = world.time - t0;
+    if (t >= damping.from_time) damp_velocities(world, damping_factor);
     if (s % check_every != 0) continue;
     const double speed = speed_p99(world);
     history.push_back(measure());
@@ -232,15 +265,18 @@ void write_contact_forces(const World& world, const StepSettings& settings, cons
 }
 
 // A large flat-bottomed silo within the size conditions of Mankoc et al. 2007
-// (reference/silo_mankoc.toml): filled and settled once on a closed rough plate; then, for each
-// orifice diameter (4, 5 and 6 d), a copy of the settled silo has the plate's particles within D/2
-// of the axis taken away and discharges for 0.35 s. The settled fill's contact forces are written too. Discharged grains (5 cm below the plate) are parked far below
-// as static bodies, so they cost nothing and pile up nowhere.
-void silo(const fs::path& out) {
+// (reference/silo_mankoc.toml, or `scene_file`): filled and settled once on a closed rough plate,
+// damped once the lattice has landed (it falls ~4 m as one block, and the soft fill otherwise
+// rebounds for seconds); then, for each orifice diameter (5, 6, 7 and 8 d), a copy of the settled
+// silo has the plate's particles within D/2 of the axis taken away and discharges undamped for
+// 0.35 s. The settled fill's contact forces are written too. Discharged grains (5 cm below the
+// plate) are parked far below as static bodies, so they cost nothing and pile up nowhere.
+void silo(const fs::path& out, const fs::path& scene_file) {
   constexpr double kDischargeTime = 0.35;  // s after the orifice opens; the rate is fitted from 0.1 s
-  Scene scene = reference("silo_mankoc.toml");
+  Scene scene = scene_file.empty() ? reference("silo_mankoc.toml") : load_scene(scene_file);
   World settled = make_world(scene);
   CpuStepper settle = tall_scene_stepper(scene, settled);
+  const SettleDamping damping = damping_after_fall(scene, settled);
   const double dt = settle.settings().dt;
   const std::size_t grains = scene.emitters.at(0).count;
   std::fprintf(stderr, "silo: %zu grains, dt = %.3g s, settling\n", grains, dt);
@@ -253,7 +289,8 @@ void silo(const fs::path& out) {
     return percentile(tops, 0.95);
   };
   const double settle_time =
-      run_until_rest(settle, settled, 0.8, scene.simulation.duration, 0.02, "silo settle", fill_height);
+      run_until_rest(settle, settled, damping.from_time + 0.2, scene.simulation.duration, 0.02, "silo settle",
+                     fill_height, damping);
   const double fill = fill_height();
   std::string info = fmt::format("grains,settle_s,fill_m,width_m,dt_s,settle_wall_s\n{},{:.3f},{:.4f},{:.4f},{:.4g},{:.0f}\n",
                                  grains, settle_time, fill, 2 * scene.boundaries.at(0).radius, dt,
@@ -266,7 +303,7 @@ void silo(const fs::path& out) {
   const double d = 2 * scene.grain.radius * std::cbrt(4.0);  // m, volume-equivalent diameter
   std::string csv = "orifice_m,time_s,discharged\n";
   std::string runs = "orifice_m,grains,seconds\n";
-  for (double ratio : {4.0, 5.0, 6.0}) {
+  for (double ratio : {5.0, 6.0, 7.0, 8.0}) {
     const double orifice = ratio * d;
     World world = settled;
     world.time = 0;
@@ -341,7 +378,10 @@ Collapse collapse_column(double r0, std::size_t count) {
   };
   const std::string label = fmt::format("column r0 = {:.3f} m", r0);
   Collapse c;
-  c.settle_time = run_until_rest(stepper, world, 0.5, 2.5, 0.02, label + " settle", [&] { return extent(true); });
+  // The filling is preparation: damped once the lattice has landed, as in the silo.
+  const SettleDamping damping = damping_after_fall(scene, world);
+  c.settle_time = run_until_rest(stepper, world, damping.from_time + 0.2, 2.5, 0.02, label + " settle",
+                                 [&] { return extent(true); }, damping);
   c.r0 = r0;
   c.h0 = extent(true);
   world.walls.cylinders.clear();  // released
@@ -354,12 +394,12 @@ Collapse collapse_column(double r0, std::size_t count) {
   return c;
 }
 
-// Runout against aspect ratio: 15,000 grains per column, the cylinder's radius setting the aspect
+// Runout against aspect ratio: 20,000 grains per column, the cylinder's radius setting the aspect
 // ratio (from 0.5 to 5; the break of Lube et al. is at 1.7).
 void column(const fs::path& out) {
   std::string csv = "r0_m,grains,h0_m,runout_m,aspect,normalised_runout,settle_s,spread_s,seconds\n";
-  for (double r0 : {0.335, 0.25, 0.20, 0.15}) {
-    const Collapse c = collapse_column(r0, 15000);
+  for (double r0 : {0.37, 0.275, 0.22, 0.165}) {
+    const Collapse c = collapse_column(r0, 20000);
     csv += fmt::format("{},{},{:.5f},{:.5f},{:.4f},{:.4f},{:.2f},{:.2f},{:.1f}\n", c.r0, c.grains, c.h0, c.runout,
                        c.h0 / c.r0, (c.runout - c.r0) / c.r0, c.settle_time, c.spread_time, c.seconds);
     ts::write_file_atomically(out / "column.csv", csv);  // after each column: a stopped run keeps its rows
@@ -409,7 +449,7 @@ void agreement(const fs::path& out, const std::string& part) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s OUT_DIR [restitution|repose|silo|column|all|agreement[-heap|-silo|-bed]]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|column|all|agreement[-heap|-silo|-bed]]\n", argv[0]);
     return 2;
   }
   try {
@@ -419,7 +459,7 @@ int main(int argc, char** argv) {
     if (what == "restitution" || what == "all") restitution(out);
     if (what == "repose" || what == "all") repose(out);
     if (what == "column" || what == "all") column(out);
-    if (what == "silo" || what == "all") silo(out);
+    if (what == "silo" || what == "all") silo(out, what == "silo" && argc > 3 ? fs::path(argv[3]) : fs::path());
     if (what == "agreement") agreement(out, "all");
     if (what.rfind("agreement-", 0) == 0) agreement(out, what.substr(10));
     return 0;
