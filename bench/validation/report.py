@@ -122,6 +122,26 @@ ring, fitted from the edge of the flat top, above 80 % of the height, out to 20 
 """
 
 
+def orifice_open_diameter(D, plate_radius=COARSE_RADIUS, cell=2e-4):
+    """Diameter (m) of the disc whose area is the hole's, for the hole validation_runs.cpp cuts into the
+    rough plate (touching spheres on a square lattice, centres within D/2 + r of the axis removed):
+    the area, seen from above, farther than r from every remaining sphere centre and connected to the axis."""
+    from scipy import ndimage
+    spacing = 2 * plate_radius
+    reach = D / 2 + 3 * spacing
+    sites = np.arange(-np.ceil(reach / spacing), np.ceil(reach / spacing) + 1) * spacing
+    X, Y = np.meshgrid(sites, sites)
+    keep = np.hypot(X, Y) >= D / 2 + plate_radius
+    g = np.arange(-reach, reach, cell)
+    GX, GY = np.meshgrid(g, g)
+    free = np.ones(GX.shape, bool)
+    for x, y in zip(X[keep], Y[keep]):
+        free &= (GX - x) ** 2 + (GY - y) ** 2 > plate_radius ** 2
+    labels, _ = ndimage.label(free)
+    hole = labels == labels[len(g) // 2, len(g) // 2]
+    return float(np.sqrt(4 * hole.sum() * cell * cell / np.pi))
+
+
 def silo(run, docs):
     d = np.genfromtxt(os.path.join(run, "silo.csv"), delimiter=",", names=True)
     info = np.genfromtxt(os.path.join(run, "silo_fill.csv"), delimiter=",", names=True)
@@ -153,6 +173,10 @@ def silo(run, docs):
     # Free exponent with k fixed at Beverloo's 1.5 (fitting k and the exponent together on four
     # orifices would fit almost anything).
     n_exp = float(np.polyfit(np.log(D - 1.5 * COARSE_D_EQ), np.log(W), 1)[0])
+    n_exp_k0 = float(np.polyfit(np.log(D), np.log(W), 1)[0])  # informative, not a criterion
+    widening = np.array([orifice_open_diameter(x) - x for x in D]) / COARSE_D_EQ
+    a_open, b_open = np.polyfit(D + widening * COARSE_D_EQ, W ** 0.4, 1)
+    k_open = -b_open / a_open / COARSE_D_EQ
     Dfit = np.linspace(D.min() * 0.9, D.max() * 1.1, 50)
     ax2.plot(D * 1e3, W * 1e3, "o", label="tetrasand (CPU reference)")
     ax2.plot(Dfit * 1e3, np.clip(a * Dfit + b, 0, None) ** 2.5 * 1e3, "-", label=f"Beverloo fit, k = {k:.2f}, C = {C:.2f}")
@@ -195,7 +219,11 @@ Grains 5 cm below the plate leave the simulation. CPU reference, dt = {float(inf
   W^(2/5) is linear in D within {linear_residual * 100:.1f} % and gives k = {k:.2f} and C = {C:.2f}
   (rho_b = {packing:.2f} rho, the settled fill's); with k fixed at 1.5 the free exponent is
   {n_exp:.2f} (5/2 expected: **{'meets' if abs(n_exp - 2.5) < 0.5 else 'does not meet'}** it within 0.5,
-  the tolerance set before the run).
+  the tolerance set before the run). Not a criterion, added after a run found k ~ 0: with k fixed at 0
+  the free exponent is {n_exp_k0:.2f}. So the rate scales as D^(5/2) but without Beverloo's empty annulus
+  of about 1.5 d. Part of that is the orifice: cut from a plate of touching 10 mm spheres, its rim is
+  ragged, and its open area is that of a disc {widening.min():.2f}-{widening.max():.2f} d wider than D; against that
+  area-equivalent diameter the fit at 5/2 gives k = {k_open:.2f}, still short of 1.5.
 - What it can show: {'the silo meets all three size conditions, so the 5/2 law is the one to expect; ' if conforming else 'the silo does not meet every size condition, so the fit is no test of the law; '}
   the orifices span {D.min() / COARSE_D_EQ:.0f}-{D.max() / COARSE_D_EQ:.0f} d (the width, {width / COARSE_D_EQ:.0f} d, bounds D
   through D + 30 d; a tetrahedron is {2 * BOUNDING_RADIUS / COARSE_D_EQ:.1f} d across, so 4 d is under three grains and
