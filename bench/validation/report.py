@@ -352,8 +352,8 @@ An axisymmetric column (`assets/scenes/reference/column.toml` scaled up: {grains
 column, r = 5 mm, E = 1 MPa, mu = 0.5, symplectic Euler) settles inside a smooth cylinder of radius R0
 on a rough floor; the cylinder is then removed and the column spreads, undamped. The column is filled
 by a lattice of grains falling onto the floor; from the moment its top grain would land, the filling
-is damped (every grain's velocities decay with a 0.05 s time constant), which changes the state at
-rest little and cuts the seconds a soft fill takes to stop rebounding. Each phase runs until 99 % of
+is damped (every grain's velocities decay with a 0.05 s time constant), which cuts the seconds a soft
+fill takes to stop rebounding; it can also change the packing the fill reaches. Each phase runs until 99 % of
 the grains move slower than 2 cm/s, or slower than 20 cm/s with the height (settling) or radius
 (spreading) measured below staying within 0.3 % for 0.1 s (settling: at least 0.2 s after the damping
 starts; spreading: at least 0.5 s; at most 2.5 s). H0 and

@@ -173,7 +173,8 @@ double speed_p99(const World& world) {
 // Preparation only (filling a silo or a column, never a measured phase): from `from_time` on, every
 // dynamic body's velocities decay as exp(-t / time_constant) on top of the contact forces, like
 // Yade's global damping, so a fill that landed as a block stops rebounding in a few time constants.
-// The state at rest is the same (damping removes only motion); reaching it is seconds shorter.
+// It removes only motion, yet it changes the path to rest and so can change the packing reached
+// (the silo's base contact forces did change with it; docs/validation.md).
 struct SettleDamping {
   double from_time = 1e300;      // s after the phase starts
   double time_constant = 0.05;   // s
