@@ -417,6 +417,11 @@ def agreement(run, docs):
     ok_bed = abs(bed_diff) <= 0.02
     return f"""## GPU pipeline against the CPU reference (long runs, statistics)
 
+Produced by `scripts/bench.sh agreement` ({time.strftime('%Y-%m-%d')}, {os.cpu_count()} CPU cores, one process). The CPU
+reference is deterministic (sums in particle order: the same scene gives the same numbers run after
+run); the GPU pipeline's numbers have differed between runs, so one run's difference is one sample of
+its scatter.
+
 The same scenes on the CPU reference (double) and the GPU pipeline (float; renderer {renderer}):
 the trajectories part within a few hundred steps (float against double, chaotic contacts), so what must
 agree is the statistics. Tolerances were set before the run: heap angle 3 deg (as against LAMMPS),
