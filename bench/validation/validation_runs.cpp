@@ -189,15 +189,20 @@ void damp_velocities(World& world, double factor) {
   }
 }
 
-// Damping for a lattice that falls from its top onto the floor: from the moment its top grain
-// would land in free fall.
-SettleDamping damping_after_fall(const Scene& scene, const World& world) {
+// m: the height of the highest dynamic body's centre, where a falling lattice starts from.
+double lattice_top(const World& world) {
   double top = 0;
   for (std::size_t b = 0; b < world.bodies.size(); ++b) {
     if (world.bodies.motion[b] == MotionType::Dynamic) top = std::max(top, world.bodies.position[b].z());
   }
+  return top;
+}
+
+// Damping for a lattice that falls from its top onto the floor: from the moment its top grain
+// would land in free fall.
+SettleDamping damping_after_fall(const Scene& scene, const World& world) {
   SettleDamping damping;
-  damping.from_time = std::sqrt(2 * top / scene.gravity.norm());
+  damping.from_time = std::sqrt(2 * lattice_top(world) / scene.gravity.norm());
   return damping;
 }
 
@@ -238,9 +243,7 @@ double run_until_rest(CpuStepper& stepper, World& world, double min_time, double
 
 // A CPU stepper for a scene whose lattice falls from its top: dt bounded at that impact speed.
 CpuStepper tall_scene_stepper(Scene& scene, const World& world) {
-  double top = 0;
-  for (std::size_t b = 0; b < world.bodies.size(); ++b) top = std::max(top, world.bodies.position[b].z());
-  scene.simulation.max_impact_speed = std::sqrt(2 * scene.gravity.norm() * top);
+  scene.simulation.max_impact_speed = std::sqrt(2 * scene.gravity.norm() * lattice_top(world));
   StepSettings settings = scene.simulation.step;
   settings.dt = resolve_time_step(scene, world, nullptr);
   settings.check_energy = false;  // the runs take grains out (silo) or remove a wall (column)
