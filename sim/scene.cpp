@@ -338,6 +338,8 @@ void read_boundary(const toml::table& t, const fs::path& file, Scene& scene) {
         b.size = r.vector<2>("size", std::nullopt);
         if (!(b.size.array() > 0).all()) r.fail("size", "must be > 0 in both directions");
         b.hole_radius = r.non_negative("hole_radius", 0.0);
+        b.round_rim = r.choice("hole_rim", {"lattice", "round"}, 0) == 1;
+        if (b.round_rim && b.hole_radius == 0) r.fail("hole_rim", "needs a hole_radius > 0");
       }
       break;
     case BoundaryType::Box:

@@ -72,6 +72,9 @@ struct Boundary {
   Eigen::Vector3d point = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  // m, unit
   Eigen::Vector2d size = Eigen::Vector2d::Zero();  // m (rough plane extent along two in-plane axes)
   double hole_radius = 0;                          // m, a round hole around `point` (rough plane: an orifice)
+  // How the hole's edge is made: false = the lattice with the spheres reaching into the hole left out
+  // (a ragged edge: the opening is wider than 2 hole_radius); true = also lined by round_hole_rim.
+  bool round_rim = false;
   // box: open top; grains stay inside [min, max].
   Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();  // m
   // cylinder: inside of a vertical wall.
@@ -135,6 +138,14 @@ World make_world(const Scene& scene);
 
 // The time-step bound for the scene's contact kinds (grain-grain, grain-wall, grain-prop).
 TimeStepBound scene_time_step_bound(const Scene& scene, const World& world);
+
+// Offsets from the hole's centre of fixed spheres of `radius` lining a round hole in a rough plane
+// (in-plane axes t1, t2, normal n into the free side; sphere tops in the plane, as the lattice's):
+// centres on a circle of hole_radius + radius, at most `radius` apart, so the opening is a disc of
+// 2 hole_radius to within bumps of 0.14 radius (a lattice with the spheres reaching into the hole left
+// out opens up to a spacing wider, unevenly).
+std::vector<Eigen::Vector3d> round_hole_rim(const Eigen::Vector3d& t1, const Eigen::Vector3d& t2,
+                                            const Eigen::Vector3d& n, double hole_radius, double radius);
 
 // Releases a pour emitter's grains as time passes, at free lattice sites of its region.
 class PourEmitter {

@@ -29,10 +29,11 @@ std::string where(const Scene& scene, int line, std::string_view key) {
 }
 
 // A static body of touching (or `spacing`-spaced) spheres on a rectangular lattice whose tops lie
-// in the plane through `surface` with normal n; particles reaching into the hole are left out.
+// in the plane through `surface` with normal n; particles reaching into the hole are left out, and
+// a round rim lines the hole when asked.
 void add_rough_rectangle(World& world, const Eigen::Vector3d& surface, const Eigen::Vector3d& n,
                          const Eigen::Vector3d& t1, const Eigen::Vector3d& t2, const Eigen::Vector2d& size,
-                         double hole_radius, double radius, double spacing, std::uint16_t material) {
+                         double hole_radius, bool round_rim, double radius, double spacing, std::uint16_t material) {
   const int n1 = static_cast<int>(std::floor(size.x() / spacing)) + 1;
   const int n2 = static_cast<int>(std::floor(size.y() / spacing)) + 1;
   std::vector<Eigen::Vector3d> offsets;
@@ -42,6 +43,10 @@ void add_rough_rectangle(World& world, const Eigen::Vector3d& surface, const Eig
       if (hole_radius > 0 && std::hypot(a, b) < hole_radius + radius) continue;
       offsets.push_back(a * t1 + b * t2 - radius * n);
     }
+  }
+  if (round_rim) {
+    const auto rim = round_hole_rim(t1, t2, n, hole_radius, radius);
+    offsets.insert(offsets.end(), rim.begin(), rim.end());
   }
   if (offsets.empty()) return;
   BodyDesc desc;
@@ -96,8 +101,8 @@ void add_boundary(World& world, const Boundary& b) {
     case BoundaryType::Plane:
       if (b.rough) {
         const auto [t1, t2] = plane_axes(b.normal);
-        add_rough_rectangle(world, b.point, b.normal, t1, t2, b.size, b.hole_radius, b.particle_radius, b.spacing,
-                            b.material);
+        add_rough_rectangle(world, b.point, b.normal, t1, t2, b.size, b.hole_radius, b.round_rim, b.particle_radius,
+                            b.spacing, b.material);
       } else {
         world.walls.planes.push_back({b.point, b.normal, b.material});
       }
@@ -105,7 +110,7 @@ void add_boundary(World& world, const Boundary& b) {
     case BoundaryType::Box:
       for (const Face& f : box_faces(b)) {
         if (b.rough) {
-          add_rough_rectangle(world, f.point, f.normal, f.t1, f.t2, f.size, 0.0, b.particle_radius, b.spacing,
+          add_rough_rectangle(world, f.point, f.normal, f.t1, f.t2, f.size, 0.0, false, b.particle_radius, b.spacing,
                               b.material);
         } else {
           world.walls.planes.push_back({f.point, f.normal, b.material});
@@ -185,6 +190,21 @@ std::vector<Eigen::Vector3d> grain_sites_in_box(const Eigen::Vector3d& min, cons
     }
   }
   return sites;
+}
+
+std::vector<Eigen::Vector3d> round_hole_rim(const Eigen::Vector3d& t1, const Eigen::Vector3d& t2,
+                                            const Eigen::Vector3d& n, double hole_radius, double radius) {
+  const double circle = hole_radius + radius;
+  // Neighbours at most one radius apart along the circle: the gap between two spheres reaches at most
+  // radius (1 - cos 30 deg) = 0.134 radius beyond their inner edges, and no grain sphere fits through.
+  const int count = std::max(3, static_cast<int>(std::ceil(2 * std::numbers::pi * circle / radius)));
+  std::vector<Eigen::Vector3d> rim;
+  rim.reserve(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    const double angle = 2 * std::numbers::pi * i / count;
+    rim.push_back(circle * (std::cos(angle) * t1 + std::sin(angle) * t2) - radius * n);
+  }
+  return rim;
 }
 
 World make_world(const Scene& scene) {

@@ -3,8 +3,11 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
+#include <numbers>
 
 #include "core/error.h"
 #include "tests/test_support.h"
@@ -132,6 +135,62 @@ material = "sand"
   for (const auto& p : positions) {
     EXPECT_NEAR(p.z(), -1e-3, 1e-15);  // tops of the spheres at the plane
     EXPECT_GE(p.head<2>().norm() + 1e-12, 0.004 + 1e-3);
+  }
+}
+
+TEST(Scene, RoundHoleRimMakesTheOpeningADiscOfTheHoleDiameter) {
+  const double hole = 0.004, r = 1e-3;
+  const auto text = [&](std::string_view rim) {
+    return std::string(kMinimal) + fmt::format(R"(
+[[boundary]]
+type = "plane"
+rough = true
+size = [0.02, 0.02]
+hole_radius = {}
+hole_rim = "{}"
+particle_radius = {}
+material = "sand"
+)", hole, rim, r);
+  };
+  // Seen from above at the spheres' equator: the largest empty disc around the axis (the nearest sphere
+  // edge), and the farthest reach of the opening along 3600 rays (where a ray first meets a sphere).
+  const auto opening = [&](const World& w) {
+    const auto positions = particle_positions(w);
+    double nearest = 1e9, farthest = 0;
+    for (const auto& c : positions) nearest = std::min(nearest, c.head<2>().norm() - r);
+    for (int k = 0; k < 3600; ++k) {
+      const Eigen::Vector2d dir(std::cos(k * std::numbers::pi / 1800), std::sin(k * std::numbers::pi / 1800));
+      double hit = 1e9;
+      for (const auto& c : positions) {
+        const double along = c.head<2>().dot(dir), across2 = c.head<2>().squaredNorm() - along * along;
+        if (along > 0 && across2 < r * r) hit = std::min(hit, along - std::sqrt(r * r - across2));
+      }
+      farthest = std::max(farthest, hit);
+    }
+    return std::pair{nearest, farthest};
+  };
+  const auto [lattice_near, lattice_far] = opening(make_world(parse_scene(text("lattice"), "scene.toml")));
+  const World round = make_world(parse_scene(text("round"), "scene.toml"));
+  const auto [round_near, round_far] = opening(round);
+  EXPECT_NEAR(round_near, hole, 1e-12);
+  EXPECT_LT(round_far, hole + 0.14 * r);  // bumps between rim spheres of at most 0.134 r
+  EXPECT_GT(lattice_far, hole + 0.5 * r);  // the lattice's edge is ragged by a good part of a spacing
+  EXPECT_GE(lattice_near + 1e-12, hole);
+  ASSERT_EQ(round.bodies.size(), 1u);  // the rim belongs to the plate's static body
+  for (const auto& p : particle_positions(round)) EXPECT_NEAR(p.z(), -r, 1e-15);
+  try {
+    parse_scene(std::string(kMinimal) + R"(
+[[boundary]]
+type = "plane"
+rough = true
+size = [0.02, 0.02]
+hole_rim = "round"
+particle_radius = 1.0e-3
+material = "sand"
+)", "scene.toml");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("hole_rim: needs a hole_radius > 0"), std::string::npos) << e.what();
   }
 }
 
