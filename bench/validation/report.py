@@ -122,20 +122,34 @@ ring, fitted from the edge of the flat top, above 80 % of the height, out to 20 
 """
 
 
-def orifice_open_diameter(D, plate_radius=COARSE_RADIUS, cell=2e-4):
+def round_rim_sites(D, plate_radius=COARSE_RADIUS):
+    """(x, y) of the rim spheres sim/scene_world.cpp round_hole_rim puts around a hole of diameter D."""
+    circle = D / 2 + plate_radius
+    count = max(3, int(np.ceil(2 * np.pi * circle / plate_radius)))
+    angle = 2 * np.pi * np.arange(count) / count
+    return circle * np.cos(angle), circle * np.sin(angle)
+
+
+def orifice_open_diameter(D, rim, plate_radius=COARSE_RADIUS, cell=2e-4):
     """Diameter (m) of the disc whose area is the hole's, for the hole validation_runs.cpp cuts into the
-    rough plate (touching spheres on a square lattice, centres within D/2 + r of the axis removed):
-    the area, seen from above, farther than r from every remaining sphere centre and connected to the axis."""
+    rough plate (touching spheres on a square lattice, centres within D/2 + r of the axis removed; with
+    `rim`, lined by the ring of round_rim_sites): the area, seen from above, farther than r from every
+    remaining sphere centre and connected to the axis."""
     from scipy import ndimage
     spacing = 2 * plate_radius
     reach = D / 2 + 3 * spacing
     sites = np.arange(-np.ceil(reach / spacing), np.ceil(reach / spacing) + 1) * spacing
     X, Y = np.meshgrid(sites, sites)
     keep = np.hypot(X, Y) >= D / 2 + plate_radius
+    xs, ys = list(X[keep]), list(Y[keep])
+    if rim:
+        rx, ry = round_rim_sites(D, plate_radius)
+        xs += list(rx)
+        ys += list(ry)
     g = np.arange(-reach, reach, cell)
     GX, GY = np.meshgrid(g, g)
     free = np.ones(GX.shape, bool)
-    for x, y in zip(X[keep], Y[keep]):
+    for x, y in zip(xs, ys):
         free &= (GX - x) ** 2 + (GY - y) ** 2 > plate_radius ** 2
     labels, _ = ndimage.label(free)
     hole = labels == labels[len(g) // 2, len(g) // 2]
@@ -146,6 +160,10 @@ def silo(run, docs):
     d = np.genfromtxt(os.path.join(run, "silo.csv"), delimiter=",", names=True)
     info = np.genfromtxt(os.path.join(run, "silo_fill.csv"), delimiter=",", names=True)
     width, fill, grains = float(info["width_m"]), float(info["fill_m"]), int(info["grains"])
+    runs_file = os.path.join(run, "silo_runs.csv")
+    runs = np.atleast_1d(np.genfromtxt(runs_file, delimiter=",", names=True)) if os.path.exists(runs_file) else None
+    rim = runs is not None and "rim_spheres" in runs.dtype.names  # runs before the round rim cut a ragged hole
+    removed = runs["removed_on_rim"].astype(int) if rim else np.array([0])
     rows = []
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
     for D in np.unique(d["orifice_m"]):
@@ -174,7 +192,7 @@ def silo(run, docs):
     # orifices would fit almost anything).
     n_exp = float(np.polyfit(np.log(D - 1.5 * COARSE_D_EQ), np.log(W), 1)[0])
     n_exp_k0 = float(np.polyfit(np.log(D), np.log(W), 1)[0])  # informative, not a criterion
-    widening = np.array([orifice_open_diameter(x) - x for x in D]) / COARSE_D_EQ
+    widening = np.array([orifice_open_diameter(x, rim) - x for x in D]) / COARSE_D_EQ
     a_open, b_open = np.polyfit(D + widening * COARSE_D_EQ, W ** 0.4, 1)
     k_open = -b_open / a_open / COARSE_D_EQ
     Dfit = np.linspace(D.min() * 0.9, D.max() * 1.1, 50)
@@ -189,6 +207,20 @@ def silo(run, docs):
     cond3 = fill > 1.2 * width
     out_max = max(r[2] for r in rows)
     conforming = cond1 and cond2 and cond3
+    if rim:
+        opening = (f"The plate's particles within D/2 + r of the axis are taken away and a ring of its spheres "
+                   f"(centres on a circle of D/2 + r, at most r apart) lines the hole, so the opening is a disc of D: "
+                   f"its open area is that of a disc {widening.min():+.3f} to {widening.max():+.3f} d wider. Grains "
+                   f"resting in the lattice hollows where a rim sphere now stands ({removed.min()}-{removed.max()} per "
+                   f"orifice, against {int(min(r[2] for r in rows))}+ discharged) are taken out before the discharge starts.")
+        orifice_note = (f"With the orifice now a disc of D, the empty annulus at 5/2 is k = {k:.2f} d "
+                        f"(Beverloo's is about 1.5 d for spheres).")
+    else:
+        opening = ("The plate's particles within D/2 + r of the axis are taken away (no rim: the lattice's edge "
+                   "is ragged).")
+        orifice_note = (f"The orifice cut from the lattice has the open area of a disc {widening.min():.2f}-"
+                        f"{widening.max():.2f} d wider than D; against that diameter the fit at 5/2 gives "
+                        f"k = {k_open:.2f}.")
     table = "\n".join(f"| {x * 1e3:.1f} | {x / COARSE_D_EQ:.2f} | {w * 1e3:.0f} | {t} |" for x, w, t in rows)
     return f"""## Silo discharge against orifice diameter (Beverloo)
 
@@ -199,8 +231,8 @@ d = {COARSE_D_EQ * 1e3:.1f} mm volume-equivalent, E = 1 MPa, mu = 0.5, symplecti
 falls as a lattice about 4 m onto the plate; from the moment its top grain would land, the settling
 is damped (velocities decay with a 0.05 s time constant) until 99 % of the grains move slower than
 2 cm/s or the fill height stays within 0.3 % for 0.1 s. Each orifice then opens in a copy of that
-settled fill (the plate's particles within D/2 of the axis are taken away) and the silo discharges,
-undamped, for 0.35 s; the rate W is the slope of the discharged mass from 0.1 s on.
+settled fill and the silo discharges, undamped, for 0.35 s; the rate W is the slope of the discharged
+mass from 0.1 s on. {opening}
 Grains 5 cm below the plate leave the simulation. CPU reference, dt = {float(info["dt_s"]) * 1e6:.0f} us.
 
 {img}
@@ -220,10 +252,7 @@ Grains 5 cm below the plate leave the simulation. CPU reference, dt = {float(inf
   (rho_b = {packing:.2f} rho, the settled fill's); with k fixed at 1.5 the free exponent is
   {n_exp:.2f} (5/2 expected: **{'meets' if abs(n_exp - 2.5) < 0.5 else 'does not meet'}** it within 0.5,
   the tolerance set before the run). Not a criterion, added after a run found k ~ 0: with k fixed at 0
-  the free exponent is {n_exp_k0:.2f}. So the rate scales as D^(5/2) but without Beverloo's empty annulus
-  of about 1.5 d. Part of that is the orifice: cut from a plate of touching 10 mm spheres, its rim is
-  ragged, and its open area is that of a disc {widening.min():.2f}-{widening.max():.2f} d wider than D; against that
-  area-equivalent diameter the fit at 5/2 gives k = {k_open:.2f}, still short of 1.5.
+  the free exponent is {n_exp_k0:.2f}. {orifice_note}
 - What it can show: {'the silo meets all three size conditions, so the 5/2 law is the one to expect; ' if conforming else 'the silo does not meet every size condition, so the fit is no test of the law; '}
   the orifices span {D.min() / COARSE_D_EQ:.0f}-{D.max() / COARSE_D_EQ:.0f} d (the width, {width / COARSE_D_EQ:.0f} d, bounds D
   through D + 30 d; a tetrahedron is {2 * BOUNDING_RADIUS / COARSE_D_EQ:.1f} d across, so 4 d is under three grains and
@@ -256,31 +285,76 @@ def tail_fits(fn):
             "peak": float(centres[int(np.argmax(hist))]), "above3": int((fn > 3).sum()), "n": len(fn)}
 
 
-def forces(run, docs):
-    d = np.genfromtxt(os.path.join(run, "contact_forces.csv"), delimiter=",", names=True)
+def normalised_forces(file):
+    """Normal forces of one settled fill, each over its reference: at the base over the mean base force
+    (as the carbon paper under Mueth et al.'s cylinder measures them), in the bulk over the mean of its
+    5 cm layer (the load grows with depth)."""
+    d = np.genfromtxt(file, delimiter=",", names=True)
     d = d[d["normal_force_N"] > 0]
     base = d[d["base"] == 1]
     bulk = d[d["base"] == 0]
-    # The base: forces over their mean, as the carbon paper under Mueth et al.'s cylinder measures them.
-    f_base = base["normal_force_N"] / base["normal_force_N"].mean()
-    # The bulk: the mean load grows with depth, so each force is taken over the mean of its 5 cm layer.
     layer = np.floor(bulk["z_m"] / 0.05).astype(int)
     layer_mean = {k: bulk["normal_force_N"][layer == k].mean() for k in np.unique(layer)}
-    f_bulk = bulk["normal_force_N"] / np.array([layer_mean[k] for k in layer])
-    fits = {"base": tail_fits(f_base), "bulk": tail_fits(f_bulk)}
+    per_grain = None  # each grain's vertical load on the floor over their mean (files with a grain column)
+    if "grain" in d.dtype.names:
+        _, which = np.unique(base["grain"].astype(np.int64), return_inverse=True)
+        load = np.bincount(which, weights=base["fz_N"])
+        load = load[load > 0]
+        per_grain = load / load.mean()
+    return (base["normal_force_N"] / base["normal_force_N"].mean(),
+            bulk["normal_force_N"] / np.array([layer_mean[k] for k in layer]), per_grain)
+
+
+def force_fills(run):
+    """(label, grains, fill height m, contact-force file) of every settled fill in the run: the silo's,
+    and the extra piles of `tetrasand_validation_runs OUT forces`."""
+    fills = []
+    if os.path.exists(os.path.join(run, "contact_forces.csv")):
+        info = np.genfromtxt(os.path.join(run, "silo_fill.csv"), delimiter=",", names=True)
+        fills.append(("silo fill (seed 17)", int(info["grains"]), float(info["fill_m"]),
+                      os.path.join(run, "contact_forces.csv")))
+    extra = os.path.join(run, "forces_fills.csv")
+    if os.path.exists(extra):
+        for r in np.atleast_1d(np.genfromtxt(extra, delimiter=",", names=True)):
+            fills.append((f"pile, seed {int(r['seed'])}", int(r["grains"]), float(r["fill_m"]),
+                          os.path.join(run, f"contact_forces_seed{int(r['seed'])}.csv")))
+    return fills
+
+
+def forces(run, docs):
+    fills = force_fills(run)
+    per_fill = []
+    pooled = {"base": [], "bulk": [], "grain": []}
+    for label, grains, height, file in fills:
+        f_base, f_bulk, f_grain = normalised_forces(file)
+        pooled["base"].append(f_base)
+        pooled["bulk"].append(f_bulk)
+        if f_grain is not None:
+            pooled["grain"].append(f_grain)
+        per_fill.append((label, grains, height, tail_fits(f_base), tail_fits(f_bulk),
+                         tail_fits(f_grain) if f_grain is not None else None))
+    fits = {name: tail_fits(np.concatenate(v)) for name, v in pooled.items() if v}
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     for name, style in (("bulk", "o"), ("base", "s")):
         t = fits[name]
         keep = t["counts"] > 0
         ax.semilogy(t["centres"][keep], t["hist"][keep], style, ms=4,
-                    label=f"{name}: {t['n']} contacts, best tail exp(-c f^{t['alpha']:.2f})")
+                    label=f"{name}, {len(fills)} fills: {t['n']} contacts, best tail exp(-c f^{t['alpha']:.2f})")
+    if "grain" in fits:
+        t = fits["grain"]
+        keep = t["counts"] > 0
+        ax.semilogy(t["centres"][keep], t["hist"][keep], "^", ms=4,
+                    label=f"base load per grain: {t['n']} grains, best tail exp(-c f^{t['alpha']:.2f})")
+    for label, _, _, base, _, _ in per_fill:
+        keep = base["counts"] > 0
+        ax.semilogy(base["centres"][keep], base["hist"][keep], "-", lw=0.6, alpha=0.6, label=f"base, {label}")
     t = fits["bulk"]
     x = np.linspace(1, t["centres"][t["counts"] >= 5].max(), 50)
     ax.semilogy(x, np.exp(np.polyval(t["p_exp"], x)), "-", color="grey", label=f"bulk, exponential tail, beta = {t['beta']:.2f}")
     ax.semilogy(x, np.exp(np.polyval(t["p_gauss"], x ** 2)), "--", color="grey", label="bulk, Gaussian tail")
     ax.set_xlabel("f = F_n / <F_n>")
     ax.set_ylabel("P(f)")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=6)
     img = save(fig, docs, "contact_forces.png")
     in_range = lambda a: 1.1 <= a <= 1.9
 
@@ -290,31 +364,59 @@ def forces(run, docs):
         return (f"| {label} | {t['n']} | {t['peak']:.1f} | {t['beta']:.2f} | {t['alpha']:.2f} | "
                 f"{'yes' if in_range(t['alpha']) else 'no'} | {t['e_exp']:.2f} / {t['e_gauss']:.2f} ({better}) | {t['above3']} |")
 
+    grain_cells = lambda g: f"{g['n']} | {g['beta']:.2f} | {g['alpha']:.2f}" if g else "- | - | -"
+    fill_rows = "\n".join(
+        f"| {label} | {grains:,} | {height * 1e3:.0f} | {base['n']} | {base['beta']:.2f} | {base['alpha']:.2f} | "
+        f"{grain_cells(g)} | {bulk['n']} | {bulk['alpha']:.2f} |" for label, grains, height, base, bulk, g in per_fill)
+    grain_row = f"\n{row('grain', 'base load per grain')}" if "grain" in fits else ""
+    grain_text = (f"\n- Not a criterion, added after the runs above found the base tail heavy: Mueth et al.'s carbon "
+                  f"paper records the load of each bead on the base, one contact per bead, whereas a tetrahedral "
+                  f"grain on the floor's spheres spreads its load over several contacts of uneven share. Summed "
+                  f"per grain (the vertical force each grain puts on the floor, in the fills that record it: "
+                  f"{fits['grain']['n']} grains), the base tail is exp(-{fits['grain']['beta']:.2f} f) "
+                  f"(beta ~ 1.5 expected) with best alpha {fits['grain']['alpha']:.2f}."
+                  if "grain" in fits else "")
+    base_alphas = np.array([p[3]["alpha"] for p in per_fill])  # per fill: (label, grains, height, base, bulk, grain)
+    base_betas = np.array([p[3]["beta"] for p in per_fill])
+    bulk_alphas = np.array([p[4]["alpha"] for p in per_fill])
+    several = len(fills) > 1
+    spread = (f" Over the {len(fills)} fills the base alpha ranges {base_alphas.min():.2f}-{base_alphas.max():.2f} and "
+              f"beta {base_betas.min():.2f}-{base_betas.max():.2f}, the bulk alpha {bulk_alphas.min():.2f}-{bulk_alphas.max():.2f}; "
+              f"{int(sum(in_range(a) for a in base_alphas))} of {len(fills)} base tails and "
+              f"{int(sum(in_range(a) for a in bulk_alphas))} of {len(fills)} bulk tails are in 1.1-1.9 on their own."
+              if several else "")
     return f"""## Normal contact forces in a sand pile at rest in a cylinder (thesis 7.2)
 
-The settled fill of the silo above (before any orifice opens) is a sand pile at rest in a cylinder,
-the case of the thesis's table 7.1 and of Mueth, Jaeger & Nagel 1998. Normal forces of every contact
-between particles of different bodies: at the base (grain on a floor particle), each over the mean
-base force; in the bulk (grain on grain), each over the mean of its 5 cm layer, since the load grows
-with depth. Tail fits over histogram bins (width 0.2) holding at least 5 forces.
+Settled fills of the silo above (before any orifice opens) are sand piles at rest in a cylinder, the
+case of the thesis's table 7.1 and of Mueth, Jaeger & Nagel 1998: the silo's own fill and
+{len(fills) - 1} more piles in the same cylinder with other seeds (other lattice jitters and
+orientations), settled the same way (`tetrasand_validation_runs OUT forces`). Normal forces of every
+contact between particles of different bodies: at the base (grain on a floor particle), each over its
+fill's mean base force; in the bulk (grain on grain), each over the mean of its fill's 5 cm layer,
+since the load grows with depth. The fills are pooled; tail fits over histogram bins (width 0.2)
+holding at least 5 forces.
 
 {img}
 
-| contacts | count | peak of P(f) at f | beta, exp(-beta f) | alpha, exp(-c f^alpha) | alpha in 1.1-1.9 | residuals exp / Gauss | above f = 3 |
+| contacts (all fills) | count | peak of P(f) at f | beta, exp(-beta f) | alpha, exp(-c f^alpha) | alpha in 1.1-1.9 | residuals exp / Gauss | above f = 3 |
 |---|---|---|---|---|---|---|---|
 {row("bulk", "bulk")}
-{row("base", "base")}
+{row("base", "base")}{grain_row}
+
+| fill | grains | height (mm) | base contacts | base beta | base alpha | grains on the base | per-grain beta | per-grain alpha | bulk contacts | bulk alpha |
+|---|---|---|---|---|---|---|---|---|---|---|
+{fill_rows}
 
 - Expected: a plateau or peak near or below f = 1 and a tail that falls at least exponentially:
   P ~ exp(-beta f) with beta ~ 1.5 at the base (Mueth et al. 1998), and for large systems faster,
   exp(-c f^alpha) with alpha = 1.5 +- 0.4 (Mueth et al. 1998) or 1.7 +- 0.1 (van Eerd et al. 2007,
   DEM), the thesis's equation 7.2.
-- Measured: peak below f = 1.5 in the bulk: **{'yes' if fits['bulk']['peak'] < 1.5 else 'no'}**, at the base:
+- Measured (all fills): peak below f = 1.5 in the bulk: **{'yes' if fits['bulk']['peak'] < 1.5 else 'no'}**, at the base:
   **{'yes' if fits['base']['peak'] < 1.5 else 'no'}**; bulk tail exponent alpha = {fits['bulk']['alpha']:.2f}
   (**{'meets' if in_range(fits['bulk']['alpha']) else 'does not meet'}** the literature's 1.1-1.9); base tail
   alpha = {fits['base']['alpha']:.2f} (**{'meets' if in_range(fits['base']['alpha']) else 'does not meet'}** it) on
-  {fits['base']['n']} base contacts. The small version is the test
-  `ContactForces.SettledBedCarriesItsWeightOnBroadlySpreadNormalForces`.
+  {fits['base']['n']} base contacts.{spread} The small version is the test
+  `ContactForces.SettledBedCarriesItsWeightOnBroadlySpreadNormalForces`.{grain_text}
 """
 
 
@@ -470,7 +572,8 @@ def main():
              section(repose, ["repose.csv"], "Angle of repose against friction"),
              section(column, ["column.csv"], "Column collapse: runout against aspect ratio"),
              section(silo, ["silo.csv", "silo_fill.csv"], "Silo discharge against orifice diameter (Beverloo)"),
-             section(forces, ["contact_forces.csv"], "Normal contact forces in a sand pile at rest in a cylinder")]
+             section(forces, ["contact_forces.csv", "silo_fill.csv"],
+                     "Normal contact forces in a sand pile at rest in a cylinder")]
     fill = os.path.join(run, "silo_fill.csv")
     silo_grains = int(np.genfromtxt(fill, delimiter=",", names=True)["grains"]) if os.path.exists(fill) else 0
     columns = os.path.join(run, "column.csv")

@@ -251,19 +251,21 @@ CpuStepper tall_scene_stepper(Scene& scene, const World& world) {
 }
 
 // The normal contact forces of a state at rest, one row per contact between particles of different
-// bodies (smooth walls left out): "normal_force_N,z_m,r_m,base", z and r the contact point's height
-// and distance from the axis, base = 1 where the partner is a static particle (the rough floor).
+// bodies (smooth walls left out): "normal_force_N,z_m,r_m,base,grain,fz_N", z and r the contact
+// point's height and distance from the axis, base = 1 where the partner is a static particle (the
+// rough floor), grain the body of the grain's particle and fz_N the force's vertical part on it (summed
+// per grain at the base, the load each grain puts on the floor, as Mueth et al.'s carbon paper sees it).
 void write_contact_forces(const World& world, const StepSettings& settings, const fs::path& file) {
   CpuStepper stepper(world, settings);
   const std::vector<Eigen::Vector3d> x = particle_positions(world);
-  std::string csv = "normal_force_N,z_m,r_m,base\n";
-  for (const ContactRecord& c : stepper.contacts(world)) {
+  std::string csv = "normal_force_N,z_m,r_m,base,grain,fz_N\n";
+  for (const ContactRecord& c : stepper.contacts(world)) {  // c.particle is a grain's (dynamic) particle
     if (c.partner < 0) continue;
     const auto j = static_cast<std::size_t>(c.partner);
     const Eigen::Vector3d normal = (x[c.particle] - x[j]).normalized();
     const bool base = world.bodies.motion[world.particles.body[j]] == MotionType::Static;
-    csv += fmt::format("{:.6e},{:.5f},{:.5f},{}\n", std::abs(c.force.dot(normal)), c.point.z(), c.point.head<2>().norm(),
-                       base ? 1 : 0);
+    csv += fmt::format("{:.6e},{:.5f},{:.5f},{},{},{:.6e}\n", std::abs(c.force.dot(normal)), c.point.z(),
+                       c.point.head<2>().norm(), base ? 1 : 0, world.particles.body[c.particle], c.force.z());
   }
   ts::write_file_atomically(file, csv);
 }
@@ -276,34 +278,52 @@ void write_contact_forces(const World& world, const StepSettings& settings, cons
 // (round_hole_rim), and discharges undamped for 0.35 s. The settled fill's contact forces are written
 // too. Discharged grains (5 cm below the plate) are parked far below as static bodies, so they cost
 // nothing and pile up nowhere.
-void silo(const fs::path& out, const fs::path& scene_file) {
-  constexpr double kDischargeTime = 0.35;  // s after the orifice opens; the rate is fitted from 0.1 s
-  Scene scene = scene_file.empty() ? reference("silo_mankoc.toml") : load_scene(scene_file);
-  World settled = make_world(scene);
-  CpuStepper settle = tall_scene_stepper(scene, settled);
-  const SettleDamping damping = damping_after_fall(scene, settled);
-  const double dt = settle.settings().dt;
-  const std::size_t grains = scene.emitters.at(0).count;
-  std::fprintf(stderr, "silo: %zu grains, dt = %.3g s, settling\n", grains, dt);
+// A silo scene's fill (its first emitter) dropped as a lattice and settled on the closed plate,
+// damped once the lattice has landed; its contact forces go to `forces_file`.
+struct SettledFill {
+  World world;
+  StepSettings settings;
+  std::size_t grains = 0;
+  double settle_time = 0, fill = 0, wall_seconds = 0;  // s simulated, m (95th percentile of centre heights), s wall
+};
+
+SettledFill settle_fill(Scene& scene, const std::string& label, const fs::path& forces_file) {
+  SettledFill f;
+  f.world = make_world(scene);
+  CpuStepper settle = tall_scene_stepper(scene, f.world);
+  const SettleDamping damping = damping_after_fall(scene, f.world);
+  f.settings = settle.settings();
+  f.grains = scene.emitters.at(0).count;
+  std::fprintf(stderr, "%s: %zu grains, dt = %.3g s, settling\n", label.c_str(), f.grains, f.settings.dt);
   const auto wall = std::chrono::steady_clock::now();
-  auto fill_height = [&] {  // m, the 95th percentile of the grain centres' heights
+  auto fill_height = [&] {
     std::vector<double> tops;
-    for (std::size_t b = 0; b < settled.bodies.size(); ++b) {
-      if (settled.bodies.motion[b] == MotionType::Dynamic) tops.push_back(settled.bodies.position[b].z());
+    for (std::size_t b = 0; b < f.world.bodies.size(); ++b) {
+      if (f.world.bodies.motion[b] == MotionType::Dynamic) tops.push_back(f.world.bodies.position[b].z());
     }
     return percentile(tops, 0.95);
   };
-  const double settle_time =
-      run_until_rest(settle, settled, damping.from_time + 0.2, scene.simulation.duration, 0.02, "silo settle",
-                     fill_height, damping);
-  const double fill = fill_height();
-  std::string info = fmt::format("grains,settle_s,fill_m,width_m,dt_s,settle_wall_s\n{},{:.3f},{:.4f},{:.4f},{:.4g},{:.0f}\n",
-                                 grains, settle_time, fill, 2 * scene.boundaries.at(0).radius, dt,
-                                 std::chrono::duration<double>(std::chrono::steady_clock::now() - wall).count());
-  ts::write_file_atomically(out / "silo_fill.csv", info);
-  // The settled fill is a sand pile at rest in a cylinder, where the thesis (table 7.1) and Mueth et
+  f.settle_time = run_until_rest(settle, f.world, damping.from_time + 0.2, scene.simulation.duration, 0.02,
+                                 label + " settle", fill_height, damping);
+  f.fill = fill_height();
+  f.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall).count();
+  // A settled fill is a sand pile at rest in a cylinder, where the thesis (table 7.1) and Mueth et
   // al. 1998 measure the normal contact-force distribution.
-  write_contact_forces(settled, settle.settings(), out / "contact_forces.csv");
+  write_contact_forces(f.world, f.settings, forces_file);
+  return f;
+}
+
+void silo(const fs::path& out, const fs::path& scene_file) {
+  constexpr double kDischargeTime = 0.35;  // s after the orifice opens; the rate is fitted from 0.1 s
+  Scene scene = scene_file.empty() ? reference("silo_mankoc.toml") : load_scene(scene_file);
+  const SettledFill filled = settle_fill(scene, "silo", out / "contact_forces.csv");
+  const World& settled = filled.world;
+  const double dt = filled.settings.dt;
+  const std::size_t grains = filled.grains;
+  ts::write_file_atomically(out / "silo_fill.csv",
+                            fmt::format("grains,settle_s,fill_m,width_m,dt_s,settle_wall_s\n{},{:.3f},{:.4f},{:.4f},{:.4g},{:.0f}\n",
+                                        grains, filled.settle_time, filled.fill, 2 * scene.boundaries.at(0).radius, dt,
+                                        filled.wall_seconds));
 
   const double d = 2 * scene.grain.radius * std::cbrt(4.0);  // m, volume-equivalent diameter
   std::string csv = "orifice_m,time_s,discharged\n";
@@ -356,7 +376,7 @@ void silo(const fs::path& out, const fs::path& scene_file) {
     std::sort(overlapping.begin(), overlapping.end());
     overlapping.erase(std::unique(overlapping.begin(), overlapping.end()), overlapping.end());
     for (std::size_t k : overlapping) park(k);
-    CpuStepper stepper(world, settle.settings());
+    CpuStepper stepper(world, filled.settings);
     std::size_t parked = 0;
     const auto start = std::chrono::steady_clock::now();
     const auto steps = static_cast<std::int64_t>(std::ceil(kDischargeTime / dt));
@@ -377,6 +397,22 @@ void silo(const fs::path& out, const fs::path& scene_file) {
     runs += fmt::format("{:.5f},{},{},{},{:.1f}\n", orifice, grains, rim_offsets.size(), overlapping.size(), seconds);
     ts::write_file_atomically(out / "silo.csv", csv);  // after each orifice: a stopped run keeps its rows
     ts::write_file_atomically(out / "silo_runs.csv", runs);
+  }
+}
+
+// More piles at rest for the contact-force distribution, whose base tail one fill does not settle:
+// the silo's cylinder filled with `grains` per seed (seeds 1, 2, 3: other lattice jitters and
+// orientations), each settled as the silo's fill is. One contact_forces_seedN.csv per seed and a
+// forces_fills.csv of the fills.
+void forces(const fs::path& out, std::size_t grains) {
+  std::string fills = "seed,grains,settle_s,fill_m,settle_wall_s\n";
+  for (std::uint64_t seed : {1, 2, 3}) {
+    Scene scene = reference("silo_mankoc.toml");
+    scene.emitters.at(0).count = grains;
+    scene.emitters.at(0).seed = seed;
+    const SettledFill f = settle_fill(scene, fmt::format("pile seed {}", seed), out / fmt::format("contact_forces_seed{}.csv", seed));
+    fills += fmt::format("{},{},{:.3f},{:.4f},{:.0f}\n", seed, f.grains, f.settle_time, f.fill, f.wall_seconds);
+    ts::write_file_atomically(out / "forces_fills.csv", fills);  // after each seed: a stopped run keeps its rows
   }
 }
 
@@ -485,7 +521,7 @@ void agreement(const fs::path& out, const std::string& part) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|column|all|agreement[-heap|-silo|-bed]]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|forces [GRAINS]|column|all|agreement[-heap|-silo|-bed]]\n", argv[0]);
     return 2;
   }
   try {
@@ -496,6 +532,7 @@ int main(int argc, char** argv) {
     if (what == "repose" || what == "all") repose(out);
     if (what == "column" || what == "all") column(out);
     if (what == "silo" || what == "all") silo(out, what == "silo" && argc > 3 ? fs::path(argv[3]) : fs::path());
+    if (what == "forces" || what == "all") forces(out, what == "forces" && argc > 3 ? std::stoul(argv[3]) : 40000);
     if (what == "agreement") agreement(out, "all");
     if (what.rfind("agreement-", 0) == 0) agreement(out, what.substr(10));
     return 0;
