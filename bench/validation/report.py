@@ -380,6 +380,9 @@ def forces(run, docs):
     base_betas = np.array([p[3]["beta"] for p in per_fill])
     bulk_alphas = np.array([p[4]["alpha"] for p in per_fill])
     several = len(fills) > 1
+    others = (f"the silo's own fill and {len(fills) - 1} more piles in the same cylinder with other seeds (other "
+              f"lattice jitters and orientations), settled the same way (`tetrasand_validation_runs OUT forces`)"
+              if several else "the silo's own fill")
     spread = (f" Over the {len(fills)} fills the base alpha ranges {base_alphas.min():.2f}-{base_alphas.max():.2f} and "
               f"beta {base_betas.min():.2f}-{base_betas.max():.2f}, the bulk alpha {bulk_alphas.min():.2f}-{bulk_alphas.max():.2f}; "
               f"{int(sum(in_range(a) for a in base_alphas))} of {len(fills)} base tails and "
@@ -388,9 +391,7 @@ def forces(run, docs):
     return f"""## Normal contact forces in a sand pile at rest in a cylinder (thesis 7.2)
 
 Settled fills of the silo above (before any orifice opens) are sand piles at rest in a cylinder, the
-case of the thesis's table 7.1 and of Mueth, Jaeger & Nagel 1998: the silo's own fill and
-{len(fills) - 1} more piles in the same cylinder with other seeds (other lattice jitters and
-orientations), settled the same way (`tetrasand_validation_runs OUT forces`). Normal forces of every
+case of the thesis's table 7.1 and of Mueth, Jaeger & Nagel 1998: {others}. Normal forces of every
 contact between particles of different bodies: at the base (grain on a floor particle), each over its
 fill's mean base force; in the bulk (grain on grain), each over the mean of its fill's 5 cm layer,
 since the load grows with depth. The fills are pooled; tail fits over histogram bins (width 0.2)
@@ -592,22 +593,25 @@ def main():
     silo_grains = int(np.genfromtxt(fill, delimiter=",", names=True)["grains"]) if os.path.exists(fill) else 0
     columns = os.path.join(run, "column.csv")
     column_grains = int(np.genfromtxt(columns, delimiter=",", names=True)["grains"][0]) if os.path.exists(columns) else 0
+    extra_piles = max(0, len(force_fills(run)) - 1) if os.path.exists(fill) else 0
+    piles = f" and {extra_piles} more pil{'es' if extra_piles > 1 else 'e'}" if extra_piles else ""
+    note = os.path.join(run, "NOTE.md")  # how this run was made, when it was not one plain command
+    made = (": see the note below for which parts ran when" if os.path.exists(note)
+            else " in one run:\nevery section below except the last comes from it")
     header = f"""# Physical validation
 
-Produced by `scripts/bench.sh validation` ({time.strftime('%Y-%m-%d')}, {os.cpu_count()} CPU cores) in one run:
-every section below except the last comes from it. All of them ran on the CPU reference (double
+Produced by `scripts/bench.sh validation` ({time.strftime('%Y-%m-%d')}, {os.cpu_count()} CPU cores){made}. All of them ran on the CPU reference (double
 precision; no NVIDIA GPU was lent to this project's sessions, and on Mesa's llvmpipe the GPU pipeline
 is slower than the CPU reference). Tetrahedral grains of four touching spheres, quartz density,
 E = 1 MPa in the scene runs. The restitution run is one r = 1 mm sphere; the angle of repose (4 heaps of
 3,000 grains), the column collapse (4 columns of {column_grains:,} grains), the silo ({silo_grains:,} grains, sized to the
-conditions of Mankoc et al. 2007) and the contact forces (that silo's settled fill) use coarse r = 5 mm
+conditions of Mankoc et al. 2007) and the contact forces (that silo's settled fill{piles}) use coarse r = 5 mm
 grains, whose longer time step covers the same number of grain diameters in fewer steps.
 
 The same contact law run by LAMMPS (through `tetrasand export lammps`) settles beds, rebounds grains and
 builds heaps like tetrasand does: see the section "Simulation against LAMMPS" of docs/benchmarks.md,
 produced by `scripts/bench.sh peers-sim`.
 """
-    note = os.path.join(run, "NOTE.md")  # how this run was made, when it was not one plain command
     if os.path.exists(note):
         header += "\n" + open(note).read()
     text = header + "\n" + "\n".join(parts) + "\n" + AGREEMENT_START + kept + AGREEMENT_END
