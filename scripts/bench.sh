@@ -18,7 +18,7 @@
 #               sampler's rounds x iterations trade -> section sampler of docs/benchmarks.md (~10 min)
 #   validation  restitution, angle of repose, column collapse (4 x 20,000 grains), Mankoc-sized silo
 #               discharge (80,000 grains) with a Beverloo fit, contact-force distribution (the silo's fill
-#               and 3 more 40,000-grain piles), on the CPU reference
+#               and 3 more 30,000-grain piles), on the CPU reference
 #               -> docs/validation.md and docs/validation/*.png                        (~2 h, 2 cores)
 #   agreement   GPU pipeline against the CPU reference on the heap, the small silo and the bed
 #               -> its section of docs/validation.md                    (~30 min on llvmpipe, 2 cores)

@@ -538,7 +538,7 @@ int main(int argc, char** argv) {
     if (what == "repose" || what == "all") repose(out);
     if (what == "column" || what == "all") column(out);
     if (what == "silo" || what == "all") silo(out, what == "silo" && argc > 3 ? fs::path(argv[3]) : fs::path());
-    if (what == "forces" || what == "all") forces(out, what == "forces" && argc > 3 ? std::stoul(argv[3]) : 40000);
+    if (what == "forces" || what == "all") forces(out, what == "forces" && argc > 3 ? std::stoul(argv[3]) : 30000);
     if (what == "agreement") agreement(out, "all");
     if (what.rfind("agreement-", 0) == 0) agreement(out, what.substr(10));
     return 0;
