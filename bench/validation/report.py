@@ -251,8 +251,8 @@ Grains 5 cm below the plate leave the simulation. CPU reference, dt = {float(inf
   W^(2/5) is linear in D within {linear_residual * 100:.1f} % and gives k = {k:.2f} and C = {C:.2f}
   (rho_b = {packing:.2f} rho, the settled fill's); with k fixed at 1.5 the free exponent is
   {n_exp:.2f} (5/2 expected: **{'meets' if abs(n_exp - 2.5) < 0.5 else 'does not meet'}** it within 0.5,
-  the tolerance set before the run). Not a criterion, added after a run found k ~ 0: with k fixed at 0
-  the free exponent is {n_exp_k0:.2f}. {orifice_note}
+  the tolerance set before the run). Informative, not a criterion (added after a run with the
+  lattice-edge orifice found k ~ 0): with k fixed at 0 the free exponent is {n_exp_k0:.2f}. {orifice_note}
 - What it can show: {'the silo meets all three size conditions, so the 5/2 law is the one to expect; ' if conforming else 'the silo does not meet every size condition, so the fit is no test of the law; '}
   the orifices span {D.min() / COARSE_D_EQ:.0f}-{D.max() / COARSE_D_EQ:.0f} d (the width, {width / COARSE_D_EQ:.0f} d, bounds D
   through D + 30 d; a tetrahedron is {2 * BOUNDING_RADIUS / COARSE_D_EQ:.1f} d across, so 4 d is under three grains and
