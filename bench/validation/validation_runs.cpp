@@ -270,14 +270,6 @@ void write_contact_forces(const World& world, const StepSettings& settings, cons
   ts::write_file_atomically(file, csv);
 }
 
-// A large flat-bottomed silo within the size conditions of Mankoc et al. 2007
-// (reference/silo_mankoc.toml, or `scene_file`): filled and settled once on a closed rough plate,
-// damped once the lattice has landed (it falls ~4 m as one block, and the soft fill otherwise
-// rebounds for seconds); then, for each orifice diameter (5, 6, 7 and 8 d), a copy of the settled
-// silo has the plate's particles within D/2 of the axis taken away, a round rim lining the hole
-// (round_hole_rim), and discharges undamped for 0.35 s. The settled fill's contact forces are written
-// too. Discharged grains (5 cm below the plate) are parked far below as static bodies, so they cost
-// nothing and pile up nowhere.
 // A silo scene's fill (its first emitter) dropped as a lattice and settled on the closed plate,
 // damped once the lattice has landed; its contact forces go to `forces_file`.
 struct SettledFill {
@@ -313,6 +305,14 @@ SettledFill settle_fill(Scene& scene, const std::string& label, const fs::path& 
   return f;
 }
 
+// A large flat-bottomed silo within the size conditions of Mankoc et al. 2007
+// (reference/silo_mankoc.toml, or `scene_file`): filled and settled once on a closed rough plate,
+// damped once the lattice has landed (it falls ~4 m as one block, and the soft fill otherwise
+// rebounds for seconds); then, for each orifice diameter (5, 6, 7 and 8 d), a copy of the settled
+// silo has the plate's particles within D/2 of the axis taken away, a round rim lining the hole
+// (round_hole_rim), and discharges undamped for 0.35 s. The settled fill's contact forces are written
+// too. Discharged grains (5 cm below the plate) are parked far below as static bodies, so they cost
+// nothing and pile up nowhere.
 void silo(const fs::path& out, const fs::path& scene_file) {
   constexpr double kDischargeTime = 0.35;  // s after the orifice opens; the rate is fitted from 0.1 s
   Scene scene = scene_file.empty() ? reference("silo_mankoc.toml") : load_scene(scene_file);
