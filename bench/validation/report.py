@@ -8,6 +8,7 @@ this run (nothing is hard-coded but the literature's values and the tolerances).
 import os
 import sys
 import time
+from collections import namedtuple
 
 import matplotlib
 
@@ -328,6 +329,10 @@ def force_fills(run):
     return fills
 
 
+# One settled fill's tail fits (tail_fits dicts; grain: per-grain base loads, None where not recorded).
+FillFits = namedtuple("FillFits", "label grains height base bulk grain")
+
+
 def forces(run, docs):
     fills = force_fills(run)
     per_fill = []
@@ -338,8 +343,8 @@ def forces(run, docs):
         pooled["bulk"].append(f_bulk)
         if f_grain is not None:
             pooled["grain"].append(f_grain)
-        per_fill.append((label, grains, height, tail_fits(f_base), tail_fits(f_bulk),
-                         tail_fits(f_grain) if f_grain is not None else None))
+        per_fill.append(FillFits(label, grains, height, tail_fits(f_base), tail_fits(f_bulk),
+                                 tail_fits(f_grain) if f_grain is not None else None))
     fits = {name: tail_fits(np.concatenate(v)) for name, v in pooled.items() if v}
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     for name, style in (("bulk", "o"), ("base", "s")):
@@ -352,9 +357,9 @@ def forces(run, docs):
         keep = t["counts"] > 0
         ax.semilogy(t["centres"][keep], t["hist"][keep], "^", ms=4,
                     label=f"base load per grain: {t['n']} grains, best tail exp(-c f^{t['alpha']:.2f})")
-    for label, _, _, base, _, _ in per_fill:
-        keep = base["counts"] > 0
-        ax.semilogy(base["centres"][keep], base["hist"][keep], "-", lw=0.6, alpha=0.6, label=f"base, {label}")
+    for p in per_fill:
+        keep = p.base["counts"] > 0
+        ax.semilogy(p.base["centres"][keep], p.base["hist"][keep], "-", lw=0.6, alpha=0.6, label=f"base, {p.label}")
     t = fits["bulk"]
     x = np.linspace(1, t["centres"][t["counts"] >= 5].max(), 50)
     ax.semilogy(x, np.exp(np.polyval(t["p_exp"], x)), "-", color="grey", label=f"bulk, exponential tail, beta = {t['beta']:.2f}")
@@ -383,9 +388,10 @@ def forces(run, docs):
                   f"{fits['grain']['n']} grains), the base tail is exp(-{fits['grain']['beta']:.2f} f) "
                   f"(beta ~ 1.5 expected) with best alpha {fits['grain']['alpha']:.2f}."
                   if "grain" in fits else "")
-    base_alphas = np.array([p[3]["alpha"] for p in per_fill])  # per fill: (label, grains, height, base, bulk, grain)
-    base_betas = np.array([p[3]["beta"] for p in per_fill])
-    bulk_alphas = np.array([p[4]["alpha"] for p in per_fill])
+    base_alphas = np.array([p.base["alpha"] for p in per_fill])
+    base_betas = np.array([p.base["beta"] for p in per_fill])
+    bulk_alphas = np.array([p.bulk["alpha"] for p in per_fill])
+    heaviest = per_fill[int(np.argmin(base_alphas))]
     several = len(fills) > 1
     others = (f"the silo's own fill and {len(fills) - 1} more piles in the same cylinder with other seeds (other "
               f"lattice jitters and orientations), settled the same way (`tetrasand_validation_runs OUT forces`)"
@@ -394,8 +400,7 @@ def forces(run, docs):
               f"beta {base_betas.min():.2f}-{base_betas.max():.2f}, the bulk alpha {bulk_alphas.min():.2f}-{bulk_alphas.max():.2f}; "
               f"{int(sum(in_range(a) for a in base_alphas))} of {len(fills)} base tails and "
               f"{int(sum(in_range(a) for a in bulk_alphas))} of {len(fills)} bulk tails are in 1.1-1.9 on their own; "
-              f"the heaviest base tail is the {per_fill[int(np.argmin(base_alphas))][0]}'s "
-              f"({per_fill[int(np.argmin(base_alphas))][2] * 1e3:.0f} mm deep). Alphas of 0.50 or 3.00 lie on the "
+              f"the heaviest base tail is the {heaviest.label}'s ({heaviest.height * 1e3:.0f} mm deep). Alphas of 0.50 or 3.00 lie on the "
               f"edge of the range searched (0.5-3), so they are bounds, not fits."
               if several else "")
     return f"""## Normal contact forces in a sand pile at rest in a cylinder (thesis 7.2)
