@@ -4,7 +4,8 @@
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
 #               its section of docs/benchmarks.md (--quick: knot1 and armadillo at 64^3 and 128^3, 1,000
-#               particles on three meshes, no sampler trade: ~15 min on 2 cores; default: hours on llvmpipe)
+#               particles on three meshes, no sampler trade: under 2 min on 2 idle cores; default: 15 min on 2 idle
+#               cores, over an hour on 2 loaded ones; llvmpipe either way)
 #   sim         Cundall number (grain-steps/s) of the GPU pipeline and the CPU reference on the same
 #               settled beds, 1k to 1M grains (--grains 1000,8000 for fewer), memory per grain
 #               -> the Cundall table and plot in section sim of docs/benchmarks.md      (~8 min, 2 cores)
@@ -27,7 +28,7 @@
 #               knot1, armadillo (libcgal-demo) and a 1.3M-triangle icosphere:8 at 64^3..1024^3
 #               (--cases 'knot1@64,128 icosphere:8@64' for fewer; NAME = libcgal-demo mesh, or a path)
 #               -> section sdf of docs/benchmarks.md, docs/benchmarks/sdf_error_vs_time.png
-#               (over an hour on llvmpipe, 2 cores)
+#               (12 min on llvmpipe, 2 idle cores; over an hour on 2 loaded ones)
 #   all         every one of the above, in one run
 # Exit status: 0 when every physical comparison is within its stated tolerance, 1 otherwise.
 # The preview bench (tetrasand_bench_preview) has no peer; see docs/benchmarks.md.
