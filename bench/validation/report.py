@@ -315,6 +315,7 @@ FillForces = namedtuple("FillForces", "base on_plate bulk grain lodged_contacts 
 
 
 def normalised_forces(file):
+    """The normal forces of one settled fill's contact-force CSV, as FillForces."""
     d = np.genfromtxt(file, delimiter=",", names=True)
     d = d[d["normal_force_N"] > 0]
     base = d[d["base"] == 1]
