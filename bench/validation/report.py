@@ -371,23 +371,20 @@ def forces(run, docs):
                                  f.lodged_grains))
     fits = {name: tail_fits(np.concatenate(v)) for name, v in pooled.items() if v}
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
-    for name, style in (("bulk", "o"), ("base", "s")):
-        t = fits[name]
-        keep = t["counts"] > 0
-        ax.semilogy(t["centres"][keep], t["hist"][keep], style, ms=4,
-                    label=f"{name}, {len(fills)} fills: {t['n']} contacts, best tail exp(-c f^{t['alpha']:.2f})")
-    t = fits["on_plate"]
-    keep = t["counts"] > 0
-    ax.semilogy(t["centres"][keep], t["hist"][keep], "s", ms=6, mfc="none", color="black", lw=0.8,
-                label=f"base without contacts lodged in the plate: {t['n']}, best tail exp(-c f^{t['alpha']:.2f})")
+
+    def plot_histogram(t, fmt, label, **style):
+        keep = t["counts"] > 0  # empty bins have no logarithm
+        ax.semilogy(t["centres"][keep], t["hist"][keep], fmt, label=label, **style)
+
+    tail = lambda t: f"best tail exp(-c f^{t['alpha']:.2f})"
+    for name, fmt in (("bulk", "o"), ("base", "s")):
+        plot_histogram(fits[name], fmt, f"{name}, {len(fills)} fills: {fits[name]['n']} contacts, {tail(fits[name])}", ms=4)
+    plot_histogram(fits["on_plate"], "s", f"base without contacts lodged in the plate: {fits['on_plate']['n']}, "
+                   f"{tail(fits['on_plate'])}", ms=6, mfc="none", color="black", lw=0.8)
     if "grain" in fits:
-        t = fits["grain"]
-        keep = t["counts"] > 0
-        ax.semilogy(t["centres"][keep], t["hist"][keep], "^", ms=4,
-                    label=f"base load per grain: {t['n']} grains, best tail exp(-c f^{t['alpha']:.2f})")
+        plot_histogram(fits["grain"], "^", f"base load per grain: {fits['grain']['n']} grains, {tail(fits['grain'])}", ms=4)
     for p in per_fill:
-        keep = p.base["counts"] > 0
-        ax.semilogy(p.base["centres"][keep], p.base["hist"][keep], "-", lw=0.6, alpha=0.6, label=f"base, {p.label}")
+        plot_histogram(p.base, "-", f"base, {p.label}", lw=0.6, alpha=0.6)
     t = fits["bulk"]
     x = np.linspace(1, t["centres"][t["counts"] >= 5].max(), 50)
     ax.semilogy(x, np.exp(np.polyval(t["p_exp"], x)), "-", color="grey", label=f"bulk, exponential tail, beta = {t['beta']:.2f}")
