@@ -8,6 +8,7 @@
 #   --base REV   the revision to compare against (default HEAD: the last commit)
 #   --out DIR    where the builds and outputs go (default build-same/)
 #   --no-build   reuse the builds already in DIR
+#   --binaries A B   compare these two tetrasand executables instead of building (A = base)
 #
 # What is masked, because it changes from run to run whatever the code: the 36-character UUID that
 # OpenVDB writes into every .vdb header, and body.json's quality.seconds (wall time). Standard output
@@ -18,12 +19,15 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 base=HEAD
 out="$root/build-same"
 build=1
+bin_base=""
+bin_head=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --base) base=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --no-build) build=0; shift ;;
-    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    --binaries) bin_base=$(realpath "$2"); bin_head=$(realpath "$3"); build=0; shift 3 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) echo "same-outputs.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -113,9 +117,14 @@ for dirpath, _, files in os.walk(root):
 EOF
 }
 
+given_binaries=$bin_base
+bin_base=${bin_base:-$out/base/bin/tetrasand}
+bin_head=${bin_head:-$out/head/bin/tetrasand}
 for side in base head; do
-  echo "running the jobs with $side ..."
-  run_jobs "$out/$side/bin/tetrasand" "$out/out-$side"
+  bin=$bin_base
+  [ "$side" = head ] && bin=$bin_head
+  echo "running the jobs with $side ($bin) ..."
+  run_jobs "$bin" "$out/out-$side"
   normalise "$out/out-$side"
 done
 
@@ -130,9 +139,11 @@ done < <(cd out-base && find . -type f | sort)
 while IFS= read -r f; do
   if [ ! -f "out-base/$f" ]; then echo "only in head: $f"; different=1; fi
 done < <(cd out-head && find . -type f | sort)
+what="$base and the working tree"
+[ -n "$given_binaries" ] && what="$bin_base and $bin_head"
 if [ "$different" = 0 ]; then
-  echo "same outputs: all $files files byte-identical between $base and the working tree"
+  echo "same outputs: all $files files byte-identical between $what"
 else
-  echo "outputs differ between $base and the working tree (trees in $out/out-base and $out/out-head)"
+  echo "outputs differ between $what (trees in $out/out-base and $out/out-head)"
 fi
 exit "$different"
