@@ -2,6 +2,8 @@
 
 #include <bit>
 
+#include "shaders/common/bindings.h"
+
 namespace ts::gpu {
 
 PrefixScan::PrefixScan(const ShaderLibrary& library)
@@ -20,15 +22,15 @@ void PrefixScan::run(Queue& queue, Buffer& values, std::uint32_t count) {
   auto level_buffer = [&](std::size_t l) -> Buffer& { return l == 0 ? values : levels_[l - 1]; };
   // Down: scan each level's blocks, writing block sums to the next level.
   for (std::size_t l = 0; l < sizes.size(); ++l) {
-    level_buffer(l).bind(0);
-    level_buffer(l + 1).bind(1);
+    level_buffer(l).bind(TS_SCAN_VALUES);
+    level_buffer(l + 1).bind(TS_SCAN_BLOCK_SUMS);
     blocks_.set("count", sizes[l]);
     queue.dispatch(blocks_, (sizes[l] + 511u) / 512u);
   }
   // Up: add each level's scanned block offsets back into the level below.
   for (std::size_t l = sizes.size() - 1; l-- > 0;) {
-    level_buffer(l).bind(0);
-    level_buffer(l + 1).bind(1);
+    level_buffer(l).bind(TS_SCAN_VALUES);
+    level_buffer(l + 1).bind(TS_SCAN_BLOCK_SUMS);
     add_.set("count", sizes[l]);
     queue.dispatch_items(add_, sizes[l]);
   }
@@ -43,11 +45,11 @@ void BucketSort::finish(Queue& queue, const Buffer& keys, const Buffer& counts, 
                         Buffer& sorted, std::uint32_t count, std::uint32_t table_size) {
   glCopyNamedBufferSubData(counts.id(), starts.id(), 0, 0, static_cast<GLsizeiptr>(table_size * sizeof(std::uint32_t)));
   scan_.run(queue, starts, table_size);
-  keys.bind(1);
-  counts.bind(2);
-  slots.bind(3);
-  starts.bind(4);
-  sorted.bind(5);
+  keys.bind(TS_SORT_KEY);
+  counts.bind(TS_SORT_BUCKET_COUNT);
+  slots.bind(TS_SORT_SLOT);
+  starts.bind(TS_SORT_BUCKET_START);
+  sorted.bind(TS_SORT_SORTED);
   scatter_.set("count", count);
   queue.dispatch_items(scatter_, count);
   sort_buckets_.set("table_size", table_size);
@@ -73,10 +75,10 @@ void HashGrid::build(Queue& queue, const Buffer& positions, std::uint32_t count,
   reserve(count);
   cell_size_ = cell_size;
   cell_count_.fill_zero();
-  positions.bind(0);
-  cell_of_.bind(1);
-  cell_count_.bind(2);
-  slot_.bind(3);
+  positions.bind(TS_GRID_POSITIONS);
+  cell_of_.bind(TS_SORT_KEY);
+  cell_count_.bind(TS_SORT_BUCKET_COUNT);
+  slot_.bind(TS_SORT_SLOT);
   count_.set("count", count);
   count_.set("cell_size", cell_size);
   count_.set("table_size", table_size_);
@@ -85,9 +87,9 @@ void HashGrid::build(Queue& queue, const Buffer& positions, std::uint32_t count,
 }
 
 void HashGrid::bind() const {
-  cell_count_.bind(2);
-  cell_start_.bind(4);
-  sorted_.bind(5);
+  cell_count_.bind(TS_GRID_CELL_COUNT);
+  cell_start_.bind(TS_GRID_CELL_START);
+  sorted_.bind(TS_GRID_SORTED);
 }
 
 std::size_t HashGrid::bytes() const {

@@ -3,8 +3,8 @@
 // scatter, and an in-cell sort by particle id for deterministic neighbour order. Memory follows the
 // particle count (hash table = next power of two >= 2 x particles), never the domain size.
 //
-// Bindings the neighbour kernels read after build(): 2 = cell_count, 4 = cell_start, 5 = sorted ids
-// (see shaders/common/hash_grid.glsl for the hash).
+// Bindings the neighbour kernels read after build(): TS_GRID_CELL_COUNT, TS_GRID_CELL_START and
+// TS_GRID_SORTED (shaders/common/bindings.h; the hash is in shaders/common/hash_grid.glsl).
 #include <cstdint>
 
 #include "gpu/gl.h"
@@ -24,9 +24,10 @@ class PrefixScan {
 };
 
 // Counting sort of `count` ids by keys below `table_size`, finished here once a key kernel has
-// written each id's key (`keys`, binding 1), its bucket's size (`counts`, 2, zeroed before) and its
-// slot in the bucket (`slots`, 3): bucket starts by exclusive scan (`starts`, 4), ids scattered to
-// start + slot (`sorted`, 5), then sorted within each bucket, so the order does not depend on the
+// written each id's key (`keys`, TS_SORT_KEY), its bucket's size (`counts`, TS_SORT_BUCKET_COUNT,
+// zeroed before) and its slot in the bucket (`slots`, TS_SORT_SLOT): bucket starts by exclusive scan
+// (`starts`, TS_SORT_BUCKET_START), ids scattered to start + slot (`sorted`, TS_SORT_SORTED), then
+// sorted within each bucket, so the order does not depend on the
 // atomics that handed out the slots. Shared by the hash grid and the simulator's Morton re-sort.
 class BucketSort {
  public:
@@ -42,9 +43,9 @@ class BucketSort {
 class HashGrid {
  public:
   explicit HashGrid(const ShaderLibrary& library);
-  // positions: vec4 per particle (xyz used) bound to binding 0 during the build.
+  // positions: vec4 per particle (xyz used), bound to TS_GRID_POSITIONS during the build.
   void build(Queue& queue, const Buffer& positions, std::uint32_t count, float cell_size);
-  // Rebinds the grid buffers to bindings 2, 4 and 5 for a neighbour kernel.
+  // Rebinds the grid to TS_GRID_CELL_COUNT, TS_GRID_CELL_START and TS_GRID_SORTED for a neighbour kernel.
   void bind() const;
   std::uint32_t table_size() const { return table_size_; }
   float cell_size() const { return cell_size_; }

@@ -5,6 +5,8 @@
 #include <utility>
 
 #include "core/error.h"
+#include "shaders/common/bindings.h"
+#include "shaders/sampler/bindings.h"
 
 namespace ts::sampler {
 
@@ -25,15 +27,14 @@ std::size_t GpuRelaxer::gpu_bytes() const {
 }
 
 void GpuRelaxer::bind_sdf(const gpu::Program& program) const {
-  glBindTextureUnit(0, texture_.id());
-  program.set("sdf", 0);
+  glBindTextureUnit(TS_SAMPLER_UNIT_SDF, texture_.id());
   program.set("voxel_size", static_cast<float>(spec_.voxel_size));
   program.set("sdf_dims", static_cast<float>(spec_.dims.x()), static_cast<float>(spec_.dims.y()),
               static_cast<float>(spec_.dims.z()));
 }
 
 void GpuRelaxer::project(std::uint32_t count, int steps) {
-  positions_[0].bind(0);
+  positions_[0].bind(TS_SAMPLER_POSITIONS);
   bind_sdf(project_);
   project_.set("count", count);
   for (int s = 0; s < steps; ++s) queue_.dispatch_items(project_, count);
@@ -79,11 +80,11 @@ RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const Rela
   relax_.set("band_limit", static_cast<float>(settings.band_limit));
   while (stats.iterations < settings.max_iterations && count > 0) {
     grid_.build(queue_, positions_[0], count, static_cast<float>(cutoff));
-    positions_[0].bind(0);
-    positions_[1].bind(1);
+    positions_[0].bind(TS_SAMPLER_POSITIONS_IN);
+    positions_[1].bind(TS_SAMPLER_POSITIONS_OUT);
     grid_.bind();
-    velocities_.bind(3);
-    step_info_.bind(6);
+    velocities_.bind(TS_SAMPLER_VELOCITIES);
+    step_info_.bind(TS_SAMPLER_STEP_INFO);
     bind_sdf(relax_);
     relax_.set("count", count);
     relax_.set("table_size", grid_.table_size());
@@ -92,8 +93,8 @@ RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const Rela
     ++stats.iterations;
     if (stats.iterations % settings.check_every != 0 && stats.iterations < settings.max_iterations) continue;
 
-    step_info_.bind(6);
-    partials_.bind(7);
+    step_info_.bind(TS_SAMPLER_STEP_INFO);
+    partials_.bind(TS_SAMPLER_PARTIALS);
     reduce_.set("count", count);
     queue_.dispatch_items(reduce_, count);
     const auto partials = partials_.read<Eigen::Vector4f>((count + 255) / 256);

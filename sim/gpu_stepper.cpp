@@ -8,6 +8,8 @@
 
 #include "core/error.h"
 #include "gpu/layouts.h"
+#include "shaders/common/bindings.h"
+#include "shaders/sim/bindings.h"
 
 namespace ts::sim {
 namespace {
@@ -275,7 +277,7 @@ void GpuStepper::bind_state() const {
   particle_stats_buffer_.bind(TS_SIM_PARTICLE_STATS);
   counters_.bind(TS_SIM_COUNTERS);
   body_momentum_.bind(TS_SIM_BODY_MOMENTUM);
-  particle_position_exact_.bind(23);
+  particle_position_exact_.bind(TS_SIM_PARTICLE_POSITION_EXACT);
 }
 
 void GpuStepper::step(int steps) {
@@ -306,8 +308,8 @@ void GpuStepper::step(int steps) {
 StepStats GpuStepper::statistics() {
   StepStats stats;
   bind_state();
-  metric_partials_.bind(24);
-  stat_partials_.bind(25);
+  metric_partials_.bind(TS_SIM_METRIC_PARTIALS);
+  stat_partials_.bind(TS_SIM_STAT_PARTIALS);
   queue_.dispatch_items(metrics_, body_count_);
   queue_.dispatch_items(particle_stats_, particle_count_);
   const auto energies = metric_partials_.read<double>(4 * ((body_count_ + 255) / 256));
@@ -472,9 +474,9 @@ std::vector<std::uint32_t> GpuStepper::original_ids(const gpu::Buffer& ids, std:
 
 void GpuStepper::gather(gpu::Buffer& buffer, const gpu::Buffer& index, std::uint32_t rows, std::uint32_t width) {
   gpu::Buffer reordered(buffer.bytes());
-  buffer.bind(1);
-  reordered.bind(2);
-  index.bind(3);
+  buffer.bind(TS_SIM_GATHER_SOURCE);
+  reordered.bind(TS_SIM_GATHER_DESTINATION);
+  index.bind(TS_SIM_GATHER_INDEX);
   gather_rows_.set("rows", rows);
   gather_rows_.set("width", width);
   queue_.dispatch_items(gather_rows_, rows);
@@ -487,9 +489,9 @@ void GpuStepper::resort() {
   // The new body order: counting sort by Morton key, ids ascending within a key (deterministic).
   bucket_count_.fill_zero();
   body_position_.bind(TS_SIM_BODY_POSITION);
-  sort_key_.bind(1);
-  bucket_count_.bind(2);
-  sort_slot_.bind(3);
+  sort_key_.bind(TS_SORT_KEY);
+  bucket_count_.bind(TS_SORT_BUCKET_COUNT);
+  sort_slot_.bind(TS_SORT_SLOT);
   resort_keys_.set("body_count", body_count_);
   resort_keys_.set("cell_size", static_cast<float>(cell_size_));
   resort_keys_.set("table_size", bucket_table_);
@@ -497,19 +499,19 @@ void GpuStepper::resort() {
   bucket_sort_.finish(queue_, sort_key_, bucket_count_, sort_slot_, bucket_start_, order_, body_count_, bucket_table_);
 
   // New particle ranges (a scan of the counts in the new order) and the particle maps.
-  order_.bind(5);
+  order_.bind(TS_SIM_RESORT_ORDER);
   body_range_.bind(TS_SIM_BODY_RANGE);
-  new_first_.bind(6);
+  new_first_.bind(TS_SIM_RESORT_NEW_FIRST);
   resort_ranges_.set("body_count", body_count_);
   queue_.dispatch_items(resort_ranges_, body_count_);
   resort_scan_.run(queue_, new_first_, body_count_);
-  order_.bind(5);
-  new_first_.bind(6);
+  order_.bind(TS_SIM_RESORT_ORDER);
+  new_first_.bind(TS_SIM_RESORT_NEW_FIRST);
   body_range_.bind(TS_SIM_BODY_RANGE);
-  new_range_.bind(1);
-  source_particle_.bind(2);
-  new_of_old_.bind(3);
-  owner_.bind(4);
+  new_range_.bind(TS_SIM_RESORT_NEW_RANGE);
+  source_particle_.bind(TS_SIM_RESORT_SOURCE);
+  new_of_old_.bind(TS_SIM_RESORT_DESTINATION);
+  owner_.bind(TS_SIM_RESORT_OWNER);
   resort_particles_.set("body_count", body_count_);
   queue_.dispatch_items(resort_particles_, body_count_);
   std::swap(body_range_, new_range_);
@@ -529,8 +531,8 @@ void GpuStepper::resort() {
     gather(springs_, source_particle_, particle_count_, words);
   }
   particle_info_.bind(TS_SIM_PARTICLE_INFO);
-  new_of_old_.bind(3);
-  owner_.bind(4);
+  new_of_old_.bind(TS_SIM_RESORT_DESTINATION);
+  owner_.bind(TS_SIM_RESORT_OWNER);
   springs_.bind(TS_SIM_SPRINGS);
   resort_fixup_.set("particle_count", particle_count_);
   resort_fixup_.set("spring_model", springs ? 1 : 0);

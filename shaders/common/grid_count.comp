@@ -3,11 +3,12 @@
 // Counting sort, pass 1: each particle finds its hashed cell and takes a slot in it. Slot order within
 // a cell depends on atomics; grid_sort_cells.comp restores index order so results stay deterministic.
 #include "common/hash_grid.glsl"
+#include "common/bindings.h"
 layout(local_size_x = 256) in;
-layout(std430, binding = 0) readonly buffer Positions { vec4 positions[]; };
-layout(std430, binding = 1) writeonly buffer CellOf { uint cell_of[]; };
-layout(std430, binding = 2) buffer CellCount { uint cell_count[]; };
-layout(std430, binding = 3) writeonly buffer Slot { uint slot[]; };
+layout(std430, binding = TS_GRID_POSITIONS) readonly buffer Positions { vec4 positions[]; };
+layout(std430, binding = TS_SORT_KEY) writeonly buffer CellOf { uint cell_of[]; };
+layout(std430, binding = TS_SORT_BUCKET_COUNT) buffer CellCount { uint cell_count[]; };
+layout(std430, binding = TS_SORT_SLOT) writeonly buffer Slot { uint slot[]; };
 uniform uint count;
 uniform float cell_size;
 uniform uint table_size;

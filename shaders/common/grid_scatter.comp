@@ -1,10 +1,12 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require
 // Counting sort, pass 3: particle ids into their cell's range of the sorted array.
+#include "common/bindings.h"
 layout(local_size_x = 256) in;
-layout(std430, binding = 1) readonly buffer CellOf { uint cell_of[]; };
-layout(std430, binding = 3) readonly buffer Slot { uint slot[]; };
-layout(std430, binding = 4) readonly buffer CellStart { uint cell_start[]; };
-layout(std430, binding = 5) writeonly buffer Sorted { uint sorted_ids[]; };
+layout(std430, binding = TS_SORT_KEY) readonly buffer CellOf { uint cell_of[]; };
+layout(std430, binding = TS_SORT_SLOT) readonly buffer Slot { uint slot[]; };
+layout(std430, binding = TS_SORT_BUCKET_START) readonly buffer CellStart { uint cell_start[]; };
+layout(std430, binding = TS_SORT_SORTED) writeonly buffer Sorted { uint sorted_ids[]; };
 uniform uint count;
 void main() {
   uint i = gl_GlobalInvocationID.x;

@@ -1,10 +1,12 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require
 // Counting sort, pass 4: insertion sort of each cell's ids, so neighbours are always visited in index
 // order and float sums over them are bitwise reproducible. Cells hold a handful of ids.
+#include "common/bindings.h"
 layout(local_size_x = 256) in;
-layout(std430, binding = 2) readonly buffer CellCount { uint cell_count[]; };
-layout(std430, binding = 4) readonly buffer CellStart { uint cell_start[]; };
-layout(std430, binding = 5) buffer Sorted { uint sorted_ids[]; };
+layout(std430, binding = TS_SORT_BUCKET_COUNT) readonly buffer CellCount { uint cell_count[]; };
+layout(std430, binding = TS_SORT_BUCKET_START) readonly buffer CellStart { uint cell_start[]; };
+layout(std430, binding = TS_SORT_SORTED) buffer Sorted { uint sorted_ids[]; };
 uniform uint table_size;
 void main() {
   uint c = gl_GlobalInvocationID.x;

@@ -88,29 +88,7 @@ TS_LAYOUT(SimSpringSlots64) {
 #define TS_BINDING_SDF_TRIANGLES 0
 #define TS_BINDING_SDF_PRISMS 1
 
-// Simulator state, one vec4 (or uvec4) buffer per quantity (structure of arrays). The hashed grid
-// (gpu/hash_grid.h) uses bindings 0-5 while it builds and 2, 4, 5 when neighbour kernels read it.
-#define TS_SIM_PARTICLE_POSITION 0   // xyz: world position [m]; w: radius [m] (the grid's input)
-#define TS_SIM_PARTICLE_VELOCITY 6   // xyz: velocity of the sphere centre [m/s]
-#define TS_SIM_PARTICLE_INFO 7       // uvec4: x body index, y material index
-#define TS_SIM_PARTICLE_LOCAL 8      // xyz: offset from the body's centre of mass in its frame [m]; w: radius [m]
-#define TS_SIM_BODY_POSITION 9       // xyz: centre of mass [m]; w: inverse mass [1/kg] (0 unless dynamic)
-#define TS_SIM_BODY_ORIENTATION 10   // unit quaternion (x, y, z, w); body axes = principal axes
-#define TS_SIM_BODY_VELOCITY 11      // xyz: [m/s]; w: motion type (0 dynamic, 1 kinematic, 2 static)
-#define TS_SIM_BODY_OMEGA 12         // xyz: angular velocity [rad/s] (derived from the momentum)
-#define TS_SIM_BODY_INV_INERTIA 13   // 3 vec4 per body: rows of I0^-1 (body frame) [1/(kg m^2)]; row 0 w: bounding radius [m]
-#define TS_SIM_BODY_RANGE 14         // uvec4: x first particle, y particle count, z first keyframe, w keyframe count (0: none)
-// 2 per particle (one buffer, so the contact kernel stays within 16 storage blocks): [2i] xyz contact
-// force on the particle [N]; [2i + 1] xyz its torque about the body's centre of mass [N m].
-#define TS_SIM_PARTICLE_WRENCH 15
-#define TS_SIM_PAIRS 17              // SimPair[material_count^2]
-#define TS_SIM_PLANES 18             // SimPlane[]
-#define TS_SIM_CYLINDERS 19          // SimCylinder[]
-#define TS_SIM_PARTICLE_STATS 20     // x: pair contacts (counted by the lower id), y: wall contacts, z: largest overlap / smaller radius, w: overlap clamps
-#define TS_SIM_COUNTERS 21           // uint[]: 0 velocity clamps, 1 angular velocity clamps, 2 spring slot overflows
-#define TS_SIM_BODY_MOMENTUM 22      // xyz: angular momentum [kg m^2/s] (world frame)
-#define TS_SIM_SPRINGS 16             // SimSpringSlots (SimSpringSlots64 with TS_FP64) per particle
-#define TS_SIM_KEYFRAMES 26           // 2 real4 per key of a kinematic track (sim::Keyframe): xyz centre of mass [m], w time [s]; quaternion (x, y, z, w)
+// The simulator's binding slots are in shaders/sim/bindings.h.
 
 // Motion types (TS_SIM_BODY_VELOCITY.w)
 #define TS_MOTION_DYNAMIC 0

@@ -1,8 +1,10 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require
 // Exclusive prefix sum, pass 2: adds each block's scanned offset to its 512 values.
+#include "common/bindings.h"
 layout(local_size_x = 256) in;
-layout(std430, binding = 0) buffer Values { uint values[]; };
-layout(std430, binding = 1) readonly buffer BlockOffsets { uint block_offsets[]; };
+layout(std430, binding = TS_SCAN_VALUES) buffer Values { uint values[]; };
+layout(std430, binding = TS_SCAN_BLOCK_SUMS) readonly buffer BlockOffsets { uint block_offsets[]; };
 uniform uint count;
 void main() {
   uint i = gl_GlobalInvocationID.x;

@@ -1,9 +1,11 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require
 // Exclusive prefix sum, pass 1: each work group scans 512 values in shared memory (Blelloch 1990) and
 // writes its total to block_sums, which the host scans recursively before scan_add.comp adds it back.
+#include "common/bindings.h"
 layout(local_size_x = 256) in;
-layout(std430, binding = 0) buffer Values { uint values[]; };
-layout(std430, binding = 1) writeonly buffer BlockSums { uint block_sums[]; };
+layout(std430, binding = TS_SCAN_VALUES) buffer Values { uint values[]; };
+layout(std430, binding = TS_SCAN_BLOCK_SUMS) writeonly buffer BlockSums { uint block_sums[]; };
 uniform uint count;
 shared uint temp[512];
 void main() {

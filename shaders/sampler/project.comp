@@ -3,9 +3,10 @@
 // Final projection onto the zero level set: p <- p - phi grad(phi), repeated by the host. Repulsion
 // on a curved surface leaves particles a few percent of the spacing off it (formulas.md). Mobile
 // particles only (positions.w = 1).
+#include "sampler/bindings.h"
 #include "sampler/sdf_sample.glsl"
 layout(local_size_x = 128) in;
-layout(std430, binding = 0) buffer Positions { vec4 positions[]; };
+layout(std430, binding = TS_SAMPLER_POSITIONS) buffer Positions { vec4 positions[]; };
 uniform uint count;
 void main() {
   uint i = gl_GlobalInvocationID.x;

@@ -1,10 +1,12 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require
 // Convergence reduction: per work group, the sum of the gradient steps of the mobile particles, the
 // largest |phi|, the count of particles outside the band and the count of mobile particles. The host
 // adds the partials in order (deterministic, no float atomics).
+#include "sampler/bindings.h"
 layout(local_size_x = 256) in;
-layout(std430, binding = 6) readonly buffer StepInfo { vec4 step_info[]; };
-layout(std430, binding = 7) writeonly buffer Partials { vec4 partials[]; };
+layout(std430, binding = TS_SAMPLER_STEP_INFO) readonly buffer StepInfo { vec4 step_info[]; };
+layout(std430, binding = TS_SAMPLER_PARTIALS) writeonly buffer Partials { vec4 partials[]; };
 uniform uint count;
 shared vec4 scratch[256];
 void main() {

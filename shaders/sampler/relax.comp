@@ -14,19 +14,21 @@
 // positions.w = 1 marks a mobile particle; 0 a frozen one, which still repels but does not move (the
 // local re-relaxation after an injection moves only the particles near the new ones).
 #include "common/hash_grid.glsl"
+#include "common/bindings.h"
+#include "sampler/bindings.h"
 #include "sampler/sdf_sample.glsl"
 
 layout(local_size_x = 128) in;
-layout(std430, binding = 0) readonly buffer PositionsIn { vec4 p_in[]; };
-layout(std430, binding = 1) writeonly buffer PositionsOut { vec4 p_out[]; };
-layout(std430, binding = 2) readonly buffer CellCount { uint cell_count[]; };
-layout(std430, binding = 3) buffer Velocities { vec4 velocity[]; };  // xyz: momentum step [m], own entry only
-layout(std430, binding = 4) readonly buffer CellStart { uint cell_start[]; };
-layout(std430, binding = 5) readonly buffer Sorted { uint sorted_ids[]; };
+layout(std430, binding = TS_SAMPLER_POSITIONS_IN) readonly buffer PositionsIn { vec4 p_in[]; };
+layout(std430, binding = TS_SAMPLER_POSITIONS_OUT) writeonly buffer PositionsOut { vec4 p_out[]; };
+layout(std430, binding = TS_GRID_CELL_COUNT) readonly buffer CellCount { uint cell_count[]; };
+layout(std430, binding = TS_SAMPLER_VELOCITIES) buffer Velocities { vec4 velocity[]; };  // xyz: momentum step [m], own entry only
+layout(std430, binding = TS_GRID_CELL_START) readonly buffer CellStart { uint cell_start[]; };
+layout(std430, binding = TS_GRID_SORTED) readonly buffer Sorted { uint sorted_ids[]; };
 // x: |tangential gradient step| [m] (the residual; 0 if frozen; the normal term is left out because
 // hardware trilinear filtering quantises phi to a fraction of a voxel, a floor that says nothing about
 // the arrangement, and the exact projection fixes the normal position afterwards), y: |phi| [m], z: 1 if outside the band, w: 1 if mobile
-layout(std430, binding = 6) writeonly buffer StepInfo { vec4 step_info[]; };
+layout(std430, binding = TS_SAMPLER_STEP_INFO) writeonly buffer StepInfo { vec4 step_info[]; };
 
 uniform uint count;
 uniform float cell_size;       // = repulsion cutoff [m]

@@ -4,7 +4,7 @@
 #ifndef TETRASAND_SAMPLER_SDF_SAMPLE_GLSL
 #define TETRASAND_SAMPLER_SDF_SAMPLE_GLSL
 
-uniform sampler3D sdf;
+layout(binding = TS_SAMPLER_UNIT_SDF) uniform sampler3D sdf;  // the including kernel includes sampler/bindings.h
 uniform float voxel_size;  // [m]
 uniform vec3 sdf_dims;     // voxels along x, y, z
 

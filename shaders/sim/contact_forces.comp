@@ -6,14 +6,16 @@
 // With the spring tangential model each dynamic particle keeps its contacts' springs in its own
 // history slots (read at the start, rewritten in gather order), matched by partner id, as
 // CpuStepper::visit_contacts does. At most 16 storage blocks (the per-stage minimum of GL 4.3).
+#include "common/bindings.h"
+#include "sim/bindings.h"
 #include "common/hash_grid.glsl"
 #include "common/layouts.h"
 #include "sim/contact.glsl"
 #include "sim/rigid.glsl"
 layout(local_size_x = 128) in;
 layout(std430, binding = TS_SIM_PARTICLE_POSITION) readonly buffer P { vec4 particle_position[]; };
-layout(std430, binding = 4) readonly buffer CellStart { uint cell_start[]; };
-layout(std430, binding = 5) readonly buffer Sorted { uint sorted_ids[]; };
+layout(std430, binding = TS_GRID_CELL_START) readonly buffer CellStart { uint cell_start[]; };
+layout(std430, binding = TS_GRID_SORTED) readonly buffer Sorted { uint sorted_ids[]; };
 layout(std430, binding = TS_SIM_PARTICLE_VELOCITY) readonly buffer V { real4 particle_velocity[]; };
 layout(std430, binding = TS_SIM_PARTICLE_INFO) readonly buffer I { uvec4 particle_info[]; };
 layout(std430, binding = TS_SIM_BODY_POSITION) readonly buffer BP { real4 body_position[]; };
@@ -25,7 +27,7 @@ layout(std430, binding = TS_SIM_CYLINDERS) readonly buffer Cylinders { SimCylind
 layout(std430, binding = TS_SIM_PARTICLE_STATS) writeonly buffer S { vec4 particle_stats[]; };
 layout(std430, binding = TS_SIM_COUNTERS) buffer C { uint counters[]; };
 #ifdef TS_FP64
-layout(std430, binding = 23) readonly buffer PX { dvec4 particle_position_exact[]; };
+layout(std430, binding = TS_SIM_PARTICLE_POSITION_EXACT) readonly buffer PX { dvec4 particle_position_exact[]; };
 #define POSITION(k) particle_position_exact[k]
 layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots64 springs[]; };
 #else

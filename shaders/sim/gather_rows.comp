@@ -1,10 +1,12 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require
 // Re-sort, pass 4: dst row r = src row index[r], rows of `width` uvec4 words, copied bit for bit (so
 // any per-body or per-particle array, float or double, moves with one kernel).
+#include "sim/bindings.h"
 layout(local_size_x = 128) in;
-layout(std430, binding = 1) readonly buffer Src { uvec4 src[]; };
-layout(std430, binding = 2) writeonly buffer Dst { uvec4 dst[]; };
-layout(std430, binding = 3) readonly buffer Index { uint index[]; };
+layout(std430, binding = TS_SIM_GATHER_SOURCE) readonly buffer Src { uvec4 src[]; };
+layout(std430, binding = TS_SIM_GATHER_DESTINATION) writeonly buffer Dst { uvec4 dst[]; };
+layout(std430, binding = TS_SIM_GATHER_INDEX) readonly buffer Index { uint index[]; };
 uniform uint rows;
 uniform uint width;
 void main() {

@@ -6,6 +6,7 @@
 // velocities, semi-implicit Euler with the new ones. Static bodies are skipped; kinematic bodies
 // follow their prescribed velocities or
 // their keyframes (sim/keyframes.glsl). Velocity clamps (thesis 3.3.1) are counted, never silent.
+#include "sim/bindings.h"
 #include "common/layouts.h"
 #include "sim/rigid.glsl"
 layout(local_size_x = 64) in;

@@ -3,6 +3,7 @@
 // Metrics for the CSV and the blow-up check, per work group (the host adds partials in order):
 // x: translational kinetic energy [J], y: rotational kinetic energy [J], z: potential energy [J]
 // relative to z = 0, w: NaN/inf count. Only dynamic bodies count.
+#include "sim/bindings.h"
 #include "common/layouts.h"
 #include "sim/rigid.glsl"
 layout(local_size_x = 256) in;
@@ -10,7 +11,7 @@ layout(std430, binding = TS_SIM_BODY_POSITION) readonly buffer BP { real4 body_p
 layout(std430, binding = TS_SIM_BODY_VELOCITY) readonly buffer BV { real4 body_velocity[]; };
 layout(std430, binding = TS_SIM_BODY_OMEGA) readonly buffer BW { real4 body_omega[]; };
 layout(std430, binding = TS_SIM_BODY_MOMENTUM) readonly buffer BL { real4 body_momentum[]; };
-layout(std430, binding = 24) writeonly buffer Partials { dvec4 partials[]; };
+layout(std430, binding = TS_SIM_METRIC_PARTIALS) writeonly buffer Partials { dvec4 partials[]; };
 uniform uint body_count;
 uniform vec3 gravity;
 shared dvec4 scratch[256];

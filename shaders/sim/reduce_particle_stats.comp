@@ -2,10 +2,11 @@
 #extension GL_GOOGLE_include_directive : require
 // Contact statistics per work group (the host adds partials in order): x pair contacts, y wall
 // contacts, z largest overlap ratio (max), w overlap clamps.
+#include "sim/bindings.h"
 #include "common/layouts.h"
 layout(local_size_x = 256) in;
 layout(std430, binding = TS_SIM_PARTICLE_STATS) readonly buffer S { vec4 particle_stats[]; };
-layout(std430, binding = 25) writeonly buffer Partials { vec4 partials[]; };
+layout(std430, binding = TS_SIM_STAT_PARTIALS) writeonly buffer Partials { vec4 partials[]; };
 uniform uint particle_count;
 shared vec4 scratch[256];
 void main() {

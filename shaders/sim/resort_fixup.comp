@@ -2,12 +2,13 @@
 #extension GL_GOOGLE_include_directive : require
 // Re-sort, pass 5, per new particle: its owner is the body's new index, and its springs name their
 // partner particles by their new ids (walls and free slots unchanged).
+#include "sim/bindings.h"
 #include "common/layouts.h"
 #include "sim/precision.glsl"
 layout(local_size_x = 128) in;
 layout(std430, binding = TS_SIM_PARTICLE_INFO) buffer I { uvec4 particle_info[]; };
-layout(std430, binding = 3) readonly buffer Destination { uint new_of_old[]; };
-layout(std430, binding = 4) readonly buffer Owner { uint owner[]; };
+layout(std430, binding = TS_SIM_RESORT_DESTINATION) readonly buffer Destination { uint new_of_old[]; };
+layout(std430, binding = TS_SIM_RESORT_OWNER) readonly buffer Owner { uint owner[]; };
 #ifdef TS_FP64
 layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots64 springs[]; };
 #else

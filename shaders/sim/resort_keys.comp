@@ -4,14 +4,16 @@
 // of each cell coordinate, interleaved) masked to the table size, so bodies in neighbouring cells get
 // nearby keys and end up near each other in memory; and a slot in its key's bucket (order fixed later
 // by common/grid_sort_cells.comp, so the result does not depend on the atomics).
+#include "common/bindings.h"
+#include "sim/bindings.h"
 #include "common/hash_grid.glsl"
 #include "common/layouts.h"
 #include "sim/precision.glsl"
 layout(local_size_x = 256) in;
 layout(std430, binding = TS_SIM_BODY_POSITION) readonly buffer BP { real4 body_position[]; };
-layout(std430, binding = 1) writeonly buffer Key { uint key[]; };
-layout(std430, binding = 2) buffer Count { uint bucket_count[]; };
-layout(std430, binding = 3) writeonly buffer Slot { uint slot[]; };
+layout(std430, binding = TS_SORT_KEY) writeonly buffer Key { uint key[]; };
+layout(std430, binding = TS_SORT_BUCKET_COUNT) buffer Count { uint bucket_count[]; };
+layout(std430, binding = TS_SORT_SLOT) writeonly buffer Slot { uint slot[]; };
 uniform uint body_count;
 uniform float cell_size;
 uniform uint table_size;

@@ -2,15 +2,17 @@
 #extension GL_GOOGLE_include_directive : require
 // Re-sort, pass 3, per new body: its new range (keyframe references kept), and for each of its
 // particles where it comes from, where it goes, and which body now owns it.
+#include "common/bindings.h"
+#include "sim/bindings.h"
 #include "common/layouts.h"
 layout(local_size_x = 128) in;
-layout(std430, binding = 5) readonly buffer Order { uint order[]; };
-layout(std430, binding = 6) readonly buffer NewFirst { uint new_first[]; };
+layout(std430, binding = TS_SIM_RESORT_ORDER) readonly buffer Order { uint order[]; };
+layout(std430, binding = TS_SIM_RESORT_NEW_FIRST) readonly buffer NewFirst { uint new_first[]; };
 layout(std430, binding = TS_SIM_BODY_RANGE) readonly buffer BR { uvec4 body_range[]; };
-layout(std430, binding = 1) writeonly buffer NewRange { uvec4 new_range[]; };
-layout(std430, binding = 2) writeonly buffer Source { uint source_particle[]; };  // new particle -> old
-layout(std430, binding = 3) writeonly buffer Destination { uint new_of_old[]; };  // old particle -> new
-layout(std430, binding = 4) writeonly buffer Owner { uint owner[]; };             // new particle -> new body
+layout(std430, binding = TS_SIM_RESORT_NEW_RANGE) writeonly buffer NewRange { uvec4 new_range[]; };
+layout(std430, binding = TS_SIM_RESORT_SOURCE) writeonly buffer Source { uint source_particle[]; };  // new particle -> old
+layout(std430, binding = TS_SIM_RESORT_DESTINATION) writeonly buffer Destination { uint new_of_old[]; };  // old particle -> new
+layout(std430, binding = TS_SIM_RESORT_OWNER) writeonly buffer Owner { uint owner[]; };             // new particle -> new body
 uniform uint body_count;
 void main() {
   uint b = gl_GlobalInvocationID.x;

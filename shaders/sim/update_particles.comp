@@ -1,6 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Step 1: body poses -> particle world positions and velocities (thesis eq. 3.43: v_p = v + w x (R o_p)).
+#include "sim/bindings.h"
 #include "common/layouts.h"
 #include "sim/rigid.glsl"
 layout(local_size_x = 128) in;
@@ -13,7 +14,7 @@ layout(std430, binding = TS_SIM_BODY_ORIENTATION) readonly buffer BQ { real4 bod
 layout(std430, binding = TS_SIM_BODY_VELOCITY) readonly buffer BV { real4 body_velocity[]; };
 layout(std430, binding = TS_SIM_BODY_OMEGA) readonly buffer BW { real4 body_omega[]; };
 #ifdef TS_FP64
-layout(std430, binding = 23) writeonly buffer PX { dvec4 particle_position_exact[]; };
+layout(std430, binding = TS_SIM_PARTICLE_POSITION_EXACT) writeonly buffer PX { dvec4 particle_position_exact[]; };
 #endif
 uniform uint particle_count;
 void main() {

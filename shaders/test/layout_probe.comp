@@ -2,15 +2,16 @@
 #extension GL_GOOGLE_include_directive : require
 // Declares every shared layout in a std430 block so tests can read the compiler's offsets back.
 #include "common/layouts.h"
+#include "test/bindings.h"
 layout(local_size_x = 1) in;
-layout(std430, binding = 0) buffer SdfTriangles { SdfTriangle sdf_triangles[]; };
-layout(std430, binding = 1) buffer SamplerGrids { SamplerGrid sampler_grids[]; };
-layout(std430, binding = 2) buffer SimPairs { SimPair sim_pairs[]; };
-layout(std430, binding = 3) buffer SimPlanes { SimPlane sim_planes[]; };
-layout(std430, binding = 4) buffer SdfPrisms { SdfPrism sdf_prisms[]; };
-layout(std430, binding = 5) buffer SimCylinders { SimCylinder sim_cylinders[]; };
-layout(std430, binding = 6) buffer SimSprings { SimSpringSlots sim_springs[]; };
-layout(std430, binding = 7) buffer SimSprings64 { SimSpringSlots64 sim_springs64[]; };
+layout(std430, binding = TS_TEST_PROBE_SDF_TRIANGLES) buffer SdfTriangles { SdfTriangle sdf_triangles[]; };
+layout(std430, binding = TS_TEST_PROBE_SAMPLER_GRIDS) buffer SamplerGrids { SamplerGrid sampler_grids[]; };
+layout(std430, binding = TS_TEST_PROBE_SIM_PAIRS) buffer SimPairs { SimPair sim_pairs[]; };
+layout(std430, binding = TS_TEST_PROBE_SIM_PLANES) buffer SimPlanes { SimPlane sim_planes[]; };
+layout(std430, binding = TS_TEST_PROBE_SDF_PRISMS) buffer SdfPrisms { SdfPrism sdf_prisms[]; };
+layout(std430, binding = TS_TEST_PROBE_SIM_CYLINDERS) buffer SimCylinders { SimCylinder sim_cylinders[]; };
+layout(std430, binding = TS_TEST_PROBE_SIM_SPRINGS) buffer SimSprings { SimSpringSlots sim_springs[]; };
+layout(std430, binding = TS_TEST_PROBE_SIM_SPRINGS64) buffer SimSprings64 { SimSpringSlots64 sim_springs64[]; };
 void main() {
   // Touch each block so no compiler drops it.
   sdf_triangles[0].face_normal.w += 1.0;

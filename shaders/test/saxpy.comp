@@ -1,8 +1,10 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require
 // y <- a x + y: the smallest kernel, used by tests of the GPU layer (dispatch, barriers, readback, timers).
+#include "test/bindings.h"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer X { float x[]; };
-layout(std430, binding = 1) buffer Y { float y[]; };
+layout(std430, binding = TS_TEST_SAXPY_X) readonly buffer X { float x[]; };
+layout(std430, binding = TS_TEST_SAXPY_Y) buffer Y { float y[]; };
 uniform float a;
 uniform uint count;
 void main() {

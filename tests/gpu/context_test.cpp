@@ -8,6 +8,7 @@
 #include "gpu/context.h"
 #include "gpu/gl.h"
 #include "gpu/shader_library.h"
+#include "shaders/test/bindings.h"
 
 namespace ts::gpu {
 namespace {
@@ -51,8 +52,8 @@ TEST(GpuQueue, DispatchComputesSaxpyAndReadsBack) {
   std::iota(x.begin(), x.end(), 0.0f);
   std::fill(y.begin(), y.end(), 1.0f);
   Buffer bx = Buffer::from<float>(x), by = Buffer::from<float>(y);
-  bx.bind(0);
-  by.bind(1);
+  bx.bind(TS_TEST_SAXPY_X);
+  by.bind(TS_TEST_SAXPY_Y);
   saxpy.set("a", 2.0f);
   saxpy.set("count", n);
   Queue queue(/*timings=*/true, /*check_errors=*/true);

@@ -1,0 +1,71 @@
+// Binding slots of the simulator's kernels, named once for GLSL and C++ (sim/gpu_stepper.cpp).
+// The state buffers (TS_SIM_PARTICLE_* .. TS_SIM_STAT_PARTIALS, 0-25) are one structure of arrays, one
+// vec4 (or uvec4) buffer per quantity, bound together by GpuStepper::bind_state before each step's
+// kernels. The re-sort's scratch buffers (TS_SIM_RESORT_*, TS_SIM_GATHER_*) reuse low slots only in
+// their own passes, which bind them first. The preview renderer, which shares the context in
+// `tetrasand sim`, keeps clear of every slot here (shaders/preview/bindings.h); tests/gpu/
+// bindings_test.cpp checks that, that no kernel uses a bare number and that no two names of one
+// pass share a slot. The hashed grid's slots are in shaders/common/bindings.h.
+//
+//   pass (kernel)                 slots
+//   sim/update_particles.comp     PARTICLE_POSITION, _VELOCITY, _INFO, _LOCAL, _POSITION_EXACT (fp64),
+//                                 BODY_POSITION, _ORIENTATION, _VELOCITY, _OMEGA
+//   common/grid_* (the grid)      TS_GRID_POSITIONS = PARTICLE_POSITION, TS_SORT_* (1-5)
+//   sim/contact_forces.comp       PARTICLE_POSITION, _VELOCITY, _INFO, _WRENCH, _STATS, _POSITION_EXACT
+//                                 (fp64), BODY_POSITION, _OMEGA, PAIRS, PLANES, CYLINDERS, COUNTERS,
+//                                 SPRINGS, TS_GRID_CELL_START, TS_GRID_SORTED
+//   sim/integrate_bodies.comp     BODY_POSITION, _ORIENTATION, _VELOCITY, _OMEGA, _INV_INERTIA, _RANGE,
+//                                 _MOMENTUM, PARTICLE_WRENCH, COUNTERS, KEYFRAMES
+//   sim/reduce_metrics.comp       BODY_POSITION, _VELOCITY, _OMEGA, _MOMENTUM, METRIC_PARTIALS
+//   sim/reduce_particle_stats.comp PARTICLE_STATS, STAT_PARTIALS
+//   sim/resort_keys.comp          BODY_POSITION, TS_SORT_KEY, TS_SORT_BUCKET_COUNT, TS_SORT_SLOT
+//   sim/resort_ranges.comp        RESORT_ORDER, BODY_RANGE, RESORT_NEW_FIRST
+//   sim/resort_particles.comp     RESORT_ORDER, RESORT_NEW_FIRST, BODY_RANGE, RESORT_NEW_RANGE,
+//                                 RESORT_SOURCE, RESORT_DESTINATION, RESORT_OWNER
+//   sim/gather_rows.comp          GATHER_SOURCE, GATHER_DESTINATION, GATHER_INDEX
+//   sim/resort_fixup.comp         PARTICLE_INFO, RESORT_DESTINATION, RESORT_OWNER, SPRINGS
+#ifndef TETRASAND_SIM_BINDINGS_H
+#define TETRASAND_SIM_BINDINGS_H
+
+// Aliases of shaders/common/bindings.h names (TS_SORT_*) expand where they are used: a user includes
+// both headers.
+
+// ---- State: one buffer per quantity (structure of arrays). real4 = vec4, or dvec4 with TS_FP64.
+#define TS_SIM_PARTICLE_POSITION 0   // vec4: xyz world position [m]; w: radius [m] (= TS_GRID_POSITIONS)
+#define TS_SIM_PARTICLE_VELOCITY 6   // real4: xyz velocity of the sphere centre [m/s]
+#define TS_SIM_PARTICLE_INFO 7       // uvec4: x body index, y material index
+#define TS_SIM_PARTICLE_LOCAL 8      // real4: xyz offset from the body's centre of mass in its frame [m]; w: radius [m]
+#define TS_SIM_BODY_POSITION 9       // real4: xyz centre of mass [m]; w: inverse mass [1/kg] (0 unless dynamic)
+#define TS_SIM_BODY_ORIENTATION 10   // real4: unit quaternion (x, y, z, w); body axes = principal axes
+#define TS_SIM_BODY_VELOCITY 11      // real4: xyz [m/s]; w: motion type (TS_MOTION_*)
+#define TS_SIM_BODY_OMEGA 12         // real4: xyz angular velocity [rad/s] (derived from the momentum)
+#define TS_SIM_BODY_INV_INERTIA 13   // 3 real4 per body: rows of I0^-1 (body frame) [1/(kg m^2)]; row 0 w: bounding radius [m]
+#define TS_SIM_BODY_RANGE 14         // uvec4: x first particle, y particle count, z first keyframe, w keyframe count (0: none)
+// 2 real4 per particle (one buffer, so the contact kernel stays within 16 storage blocks): [2i] xyz
+// contact force on the particle [N]; [2i + 1] xyz its torque about the body's centre of mass [N m].
+#define TS_SIM_PARTICLE_WRENCH 15
+#define TS_SIM_SPRINGS 16            // SimSpringSlots (SimSpringSlots64 with TS_FP64) per particle
+#define TS_SIM_PAIRS 17              // SimPair[material_count^2]
+#define TS_SIM_PLANES 18             // SimPlane[]
+#define TS_SIM_CYLINDERS 19          // SimCylinder[]
+#define TS_SIM_PARTICLE_STATS 20     // vec4: x pair contacts (counted by the lower id), y wall contacts, z largest overlap / smaller radius, w overlap clamps
+#define TS_SIM_COUNTERS 21           // uint[]: 0 velocity clamps, 1 angular velocity clamps, 2 spring slot overflows
+#define TS_SIM_BODY_MOMENTUM 22      // real4: xyz angular momentum [kg m^2/s] (world frame)
+#define TS_SIM_PARTICLE_POSITION_EXACT 23  // dvec4 (TS_FP64 only): the particle position before rounding to float [m]
+#define TS_SIM_METRIC_PARTIALS 24    // dvec4 per 256 bodies: kinetic translational, rotational, potential [J], non-finite bodies
+#define TS_SIM_STAT_PARTIALS 25      // vec4 per 256 particles: TS_SIM_PARTICLE_STATS summed (z: max)
+#define TS_SIM_KEYFRAMES 26          // 2 real4 per key of a kinematic track (sim::Keyframe): xyz centre of mass [m], w time [s]; quaternion (x, y, z, w)
+
+// ---- Re-sort by Morton key (GpuStepper::resort): the keys go through gpu::BucketSort (TS_SORT_*).
+#define TS_SIM_RESORT_ORDER TS_SORT_SORTED  // uint per new body: its old index (the sort's output)
+#define TS_SIM_RESORT_NEW_FIRST 6           // uint per new body: its first particle in the new order
+#define TS_SIM_RESORT_NEW_RANGE 1           // uvec4 per new body: its new TS_SIM_BODY_RANGE row
+#define TS_SIM_RESORT_SOURCE 2              // uint per new particle: its old index
+#define TS_SIM_RESORT_DESTINATION 3         // uint per old particle: its new index
+#define TS_SIM_RESORT_OWNER 4               // uint per new particle: its new body
+// Row gather (gather_rows.comp): destination row r = source row index[r], rows of `width` uvec4.
+#define TS_SIM_GATHER_SOURCE 1
+#define TS_SIM_GATHER_DESTINATION 2
+#define TS_SIM_GATHER_INDEX 3
+
+#endif

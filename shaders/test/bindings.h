@@ -1,0 +1,19 @@
+// Binding slots of the test kernels (tests/gpu/), named once for GLSL and the tests.
+//   test/saxpy.comp          TS_TEST_SAXPY_X, TS_TEST_SAXPY_Y
+//   test/layout_probe.comp   TS_TEST_PROBE_* (one block per shared layout; the tests read offsets back)
+#ifndef TETRASAND_TEST_BINDINGS_H
+#define TETRASAND_TEST_BINDINGS_H
+
+#define TS_TEST_SAXPY_X 0  // float[]: x, read
+#define TS_TEST_SAXPY_Y 1  // float[]: y, y <- a x + y
+
+#define TS_TEST_PROBE_SDF_TRIANGLES 0
+#define TS_TEST_PROBE_SAMPLER_GRIDS 1
+#define TS_TEST_PROBE_SIM_PAIRS 2
+#define TS_TEST_PROBE_SIM_PLANES 3
+#define TS_TEST_PROBE_SDF_PRISMS 4
+#define TS_TEST_PROBE_SIM_CYLINDERS 5
+#define TS_TEST_PROBE_SIM_SPRINGS 6
+#define TS_TEST_PROBE_SIM_SPRINGS64 7
+
+#endif

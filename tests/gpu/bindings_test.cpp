@@ -1,0 +1,193 @@
+// Static checks of the binding slots shared by GLSL and C++ (shaders/*/bindings.h): no shader or host
+// call uses a bare slot number, no two blocks of one pass share a slot, and the simulator and the
+// preview renderer, which share a context in `tetrasand sim`, use disjoint slots. Reads the sources
+// only; no GL context.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "gpu/shader_library.h"
+
+namespace ts::gpu {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSource = TETRASAND_SOURCE_DIR;
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream out;
+  out << in.rdbuf();
+  return out.str();
+}
+
+// Every file below `dir` whose extension is in `extensions`, as paths relative to `dir`.
+std::vector<fs::path> files_below(const fs::path& dir, const std::set<std::string>& extensions) {
+  std::vector<fs::path> out;
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    if (entry.is_regular_file() && extensions.count(entry.path().extension().string())) {
+      out.push_back(fs::relative(entry.path(), dir));
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// "file:line: text" for each line of `text` that matches `pattern`.
+std::vector<std::string> matching_lines(const std::string& text, const std::regex& pattern, const std::string& file) {
+  std::vector<std::string> hits;
+  std::istringstream lines(text);
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    if (std::regex_search(line, pattern)) hits.push_back(file + ":" + std::to_string(number) + ": " + line);
+  }
+  return hits;
+}
+
+// The slot namespaces GL keeps apart.
+enum class SlotKind { StorageBuffer, UniformBuffer, Image, Texture };
+
+struct Declaration {
+  SlotKind kind;
+  std::string block;  // block name, or the uniform's name for images and samplers
+  std::string slot;   // as written: a macro name or (an error) a number
+};
+
+// Every `layout(... binding = X ...)` declaration of a resolved shader source.
+std::vector<Declaration> declarations(const std::string& text) {
+  static const std::regex buffer(R"(layout\s*\(([^)]*)\)\s*(?:\w+\s+)*buffer\s+(\w+))");
+  static const std::regex uniform_block(R"(layout\s*\(([^)]*)\)\s*uniform\s+(\w+)\s*\{)");
+  static const std::regex opaque(R"(layout\s*\(([^)]*)\)\s*(?:\w+\s+)*uniform\s+(?:\w+\s+)*(\w*(?:image|sampler)\w*)\s+(\w+))");
+  static const std::regex binding(R"(binding\s*=\s*(\w+))");
+  std::vector<Declaration> out;
+  auto scan = [&](const std::regex& pattern, auto kind_of) {
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), pattern); it != std::sregex_iterator(); ++it) {
+      const std::string qualifiers = (*it)[1];
+      std::smatch slot;
+      if (!std::regex_search(qualifiers, slot, binding)) continue;
+      out.push_back({kind_of(*it), (*it)[it->size() - 1], slot[1]});
+    }
+  };
+  scan(buffer, [](const std::smatch&) { return SlotKind::StorageBuffer; });
+  scan(uniform_block, [](const std::smatch&) { return SlotKind::UniformBuffer; });
+  scan(opaque, [](const std::smatch& m) {
+    return m[2].str().find("image") != std::string::npos ? SlotKind::Image : SlotKind::Texture;
+  });
+  return out;
+}
+
+// `#define NAME VALUE` of a resolved source, aliases followed to a number (-1 when undefined).
+class Macros {
+ public:
+  explicit Macros(const std::string& text) {
+    static const std::regex define(R"(^\s*#define\s+(\w+)\s+(\w+))");
+    std::istringstream lines(text);
+    std::string line;
+    std::smatch m;
+    while (std::getline(lines, line)) {
+      if (std::regex_search(line, m, define)) values_[m[1]] = m[2];
+    }
+  }
+  long value(std::string name) const {
+    for (int hops = 0; hops < 8; ++hops) {
+      if (!name.empty() && std::isdigit(static_cast<unsigned char>(name[0]))) return std::stol(name);
+      const auto it = values_.find(name);
+      if (it == values_.end()) return -1;
+      name = it->second;
+    }
+    return -1;
+  }
+
+ private:
+  std::map<std::string, std::string> values_;
+};
+
+// A pass is one program: the shader files of one folder that share a stem (raycast.vert + .frag).
+std::map<fs::path, std::vector<fs::path>> passes() {
+  std::map<fs::path, std::vector<fs::path>> out;
+  for (const fs::path& file : files_below(kSource / "shaders", {".comp", ".vert", ".geom", ".frag"})) {
+    out[file.parent_path() / file.stem()].push_back(file);
+  }
+  return out;
+}
+
+// kind and slot number -> the names of the blocks a pass declares there.
+using SlotUse = std::map<std::pair<SlotKind, long>, std::set<std::string>>;
+
+SlotUse slots_of_pass(const std::vector<fs::path>& files) {
+  const ShaderLibrary library(kSource / "shaders");
+  SlotUse use;
+  for (const fs::path& file : files) {
+    // Both branches of #ifdef TS_FP64 are read; a block declared twice keeps one name, so it counts once.
+    const std::string text = library.load(file.generic_string()).text;
+    const Macros macros(text);
+    for (const Declaration& d : declarations(text)) {
+      const long slot = macros.value(d.slot);
+      EXPECT_GE(slot, 0) << file << ": block " << d.block << " binds to " << d.slot << ", which no header defines";
+      use[{d.kind, slot}].insert(d.block);
+    }
+  }
+  return use;
+}
+
+TEST(Bindings, NoShaderUsesABareSlotNumber) {
+  const std::regex bare(R"(binding\s*=\s*[0-9])");
+  std::vector<std::string> hits;
+  for (const fs::path& file : files_below(kSource / "shaders", {".comp", ".vert", ".geom", ".frag", ".glsl", ".h"})) {
+    for (auto& hit : matching_lines(read_text(kSource / "shaders" / file), bare, file.generic_string())) hits.push_back(hit);
+  }
+  EXPECT_TRUE(hits.empty()) << "name the slot in the stage's bindings.h:\n" << ::testing::PrintToString(hits);
+}
+
+TEST(Bindings, NoHostCallBindsABareSlotNumber) {
+  // Buffer::bind, and the GL calls that take a binding point or unit first.
+  const std::regex bare(R"((\.bind\(\s*[0-9])|(glBindBuffer(Base|Range)\(\s*\w+\s*,\s*[0-9])|(glBind(TextureUnit|ImageTexture|Sampler)\(\s*[0-9]))");
+  std::vector<std::string> hits;
+  for (const char* dir : {"core", "gpu", "sdf", "sampler", "sim", "preview", "app", "bench", "tests"}) {
+    for (const fs::path& file : files_below(kSource / dir, {".cpp", ".h"})) {
+      const fs::path path = fs::path(dir) / file;
+      for (auto& hit : matching_lines(read_text(kSource / path), bare, path.generic_string())) hits.push_back(hit);
+    }
+  }
+  EXPECT_TRUE(hits.empty()) << "use the slot's name from shaders/*/bindings.h:\n" << ::testing::PrintToString(hits);
+}
+
+TEST(Bindings, NoTwoBlocksOfOnePassShareASlot) {
+  const auto all = passes();
+  ASSERT_GT(all.size(), 20u);  // the check must see the kernels it guards
+  for (const auto& [pass, files] : all) {
+    for (const auto& [slot, blocks] : slots_of_pass(files)) {
+      EXPECT_EQ(blocks.size(), 1u) << pass << ": slot " << slot.second << " holds " << ::testing::PrintToString(blocks);
+    }
+  }
+}
+
+TEST(Bindings, TheSimulatorAndThePreviewKeepClearOfEachOthersBuffers) {
+  // `tetrasand sim` renders frames in the simulator's context: a preview pass must not leave a buffer
+  // where the simulator expects its state, whatever order the passes bind in.
+  std::map<long, std::string> sim, preview;
+  for (const auto& [pass, files] : passes()) {
+    const std::string stage = pass.begin()->string();
+    if (stage != "sim" && stage != "preview") continue;
+    for (const auto& [slot, blocks] : slots_of_pass(files)) {
+      if (slot.first != SlotKind::StorageBuffer) continue;
+      (stage == "sim" ? sim : preview)[slot.second] = pass.generic_string() + " " + *blocks.begin();
+    }
+  }
+  ASSERT_FALSE(sim.empty());
+  ASSERT_FALSE(preview.empty());
+  for (const auto& [slot, user] : preview) {
+    EXPECT_EQ(sim.count(slot), 0u) << "slot " << slot << ": " << user << " and " << sim[slot];
+  }
+}
+
+}  // namespace
+}  // namespace ts::gpu
