@@ -14,22 +14,6 @@
 #include "sim/scene_runner.h"
 
 namespace ts::app {
-namespace {
-
-// Hands run_scene a stepper it may destroy while the GPU stepper itself (and its kernel timings)
-// lives on in the command for the report at the end.
-class BorrowedStepper : public sim::Stepper {
- public:
-  explicit BorrowedStepper(sim::Stepper& stepper) : stepper_(stepper) {}
-  void load(const sim::World& world) override { stepper_.load(world); }
-  sim::StepStats advance(sim::World& world, std::int64_t steps) override { return stepper_.advance(world, steps); }
-  std::vector<sim::ContactRecord> contacts(const sim::World& world) override { return stepper_.contacts(world); }
-
- private:
-  sim::Stepper& stepper_;
-};
-
-}  // namespace
 
 Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
   auto* cmd = app.add_subcommand("sim", "Run a tetrahedral-grain DEM scene (TOML) on the GPU");
@@ -54,17 +38,12 @@ Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
     sim::Scene scene = sim::load_scene(o->scene);
     if (o->duration > 0) scene.simulation.duration = o->duration;
     std::unique_ptr<gpu::Context> context;
-    std::unique_ptr<sim::GpuPipelineStepper> gpu_stepper;
-    std::function<std::unique_ptr<sim::Stepper>(const sim::StepSettings&)> make_stepper;
+    sim::StepperFactory make_stepper;
     if (!o->cpu) {
-      gpu::ContextOptions options;
-      options.device = global.device;
-      options.debug = global.gl_debug;
-      context = std::make_unique<gpu::Context>(options);
+      context = std::make_unique<gpu::Context>(context_options(global));
       make_stepper = [&](const sim::StepSettings& settings) -> std::unique_ptr<sim::Stepper> {
-        gpu_stepper = std::make_unique<sim::GpuPipelineStepper>(
+        return std::make_unique<sim::GpuStepper>(
             *context, settings, o->precision == "double" ? sim::Precision::Double : sim::Precision::Float, o->timings);
-        return std::make_unique<BorrowedStepper>(*gpu_stepper);
       };
     }
     const bool terminal = ::isatty(STDERR_FILENO) != 0;
@@ -72,7 +51,7 @@ Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
     sim::RunHooks hooks;
     std::unique_ptr<preview::SimFrameWriter> frames;  // [output] frames = true: PNGs through the preview renderer
     if (scene.output.frames) {
-      if (!context) context = std::make_unique<gpu::Context>(gpu::ContextOptions{global.device, global.gl_debug});
+      if (!context) context = std::make_unique<gpu::Context>(context_options(global));
       frames = std::make_unique<preview::SimFrameWriter>(*context, scene);
       hooks.write_frame = [&frames](const sim::World& world, std::int64_t frame, const std::filesystem::path& dir) {
         frames->write(world, frame, dir);
@@ -91,6 +70,8 @@ Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
         log::info("{}", line);
       }
     };
+    std::string timing_report;
+    if (o->timings) hooks.on_finish = [&](sim::Stepper& stepper) { timing_report = stepper.timing_report(); };
     const sim::RunResult result = sim::run_scene(scene, o->output, hooks, make_stepper);
     if (terminal) std::fprintf(stderr, "\n");
     if (!result.time_step_warning.empty()) log::warn("{}", result.time_step_warning);
@@ -106,7 +87,7 @@ Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
                  result.spring_overflows, sim::ContactSprings::kSlots);
     }
     fmt::print("outputs: {}/metrics.csv ({} rows)\n", o->output, result.outputs);
-    if (o->timings && gpu_stepper) fmt::print("{}", gpu_stepper->timing_report());
+    if (!timing_report.empty()) fmt::print("{}", timing_report);
     return 0;
   };
 }

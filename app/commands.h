@@ -4,6 +4,8 @@
 
 #include <functional>
 
+#include "gpu/context.h"
+
 namespace ts::app {
 
 struct GlobalOptions {
@@ -14,6 +16,14 @@ struct GlobalOptions {
 };
 
 using Runner = std::function<int()>;
+
+// The GL context options every GPU command takes from the global flags.
+inline gpu::ContextOptions context_options(const GlobalOptions& global) {
+  gpu::ContextOptions options;
+  options.device = global.device;
+  options.debug = global.gl_debug;
+  return options;
+}
 
 Runner add_devices_command(CLI::App& app, const GlobalOptions& global);
 Runner add_export_command(CLI::App& app, const GlobalOptions& global);

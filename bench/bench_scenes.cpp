@@ -9,6 +9,7 @@
 
 #include "sim/grain.h"
 #include "sim/scene_runner.h"
+#include "sim/scene_world.h"
 
 namespace ts::bench {
 

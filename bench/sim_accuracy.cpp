@@ -29,6 +29,7 @@
 #include "sim/gpu_stepper.h"
 #include "sim/scene.h"
 #include "sim/scene_runner.h"
+#include "sim/scene_world.h"
 
 namespace {
 
@@ -149,7 +150,7 @@ std::string pile_runs(ts::gpu::Context& context, const std::vector<double>& modu
         std::function<std::unique_ptr<Stepper>(const StepSettings&)> make;
         if (backend.gpu) {
           make = [&](const StepSettings& s) -> std::unique_ptr<Stepper> {
-            return std::make_unique<GpuPipelineStepper>(context, s, backend.precision, false);
+            return std::make_unique<GpuStepper>(context, s, backend.precision, false);
           };
         }
         const std::string name = fmt::format("heap_{}_E{:g}_dt{:g}", backend.name, e, factor);

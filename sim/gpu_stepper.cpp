@@ -10,6 +10,7 @@
 #include "gpu/layouts.h"
 #include "shaders/common/bindings.h"
 #include "shaders/sim/bindings.h"
+#include "sim/cpu_contacts.h"
 
 namespace ts::sim {
 namespace {
@@ -33,31 +34,11 @@ struct EnergyCheck {
   double reference = 0.0, scale = 0.0;
 };
 
-// Energy (J) in the contact springs of `world` as uploaded, found once by the CPU reference: initial
-// overlaps that relax turn it into kinetic energy, which is no blow-up.
+// Energy (J) in the contact springs of `world` as uploaded, found once by the CPU reference's contact
+// stage: initial overlaps that relax turn it into kinetic energy, which is no blow-up.
 double spring_energy(const World& world, const StepSettings& settings) {
   if (world.particles.size() == 0) return 0.0;
-  CpuStepper probe(world, settings);
-  double total = 0.0;
-  for (const ContactRecord& c : probe.contacts(world)) {
-    const std::size_t i = c.particle;
-    const double ri = world.particles.radius[i];
-    double radius = ri;
-    std::uint16_t other = 0;
-    if (c.partner >= 0) {
-      const double rj = world.particles.radius[static_cast<std::size_t>(c.partner)];
-      radius = ri * rj / (ri + rj);
-      other = world.particles.material[static_cast<std::size_t>(c.partner)];
-    } else {
-      const std::size_t wall = static_cast<std::size_t>(-1 - c.partner);
-      other = wall < world.walls.planes.size() ? world.walls.planes[wall].material
-                                               : world.walls.cylinders[wall - world.walls.planes.size()].material;
-    }
-    const PairCoefficients pair = make_pair_coefficients(world.materials[world.particles.material[i]],
-                                                         world.materials[other], settings.normal_damping);
-    total += hertz_elastic_energy(c.overlap, radius, pair.effective_modulus);
-  }
-  return total;
+  return CpuContacts(settings).elastic_energy(world);
 }
 
 EnergyCheck energy_check(const World& world, const StepSettings& settings) {
@@ -78,6 +59,11 @@ EnergyCheck energy_check(const World& world, const StepSettings& settings) {
 
 GpuStepper::GpuStepper(gpu::Context& context, const World& world, const StepSettings& settings, Precision precision,
                        bool timings)
+    : GpuStepper(context, settings, precision, timings) {
+  upload(world);
+}
+
+GpuStepper::GpuStepper(gpu::Context& context, const StepSettings& settings, Precision precision, bool timings)
     : context_(context),
       settings_(settings),
       precision_(precision),
@@ -94,9 +80,7 @@ GpuStepper::GpuStepper(gpu::Context& context, const World& world, const StepSett
       resort_fixup_(gpu::Program::compute(library_, "sim/resort_fixup.comp", precision_defines(precision))),
       gather_rows_(gpu::Program::compute(library_, "sim/gather_rows.comp")),
       bucket_sort_(library_),
-      resort_scan_(library_) {
-  upload(world);
-}
+      resort_scan_(library_) {}
 
 template <typename T>
 gpu::Buffer GpuStepper::real_buffer(const std::vector<T>& values) const {
@@ -111,52 +95,133 @@ std::vector<double> GpuStepper::read_real(const gpu::Buffer& buffer, std::size_t
   return {values.begin(), values.end()};
 }
 
+namespace {
+
+// Body state as the kernels read it: one real4 row per body and quantity (three for the inverse
+// inertia), and keyframed tracks appended to one key buffer.
+struct PackedBodies {
+  std::vector<double> position, orientation, velocity, omega, inverse_inertia, momentum, keys;
+  std::vector<std::uint32_t> range;  // uvec4 per body: first particle, count, first key, key count
+};
+
+double motion_code(MotionType motion) {
+  return motion == MotionType::Dynamic     ? TS_MOTION_DYNAMIC
+         : motion == MotionType::Kinematic ? TS_MOTION_KINEMATIC
+                                           : TS_MOTION_STATIC;
+}
+
+void pack_body(const Bodies& b, std::size_t k, PackedBodies& out) {
+  const bool dynamic = b.motion[k] == MotionType::Dynamic;
+  append(out.position, b.position[k], dynamic ? b.inverse_mass[k] : 0.0);
+  const Eigen::Quaterniond& q = b.orientation[k];
+  out.orientation.insert(out.orientation.end(), {q.x(), q.y(), q.z(), q.w()});
+  append(out.velocity, b.linear_velocity[k], motion_code(b.motion[k]));
+  append(out.omega, b.angular_velocity[k], 0.0);
+  const Eigen::Matrix3d inv = dynamic ? b.inverse_inertia[k] : Eigen::Matrix3d::Zero();
+  for (int row = 0; row < 3; ++row) append(out.inverse_inertia, inv.row(row).transpose(), row == 0 ? b.bounding_radius[k] : 0.0);
+  // The GPU integrates the angular momentum L = I_world omega (omega = R I0^-1 R^T L).
+  Eigen::Vector3d l = Eigen::Vector3d::Zero();
+  if (dynamic) {
+    const Eigen::Matrix3d r = q.toRotationMatrix();
+    l = (r * b.inverse_inertia[k] * r.transpose()).inverse() * b.angular_velocity[k];
+  }
+  append(out.momentum, l, 0.0);
+  out.range.insert(out.range.end(), {b.first_particle[k], b.particle_count[k], 0u, 0u});
+}
+
+PackedBodies pack_bodies(const World& world) {
+  PackedBodies out;
+  for (std::size_t k = 0; k < world.bodies.size(); ++k) pack_body(world.bodies, k, out);
+  // Keyframed kinematic bodies: their keys, and where they start in body_range's z and w.
+  for (const KinematicTrack& track : world.tracks) {
+    out.range[4 * track.body + 2] = static_cast<std::uint32_t>(out.keys.size() / 8);
+    out.range[4 * track.body + 3] = static_cast<std::uint32_t>(track.keys.size());
+    for (const Keyframe& key : track.keys) {
+      append(out.keys, key.position, key.time);
+      out.keys.insert(out.keys.end(), {key.orientation.x(), key.orientation.y(), key.orientation.z(), key.orientation.w()});
+    }
+  }
+  if (out.keys.empty()) out.keys.assign(8, 0.0);  // a placeholder keeps the binding valid
+  return out;
+}
+
+std::vector<SimPair> pack_pairs(const std::vector<Material>& materials, const StepSettings& settings) {
+  std::vector<SimPair> pairs;
+  for (const Material& a : materials) {
+    for (const Material& c : materials) {
+      const PairCoefficients k = make_pair_coefficients(a, c, settings.normal_damping, settings.thesis_reference_speed);
+      SimPair pair{};
+      pair.coefficients = {static_cast<float>(k.effective_modulus), static_cast<float>(k.friction),
+                           static_cast<float>(k.tangential_damping), static_cast<float>(k.damping_strength)};
+      pair.extra = {static_cast<float>(k.thesis_reference_speed), static_cast<float>(k.effective_shear_modulus), 0.0f,
+                    0.0f};
+      pairs.push_back(pair);
+    }
+  }
+  return pairs;
+}
+
+std::vector<SimPlane> pack_planes(const std::vector<PlaneWall>& walls) {
+  std::vector<SimPlane> planes;
+  for (const PlaneWall& w : walls) {
+    SimPlane plane{};
+    plane.normal_offset = {static_cast<float>(w.normal.x()), static_cast<float>(w.normal.y()),
+                           static_cast<float>(w.normal.z()), static_cast<float>(w.normal.dot(w.point))};
+    plane.extent = {0.0f, 0.0f, 0.0f, 0.0f};
+    plane.material = {w.material, 0u, 0u, 0u};
+    planes.push_back(plane);
+  }
+  return planes;
+}
+
+std::vector<SimCylinder> pack_cylinders(const std::vector<CylinderWall>& walls) {
+  std::vector<SimCylinder> cylinders;
+  for (const CylinderWall& w : walls) {
+    SimCylinder c{};
+    c.axis_radius = {static_cast<float>(w.axis.x()), static_cast<float>(w.axis.y()), 0.0f, static_cast<float>(w.radius)};
+    c.range = {static_cast<float>(std::max(w.z_min, -1e30)), static_cast<float>(std::min(w.z_max, 1e30)), 0.0f, 0.0f};
+    c.material = {w.material, 0u, 0u, 0u};
+    cylinders.push_back(c);
+  }
+  return cylinders;
+}
+
+}  // namespace
+
 void GpuStepper::upload(const World& world) {
-  const Bodies& b = world.bodies;
-  const Particles& p = world.particles;
-  body_count_ = static_cast<std::uint32_t>(b.size());
-  particle_count_ = static_cast<std::uint32_t>(p.size());
+  loaded_ = true;
+  body_count_ = static_cast<std::uint32_t>(world.bodies.size());
+  particle_count_ = static_cast<std::uint32_t>(world.particles.size());
   time_ = world.time;
   gravity_ = world.gravity;
   const EnergyCheck check = energy_check(world, settings_);
   energy_reference_ = check.reference;
   energy_scale_ = check.scale;
-  any_kinematic_ = std::find(b.motion.begin(), b.motion.end(), MotionType::Kinematic) != b.motion.end();
-  const std::size_t real_size = precision_ == Precision::Double ? 8 : 4;
+  any_kinematic_ = std::find(world.bodies.motion.begin(), world.bodies.motion.end(), MotionType::Kinematic) !=
+                   world.bodies.motion.end();
+  upload_bodies(world);
+  upload_particles(world);
+  upload_springs(world);
+  allocate_resort(body_count_, particle_count_);
+  allocate_statistics();
+  upload_materials_and_walls(world);
+  set_uniforms();
+}
 
-  std::vector<double> position, orientation, velocity, omega, inverse_inertia, momentum;
-  std::vector<std::uint32_t> range;
-  for (std::size_t k = 0; k < b.size(); ++k) {
-    const bool dynamic = b.motion[k] == MotionType::Dynamic;
-    append(position, b.position[k], dynamic ? b.inverse_mass[k] : 0.0);
-    orientation.insert(orientation.end(), {b.orientation[k].x(), b.orientation[k].y(), b.orientation[k].z(),
-                                           b.orientation[k].w()});
-    append(velocity, b.linear_velocity[k], static_cast<double>(b.motion[k] == MotionType::Dynamic     ? TS_MOTION_DYNAMIC
-                                                               : b.motion[k] == MotionType::Kinematic ? TS_MOTION_KINEMATIC
-                                                                                                      : TS_MOTION_STATIC));
-    append(omega, b.angular_velocity[k], 0.0);
-    const Eigen::Matrix3d inv = dynamic ? b.inverse_inertia[k] : Eigen::Matrix3d::Zero();
-    for (int row = 0; row < 3; ++row) append(inverse_inertia, inv.row(row).transpose(), row == 0 ? b.bounding_radius[k] : 0.0);
-    // The GPU integrates the angular momentum L = I_world omega (omega = R I0^-1 R^T L).
-    Eigen::Vector3d l = Eigen::Vector3d::Zero();
-    if (dynamic) {
-      const Eigen::Matrix3d r = b.orientation[k].toRotationMatrix();
-      l = (r * b.inverse_inertia[k] * r.transpose()).inverse() * b.angular_velocity[k];
-    }
-    append(momentum, l, 0.0);
-    range.insert(range.end(), {b.first_particle[k], b.particle_count[k], 0u, 0u});
-  }
-  // Keyframed kinematic bodies: their keys, and where they start in body_range's z and w.
-  std::vector<double> keys;
-  for (const KinematicTrack& track : world.tracks) {
-    range[4 * track.body + 2] = static_cast<std::uint32_t>(keys.size() / 8);
-    range[4 * track.body + 3] = static_cast<std::uint32_t>(track.keys.size());
-    for (const Keyframe& key : track.keys) {
-      append(keys, key.position, key.time);
-      keys.insert(keys.end(), {key.orientation.x(), key.orientation.y(), key.orientation.z(), key.orientation.w()});
-    }
-  }
-  if (keys.empty()) keys.assign(8, 0.0);  // a placeholder keeps the binding valid
+void GpuStepper::upload_bodies(const World& world) {
+  const PackedBodies packed = pack_bodies(world);
+  body_position_ = real_buffer(packed.position);
+  body_orientation_ = real_buffer(packed.orientation);
+  body_velocity_ = real_buffer(packed.velocity);
+  body_omega_ = real_buffer(packed.omega);
+  body_inverse_inertia_ = real_buffer(packed.inverse_inertia);
+  body_momentum_ = real_buffer(packed.momentum);
+  body_range_ = gpu::Buffer::from<std::uint32_t>(packed.range);
+  keyframes_ = real_buffer(packed.keys);
+}
+
+void GpuStepper::upload_particles(const World& world) {
+  const Particles& p = world.particles;
   std::vector<double> local;
   std::vector<std::uint32_t> info;
   double max_radius = 0.0;
@@ -166,66 +231,35 @@ void GpuStepper::upload(const World& world) {
     max_radius = std::max(max_radius, p.radius[i]);
   }
   cell_size_ = particle_count_ > 0 ? 2.0 * max_radius : 1.0;
-
-  body_position_ = real_buffer(position);
-  body_orientation_ = real_buffer(orientation);
-  body_velocity_ = real_buffer(velocity);
-  body_omega_ = real_buffer(omega);
-  body_inverse_inertia_ = real_buffer(inverse_inertia);
-  body_momentum_ = real_buffer(momentum);
-  body_range_ = gpu::Buffer::from<std::uint32_t>(range);
-  keyframes_ = real_buffer(keys);
+  const std::size_t real_size = precision_ == Precision::Double ? 8 : 4;
   particle_local_ = real_buffer(local);
   particle_info_ = gpu::Buffer::from<std::uint32_t>(info);
   particle_position_ = gpu::Buffer(particle_count_ * 16);
   particle_position_exact_ = gpu::Buffer(precision_ == Precision::Double ? particle_count_ * 32 : 16);
   particle_velocity_ = gpu::Buffer(particle_count_ * 4 * real_size);
   particle_wrench_ = gpu::Buffer(particle_count_ * 8 * real_size);
-  upload_springs(world);
-  allocate_resort(body_count_, particle_count_);
+}
+
+void GpuStepper::allocate_statistics() {
   particle_stats_buffer_ = gpu::Buffer(particle_count_ * 16);
   counters_ = gpu::Buffer(4 * sizeof(std::uint32_t));
   counters_.fill_zero();
   metric_partials_ = gpu::Buffer(((body_count_ + 255) / 256 + 1) * 32);
   stat_partials_ = gpu::Buffer(((particle_count_ + 255) / 256 + 1) * 16);
+}
 
+void GpuStepper::upload_materials_and_walls(const World& world) {
   material_count_ = static_cast<std::uint32_t>(world.materials.size());
-  std::vector<SimPair> pairs;
-  for (const Material& a : world.materials) {
-    for (const Material& c : world.materials) {
-      const PairCoefficients k =
-          make_pair_coefficients(a, c, settings_.normal_damping, settings_.thesis_reference_speed);
-      SimPair pair{};
-      pair.coefficients = {static_cast<float>(k.effective_modulus), static_cast<float>(k.friction),
-                           static_cast<float>(k.tangential_damping), static_cast<float>(k.damping_strength)};
-      pair.extra = {static_cast<float>(k.thesis_reference_speed), static_cast<float>(k.effective_shear_modulus), 0.0f,
-                    0.0f};
-      pairs.push_back(pair);
-    }
-  }
-  pairs_ = gpu::Buffer::from<SimPair>(pairs);
-  std::vector<SimPlane> planes;
-  for (const PlaneWall& w : world.walls.planes) {
-    SimPlane plane{};
-    plane.normal_offset = {static_cast<float>(w.normal.x()), static_cast<float>(w.normal.y()),
-                           static_cast<float>(w.normal.z()), static_cast<float>(w.normal.dot(w.point))};
-    plane.extent = {0.0f, 0.0f, 0.0f, 0.0f};
-    plane.material = {w.material, 0u, 0u, 0u};
-    planes.push_back(plane);
-  }
-  std::vector<SimCylinder> cylinders;
-  for (const CylinderWall& w : world.walls.cylinders) {
-    SimCylinder c{};
-    c.axis_radius = {static_cast<float>(w.axis.x()), static_cast<float>(w.axis.y()), 0.0f, static_cast<float>(w.radius)};
-    c.range = {static_cast<float>(std::max(w.z_min, -1e30)), static_cast<float>(std::min(w.z_max, 1e30)), 0.0f, 0.0f};
-    c.material = {w.material, 0u, 0u, 0u};
-    cylinders.push_back(c);
-  }
+  pairs_ = gpu::Buffer::from<SimPair>(pack_pairs(world.materials, settings_));
+  const std::vector<SimPlane> planes = pack_planes(world.walls.planes);
+  const std::vector<SimCylinder> cylinders = pack_cylinders(world.walls.cylinders);
   plane_count_ = static_cast<std::uint32_t>(planes.size());
   cylinder_count_ = static_cast<std::uint32_t>(cylinders.size());
   planes_ = gpu::Buffer::from<SimPlane>(planes);
   cylinders_ = gpu::Buffer::from<SimCylinder>(cylinders);
+}
 
+void GpuStepper::set_uniforms() {
   const float dt = static_cast<float>(settings_.dt);
   const double max_speed = settings_.cfl > 0 ? settings_.cfl * cell_size_ / settings_.dt : 1e30;
   update_.set("particle_count", particle_count_);
@@ -549,26 +583,14 @@ std::size_t GpuStepper::gpu_bytes() const {
   return total;
 }
 
-void GpuPipelineStepper::load(const World& world) {
-  if (!stepper_) {
-    stepper_ = std::make_unique<GpuStepper>(context_, world, settings_, precision_, timings_);
-  } else {
-    stepper_->upload(world);
-  }
-}
-
-StepStats GpuPipelineStepper::advance(World& world, std::int64_t steps) {
-  if (!stepper_) load(world);
-  stepper_->step(static_cast<int>(steps));
-  StepStats stats = stepper_->statistics();
-  stepper_->download(world);
+StepStats GpuStepper::advance(World& world, std::int64_t steps) {
+  if (!loaded_) upload(world);
+  step(static_cast<int>(steps));
+  StepStats stats = statistics();
+  download(world);
   return stats;
 }
 
-std::vector<ContactRecord> GpuPipelineStepper::contacts(const World& world) {
-  CpuReferenceStepper reference(settings_);
-  reference.load(world);
-  return reference.contacts(world);
-}
+std::vector<ContactRecord> GpuStepper::contacts(const World& world) { return CpuContacts(settings_).contacts(world); }
 
 }  // namespace ts::sim

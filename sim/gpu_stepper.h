@@ -2,7 +2,8 @@
 // The GPU pipeline of the DEM, stage for stage the same as CpuStepper (sim/cpu_reference.h) on the same
 // World: poses -> particle positions and velocities -> hashed grid (counting sort) -> contact forces
 // gathered per particle (no float atomics) -> per-body sums and integration. Steps run with no CPU
-// round trip; statistics and state are read back only when asked.
+// round trip; statistics and state are read back only when asked. What only the CPU reference
+// computes (contact dumps, the spring energy of a loaded state) comes from sim/cpu_contacts.h.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -11,20 +12,31 @@
 #include "gpu/context.h"
 #include "gpu/gl.h"
 #include "gpu/hash_grid.h"
-#include "sim/cpu_reference.h"
-#include "sim/scene_runner.h"
+#include "sim/stepper.h"
 #include "sim/world.h"
 
 namespace ts::sim {
 
 enum class Precision { Float, Double };
 
-class GpuStepper {
+class GpuStepper : public Stepper {
  public:
+  // Compiles the kernels; load() gives the state.
+  GpuStepper(gpu::Context& context, const StepSettings& settings, Precision precision = Precision::Float,
+             bool timings = false);
+  // The same, loaded with `world`.
   GpuStepper(gpu::Context& context, const World& world, const StepSettings& settings,
              Precision precision = Precision::Float, bool timings = false);
 
   // Replaces the whole GPU state with `world` (bodies, particles, walls, materials).
+  void load(const World& world) override { upload(world); }
+  // step(), statistics() and download() in one.
+  StepStats advance(World& world, std::int64_t steps) override;
+  // Recomputed by the CPU reference on `world` (sim/cpu_contacts.h).
+  std::vector<ContactRecord> contacts(const World& world) override;
+  std::string timing_report() override { return queue_.timing_report(); }
+  const StepSettings& settings() const override { return settings_; }
+
   void upload(const World& world);
   // Advances `steps` time steps of settings.dt.
   void step(int steps = 1);
@@ -38,7 +50,6 @@ class GpuStepper {
   // CPU reference).
   std::vector<Eigen::Vector3d> particle_forces() const;
   double time() const { return time_; }
-  std::string timing_report() { return queue_.timing_report(); }
   std::size_t gpu_bytes() const;
   // The world index of each body in GPU memory order (identity until the first re-sort).
   std::vector<std::uint32_t> body_order() const { return original_ids(original_body_, body_count_); }
@@ -48,7 +59,13 @@ class GpuStepper {
   gpu::Buffer real_buffer(const std::vector<T>& values) const;
   std::vector<double> read_real(const gpu::Buffer& buffer, std::size_t count) const;
   void bind_state() const;
+  // The steps of upload().
+  void upload_bodies(const World& world);
+  void upload_particles(const World& world);
   void upload_springs(const World& world);
+  void allocate_statistics();
+  void upload_materials_and_walls(const World& world);
+  void set_uniforms();
   void download_springs(World& world) const;
   void allocate_resort(std::uint32_t body_count, std::uint32_t particle_count);
   // Re-sorts bodies (and their particles, springs renamed) by the cell of their centre.
@@ -82,27 +99,8 @@ class GpuStepper {
   double time_ = 0.0;
   double energy_reference_ = 0.0, energy_scale_ = 0.0;  // J, blow-up check as CpuStepper
   bool any_kinematic_ = false;                          // kinematic bodies do work: no energy check
+  bool loaded_ = false;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
-};
-
-// The GPU pipeline behind the scene runner's Stepper interface. Shaders are compiled once; load()
-// re-uploads the state (at the start and whenever an emitter has added grains).
-class GpuPipelineStepper : public Stepper {
- public:
-  GpuPipelineStepper(gpu::Context& context, const StepSettings& settings, Precision precision, bool timings)
-      : context_(context), settings_(settings), precision_(precision), timings_(timings) {}
-  void load(const World& world) override;
-  StepStats advance(World& world, std::int64_t steps) override;
-  // Contact dumps are recomputed by the CPU reference on the downloaded state.
-  std::vector<ContactRecord> contacts(const World& world) override;
-  std::string timing_report() { return stepper_ ? stepper_->timing_report() : std::string(); }
-
- private:
-  gpu::Context& context_;
-  StepSettings settings_;
-  Precision precision_;
-  bool timings_;
-  std::unique_ptr<GpuStepper> stepper_;
 };
 
 }  // namespace ts::sim

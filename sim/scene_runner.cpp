@@ -10,28 +10,10 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "sim/cpu_reference.h"
+#include "sim/scene_world.h"
 
 namespace ts::sim {
-
-void CpuReferenceStepper::load(const World& world) { stepper_ = std::make_unique<CpuStepper>(world, settings_); }
-
-StepStats CpuReferenceStepper::advance(World& world, std::int64_t steps) {
-  StepStats last, clamps;
-  for (std::int64_t i = 0; i < steps; ++i) {
-    last = stepper_->step(world);
-    clamps.velocity_clamps += last.velocity_clamps;
-    clamps.angular_velocity_clamps += last.angular_velocity_clamps;
-    clamps.overlap_clamps += last.overlap_clamps;
-    clamps.spring_overflows += last.spring_overflows;
-  }
-  last.spring_overflows = clamps.spring_overflows;
-  last.velocity_clamps = clamps.velocity_clamps;
-  last.angular_velocity_clamps = clamps.angular_velocity_clamps;
-  last.overlap_clamps = clamps.overlap_clamps;
-  return last;
-}
-
-std::vector<ContactRecord> CpuReferenceStepper::contacts(const World& world) { return stepper_->contacts(world); }
 
 double resolve_time_step(const Scene& scene, const World& world, std::string* warning) {
   const TimeStepBound bound = scene_time_step_bound(scene, world);
@@ -161,7 +143,7 @@ class OutputWriter {
 }  // namespace
 
 RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir, const RunHooks& hooks,
-                    const std::function<std::unique_ptr<Stepper>(const StepSettings&)>& make_stepper) {
+                    const StepperFactory& make_stepper) {
   World world = make_world(scene);
   RunResult result;
   result.dt = resolve_time_step(scene, world, &result.time_step_warning);
@@ -169,7 +151,7 @@ RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir,
   StepSettings settings = scene.simulation.step;
   settings.dt = result.dt;
   std::unique_ptr<Stepper> stepper =
-      make_stepper ? make_stepper(settings) : std::make_unique<CpuReferenceStepper>(settings);
+      make_stepper ? make_stepper(settings) : std::make_unique<CpuStepper>(settings);
 
   std::vector<PourEmitter> pours;
   std::int64_t emit_every = scene.output.every;  // steps between pour checks: about twice per release
@@ -225,6 +207,7 @@ RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir,
   result.last = stats;
   result.grains = dynamic_bodies(world);
   result.outputs = output.count();
+  if (hooks.on_finish) hooks.on_finish(*stepper);
   return result;
 }
 

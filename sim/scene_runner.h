@@ -1,7 +1,7 @@
 #pragma once
 // Runs a scene from start to finish: builds the world, settles the time step (auto, or the user's
 // with a warning above the bound), releases pour emitters as time passes, steps through a Stepper
-// (the CPU reference here; the GPU pipeline through an adapter) and writes the [output] files:
+// (sim/stepper.h: the CPU reference by default, or the GPU pipeline) and writes the [output] files:
 //   metrics.csv                one row per output (energies, contacts, overlap, clamp and spring-slot
 //                              overflow counts since the previous row)
 //   particles_NNNNNN.ply       binary little-endian: float x y z radius, uint body
@@ -15,42 +15,22 @@
 #include <memory>
 #include <vector>
 
-#include "sim/cpu_reference.h"
 #include "sim/scene.h"
+#include "sim/stepper.h"
 
 namespace ts::sim {
-
-// The stepping engine the runner drives.
-class Stepper {
- public:
-  virtual ~Stepper() = default;
-  // Takes `world` as the whole new state (at start and after emitters added grains).
-  virtual void load(const World& world) = 0;
-  // Advances `steps` steps and brings `world` up to date. Returns the last step's statistics with
-  // the clamp counts summed over the steps. Throws ts::Error(ExitCode::Unstable) on a blow-up.
-  virtual StepStats advance(World& world, std::int64_t steps) = 0;
-  // The contacts of the state last loaded or advanced to; empty when the engine cannot list them.
-  virtual std::vector<ContactRecord> contacts(const World& world) = 0;
-};
-
-class CpuReferenceStepper : public Stepper {
- public:
-  explicit CpuReferenceStepper(const StepSettings& settings) : settings_(settings) {}
-  void load(const World& world) override;
-  StepStats advance(World& world, std::int64_t steps) override;
-  std::vector<ContactRecord> contacts(const World& world) override;
-
- private:
-  StepSettings settings_;
-  std::unique_ptr<CpuStepper> stepper_;
-};
 
 struct RunHooks {
   // Called for each output when [output] frames = true; `frame` counts outputs from 0.
   std::function<void(const World& world, std::int64_t frame, const std::filesystem::path& dir)> write_frame;
   // Called after every output (progress reports, tests).
   std::function<void(const World& world, const StepStats& stats, std::int64_t step)> on_output;
+  // Called once with the engine after the last step (e.g. for its --timings report).
+  std::function<void(Stepper& stepper)> on_finish;
 };
+
+// Makes the engine of a run from the settings with dt resolved; the runner loads the world.
+using StepperFactory = std::function<std::unique_ptr<Stepper>(const StepSettings& settings)>;
 
 struct RunResult {
   std::int64_t steps = 0;
@@ -69,7 +49,7 @@ double resolve_time_step(const Scene& scene, const World& world, std::string* wa
 
 // `make_stepper` receives the settings with dt filled in (default: the CPU reference).
 RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir, const RunHooks& hooks = {},
-                    const std::function<std::unique_ptr<Stepper>(const StepSettings&)>& make_stepper = {});
+                    const StepperFactory& make_stepper = {});
 
 // Output writers (atomic), usable on their own.
 void write_particles_ply(const World& world, const std::filesystem::path& file);

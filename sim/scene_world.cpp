@@ -7,7 +7,7 @@
 #include <numbers>
 
 #include "core/error.h"
-#include "sim/scene.h"
+#include "sim/scene_world.h"
 
 namespace ts::sim {
 namespace {

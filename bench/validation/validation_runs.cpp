@@ -26,6 +26,7 @@
 #include "sim/gpu_stepper.h"
 #include "sim/scene.h"
 #include "sim/scene_runner.h"
+#include "sim/scene_world.h"
 #include "sim/time_step.h"
 
 namespace {
@@ -89,7 +90,7 @@ struct Run {
   std::size_t grains = 0;
 };
 
-using MakeStepper = std::function<std::unique_ptr<Stepper>(const StepSettings&)>;
+using MakeStepper = StepperFactory;
 
 // Runs `scene` (on the CPU reference unless `make` says otherwise) with no files but the runner's own.
 Run run(Scene scene, const fs::path& dir, const std::string& name, bool record_heights, const MakeStepper& make = {}) {
@@ -485,7 +486,7 @@ void column(const fs::path& out) {
 void agreement(const fs::path& out, const std::string& part) {
   ts::gpu::Context context;
   const MakeStepper gpu = [&](const StepSettings& s) -> std::unique_ptr<Stepper> {
-    return std::make_unique<GpuPipelineStepper>(context, s, Precision::Float, false);
+    return std::make_unique<GpuStepper>(context, s, Precision::Float, false);
   };
   ts::write_file_atomically(out / "agreement_renderer.txt", context.summary() + "\n");
   std::string silo_csv = "backend,seed,time_s,discharged\n";

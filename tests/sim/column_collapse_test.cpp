@@ -10,6 +10,7 @@
 #include "sim/cpu_reference.h"
 #include "sim/scene.h"
 #include "sim/scene_runner.h"
+#include "sim/scene_world.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {

@@ -15,6 +15,7 @@
 #include "sim/grain.h"
 #include "sim/scene.h"
 #include "sim/scene_runner.h"
+#include "sim/scene_world.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {

@@ -12,6 +12,7 @@
 #include "sim/gpu_stepper.h"
 #include "sim/scene.h"
 #include "sim/scene_runner.h"
+#include "sim/scene_world.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {

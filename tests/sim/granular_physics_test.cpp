@@ -14,6 +14,8 @@
 #include "core/atomic_file.h"
 #include "sim/scene.h"
 #include "sim/scene_runner.h"
+#include "sim/cpu_reference.h"
+#include "sim/scene_world.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {

@@ -1,4 +1,5 @@
 #include "sim/scene.h"
+#include "sim/scene_world.h"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>

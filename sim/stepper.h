@@ -1,0 +1,96 @@
+#pragma once
+// The one interface of the two DEM engines, and the data every engine takes and gives: the settings
+// of a step, the statistics of a step and one contact of a state. sim::CpuStepper
+// (sim/cpu_reference.h, double precision) and sim::GpuStepper (sim/gpu_stepper.h, GL compute) both
+// implement Stepper; sim::run_scene (sim/scene_runner.h) drives either through it.
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sim/contact_model.h"
+#include "sim/world.h"
+
+namespace ts::sim {
+
+enum class Integrator {
+  ForwardEuler,       // thesis eqs. 3.44-3.50: positions and orientations advance with the old velocities
+  SemiImplicitEuler,  // symplectic: velocities first, then positions/orientations with the new ones
+};
+
+// The tangential force law.
+enum class TangentialModel {
+  Viscous,  // thesis eq. 3.28: viscous, capped at mu F_n; no static friction, so heaps creep slowly
+  Spring,   // elastic spring per contact plus the viscous term, capped (static friction)
+};
+
+struct StepSettings {
+  double dt = 1e-5;  // s
+  NormalDamping normal_damping = NormalDamping::Tsuji;
+  TangentialModel tangential = TangentialModel::Viscous;
+  double thesis_reference_speed = 1.0;  // m/s: where the thesis damping gives exactly the restitution
+  Integrator integrator = Integrator::ForwardEuler;
+  // Velocity clamp (thesis 3.3.1, CFL): no particle may move more than `cfl` grid cells in a step;
+  // the body's linear speed and its angular speed times its bounding radius are capped at
+  // cfl * cell / dt. <= 0 disables it.
+  double cfl = 0.5;
+  // Overlap clamp: the overlap entering the force is capped at this fraction of the smaller
+  // radius, bounding the force after a bad step. <= 0 disables it.
+  double max_overlap_ratio = 0.5;
+  // Optional low-speed angular damping (off when rate = 0): a body whose fastest point moves slower
+  // than `angular_damping_speed` (m/s) has its angular velocity scaled by (1 - rate dt), rate 1/s.
+  double angular_damping_rate = 0;
+  double angular_damping_speed = 0;
+  // Blow-up detection: the mechanical energy (kinetic + potential + contact springs, at the start of
+  // each step) may not exceed its value at the first step by more than this fraction of (kinetic +
+  // spring energy then + M |g| d_max) while no work is done on the system.
+  bool check_energy = true;
+  double energy_growth_tolerance = 0.5;
+  // GPU pipeline only: every this many steps the bodies are re-sorted by the cell of their centre
+  // (Morton order), so neighbours sit near each other in memory; 0 = never. Results stay
+  // deterministic; forces change only by the order of float sums.
+  std::int64_t resort_every = 100;
+};
+
+struct StepStats {
+  Energy energy;                          // J, after the step
+  double elastic_energy = 0;              // J, in the contact springs at the start of the step (CPU reference)
+  std::size_t contacts = 0;               // particle pairs in contact (each pair once)
+  std::size_t wall_contacts = 0;          // particle-wall contacts
+  double max_overlap_ratio = 0;           // largest overlap / smaller radius
+  std::size_t velocity_clamps = 0;        // bodies whose linear speed was capped
+  std::size_t angular_velocity_clamps = 0;
+  std::size_t overlap_clamps = 0;         // contacts whose overlap was capped
+  std::size_t spring_overflows = 0;       // contacts beyond a particle's spring slots (no spring: viscous only)
+};
+
+// One contact of the current state, for dumps and tests.
+struct ContactRecord {
+  std::uint32_t particle = 0;
+  std::int64_t partner = 0;      // the other particle, or -1 - wall index (planes first, then cylinders)
+  Eigen::Vector3d point;         // m, middle of the overlap
+  Eigen::Vector3d force;         // N, on `particle`
+  double overlap = 0;            // m
+};
+
+// A DEM engine as the scene runner drives it: load a state, advance it, list its contacts.
+class Stepper {
+ public:
+  virtual ~Stepper() = default;
+  // Takes `world` as the whole new state (at the start, and after emitters added grains). The
+  // energy check's reference is taken again from it.
+  virtual void load(const World& world) = 0;
+  // Advances `steps` steps of settings().dt and brings `world` up to date. Returns the last step's
+  // statistics with the clamp and spring-overflow counts summed over the steps. Throws
+  // ts::Error(ExitCode::Unstable) on a blow-up; `world` may then hold the offending state.
+  virtual StepStats advance(World& world, std::int64_t steps) = 0;
+  // Every contact of `world` (each particle pair once), as the CPU reference computes them.
+  virtual std::vector<ContactRecord> contacts(const World& world) = 0;
+  // Per-kernel times for --timings; empty where the engine keeps none.
+  virtual std::string timing_report() { return {}; }
+  virtual const StepSettings& settings() const = 0;
+};
+
+}  // namespace ts::sim
