@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "sim/grain.h"
 #include "sim/scene_runner.h"
+#include "sim/scene_world.h"
 
 namespace ts::sim {
 namespace {
@@ -214,6 +215,349 @@ struct PourEvent {
   const Emitter* emitter;
 };
 
+// Everything the deck's sections are written from: the initial world, the grain, the molecule and
+// atom type of every body, the simulation box, the run's length and the pour events in time order.
+struct DeckPlan {
+  DeckPlan(const Scene& s, World w, const GrainShape& g) : scene(s), world(std::move(w)), grain(g) {}
+  const Scene& scene;
+  World world;
+  GrainShape grain;
+  double dt = 0;  // s
+  std::int64_t steps = 0;
+  std::vector<std::int64_t> mol;  // molecule id per body
+  std::size_t dynamic_count = 0, frozen_particles = 0;
+  double max_radius = 0, max_body_extent = 0;  // m
+  Box box;
+  std::vector<PourEvent> pours;
+  // Atom types: materials first (type = material + 1), then one per dynamic prop.
+  std::vector<AtomType> types;
+  std::vector<int> body_type;  // per body; 0: its material's type
+  std::set<int> dynamic_types;
+  double g_ref = 0;  // m/s^2, for the reference overlaps
+
+  ReferenceContact type_pair(std::size_t a, std::size_t b) const {
+    const AtomType &ta = types[a], &tb = types[b];
+    return ReferenceContact{ta.mass * tb.mass / (ta.mass + tb.mass), ta.radius * tb.radius / (ta.radius + tb.radius),
+                            std::min(ta.mass, tb.mass) * g_ref};
+  }
+  ReferenceContact type_wall(int t) const {
+    const AtomType& ta = types[static_cast<std::size_t>(t - 1)];
+    return ReferenceContact{ta.mass, ta.radius, ta.mass * g_ref};
+  }
+  std::string material_name(std::uint16_t m) const {
+    return scene.material_names.size() > m ? scene.material_names[m] : std::to_string(m);
+  }
+  // The contact model of a dynamic atom type against a wall of `wall_material`.
+  std::string wall_model(int type, std::uint16_t wall_material) const {
+    return granular_model(pair_model(scene, world.materials[types[static_cast<std::size_t>(type - 1)].material],
+                                     world.materials[wall_material], type_wall(type)));
+  }
+  double skin() const { return 0.3 * 2 * max_radius; }  // m
+};
+
+// The box around every particle and pour region, the largest radius and body, the frozen count.
+void plan_geometry(DeckPlan& plan) {
+  const World& w = plan.world;
+  plan.max_radius = plan.grain.particle_radius;
+  plan.max_body_extent = 2 * plan.grain.bounding_radius;
+  const std::vector<Eigen::Vector3d> x = particle_positions(w);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    plan.box.add(x[i], w.particles.radius[i]);
+    plan.max_radius = std::max(plan.max_radius, w.particles.radius[i]);
+    if (!is_dynamic(w, w.particles.body[i])) ++plan.frozen_particles;
+  }
+  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+    if (is_dynamic(w, b)) plan.max_body_extent = std::max(plan.max_body_extent, 2 * w.bodies.bounding_radius[b]);
+  }
+}
+
+void plan_pours(DeckPlan& plan) {
+  for (const Emitter& e : plan.scene.emitters) {
+    if (e.type != EmitterType::Pour) continue;
+    plan.box.add(e.min, plan.grain.bounding_radius);
+    plan.box.add(e.max, plan.grain.bounding_radius);
+    if (e.rate * plan.dt > 1.0) {
+      refuse(plan.scene, fmt::format("a pour rate of {} grains/s is more than one grain per step of {:.3g} s (fix "
+                                     "deposit inserts at most one)", e.rate, plan.dt));
+    }
+    plan.pours.push_back({static_cast<std::int64_t>(std::llround(e.start / plan.dt)), &e});
+  }
+  std::stable_sort(plan.pours.begin(), plan.pours.end(),
+                   [](const PourEvent& a, const PourEvent& b) { return a.step < b.step; });
+}
+
+void plan_atom_types(DeckPlan& plan) {
+  const World& w = plan.world;
+  for (std::uint16_t m = 0; m < w.materials.size(); ++m) {
+    plan.types.push_back({m, plan.grain.mass, plan.grain.particle_radius});
+  }
+  plan.body_type.assign(w.bodies.size(), 0);
+  plan.dynamic_types = {plan.scene.grain.material + 1};
+  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+    if (!is_dynamic(w, b)) continue;
+    const std::uint32_t first = w.bodies.first_particle[b];
+    const bool is_grain = w.bodies.particle_count[b] == 4 && w.particles.radius[first] == plan.grain.particle_radius &&
+                          w.particles.material[first] == plan.scene.grain.material;
+    if (is_grain) continue;
+    plan.types.push_back({w.particles.material[first], 1.0 / w.bodies.inverse_mass[b], w.particles.radius[first]});
+    plan.body_type[b] = static_cast<int>(plan.types.size());
+    plan.dynamic_types.insert(plan.body_type[b]);
+  }
+}
+
+DeckPlan make_plan(const Scene& scene) {
+  DeckPlan plan(scene, make_world(scene),
+                make_tetrahedral_grain(scene.grain.radius, scene.grain.edge, scene.materials[scene.grain.material].density));
+  check_exportable(scene, plan.world);
+  std::string warning;
+  plan.dt = resolve_time_step(scene, plan.world, &warning);
+  plan.steps = static_cast<std::int64_t>(std::ceil(scene.simulation.duration / plan.dt - 1e-9));
+  plan.mol = molecule_ids(plan.world, &plan.dynamic_count);
+  plan_geometry(plan);
+  plan_pours(plan);
+  if (plan.dynamic_count == 0 && plan.pours.empty()) refuse(scene, "the scene has no dynamic bodies and no pour emitter");
+  if (plan.box.lo.x() > plan.box.hi.x()) plan.box.add(Eigen::Vector3d::Zero(), plan.max_radius);
+  plan.box.lo.array() -= 4 * plan.max_radius;
+  plan.box.hi.array() += 4 * plan.max_radius;
+  plan.g_ref = std::max(scene.gravity.norm(), 1e-3);
+  plan_atom_types(plan);
+  return plan;
+}
+
+// Where LAMMPS does not do exactly what tetrasand does (LammpsDeck::approximations).
+std::vector<std::string> approximations(const DeckPlan& plan) {
+  const Scene& scene = plan.scene;
+  std::vector<std::string> out = {
+      scene.simulation.step.tangential == TangentialModel::Spring
+          ? "tangential force: tetrasand's spring (k_t = 8 G* sqrt(R* delta)) becomes mindlin with the same k_t; its "
+            "viscous part gamma_s scales with the normal damping in LAMMPS (as delta^(1/4)), equal at the overlap of "
+            "one grain resting on another"
+          : "tangential force: tetrasand's constant viscous gamma_s becomes linear_nohistory, whose damping scales "
+            "with the normal damping (as delta^(1/4)); equal at the overlap of one grain resting on another",
+      "integrator: LAMMPS fix rigid/small is velocity Verlet with Richardson quaternion updates; tetrasand uses " +
+          std::string(scene.simulation.step.integrator == Integrator::ForwardEuler ? "forward Euler (thesis 3.44-3.50)"
+                                                                                   : "semi-implicit Euler"),
+      "no velocity (CFL) or overlap clamps in LAMMPS: results differ only where tetrasand reports clamps",
+  };
+  if (!plan.world.walls.cylinders.empty()) {
+    out.push_back(
+        "cylinder walls: LAMMPS uses the wall's curvature in the effective radius (R* = r R/(R - r) inside a "
+        "cylinder of radius R); tetrasand treats walls as flat (R* = r)");
+  }
+  if (std::any_of(scene.props.begin(), scene.props.end(), [](const Prop& p) { return p.motion == MotionType::Dynamic; })) {
+    out.push_back(
+        "dynamic props: gravity acts on the atoms (weighted to the body's mass), whose centroid may sit slightly off "
+        "the mesh's centre of mass: a small gravity torque tetrasand does not have");
+    out.push_back(
+        "dynamic props: each has its own atom type, so its tangential damping is matched at its own mass, at the "
+        "overlap its whole weight would make on one contact; spread over many contacts the overlaps are smaller "
+        "and LAMMPS's damping (~ delta^(1/4)) somewhat lower than tetrasand's gamma_s");
+  }
+  if (!plan.pours.empty()) {
+    out.push_back(
+        "pour emitters: fix deposit inserts one grain every round(1/(rate dt)) steps at random free sites of the same "
+        "region, with random orientations: the same statistics, not the same grains");
+  }
+  return out;
+}
+
+// The deck's lines, one section at a time.
+class Script {
+ public:
+  void line(const std::string& s) { text_ += s + "\n"; }
+  const std::string& text() const { return text_; }
+
+ private:
+  std::string text_;
+};
+
+// What this is, how to run it, what maps exactly and what does not.
+void header_section(const DeckPlan& plan, const std::vector<std::string>& approximations, Script& out) {
+  const World& w = plan.world;
+  out.line("# LAMMPS input deck written by `tetrasand export lammps` from " + plan.scene.file.filename().string());
+  out.line("#");
+  out.line("# Run:      lmp -in in.tetrasand                 (serial)");
+  out.line("#           mpirun -np 64 lmp -in in.tetrasand   (MPI; LAMMPS 29 Sep 2021 or later with GRANULAR, RIGID, MOLECULE)");
+  out.line("# Files:    data.tetrasand  every particle of the initial state (grains, props, rough walls), molecule = body");
+  out.line("#           bodies.rigid    explicit mass, centre of mass, world-frame inertia, velocity, angular momentum");
+  out.line("#                           of every dynamic body (LAMMPS would sum the overlapping spheres instead)");
+  out.line("#           grain.mol       the grain template (used by fix deposit for pour emitters)");
+  out.line("# Output:   log.lammps (thermo every [output] every steps), particles.dump, final.dump (last state)");
+  out.line("# Units:    SI (m, kg, s, Pa), as the scene file.");
+  out.line(fmt::format("# Scene:    {} dynamic bodies, {} frozen particles (static/kinematic), {} smooth planes, {} "
+                       "smooth cylinders, {} pour emitters", plan.dynamic_count, plan.frozen_particles,
+                       w.walls.planes.size(), w.walls.cylinders.size(), plan.pours.size()));
+  out.line(fmt::format("#           dt = {:.6g} s, {} steps = {:.6g} s simulated", plan.dt, plan.steps,
+                       plan.dt * static_cast<double>(plan.steps)));
+  out.line("#");
+  out.line("# Same as tetrasand: positions, radii, body masses and inertia, gravity, dt, duration; Hertz stiffness");
+  out.line("#   (hertz/material with E = 2 E*, nu = 0, so LAMMPS's E_eff is tetrasand's mixed E*); Tsuji normal damping");
+  out.line("#   (the restitution given is the one whose LAMMPS Tsuji alpha(e) equals tetrasand's damping strength, which");
+  out.line("#   tetrasand calibrated so that the clamped contact rebounds with the scene's restitution; limit_damping is");
+  out.line("#   that clamp); Coulomb friction; damping by the rigid bodies' masses; rough walls as frozen particles");
+  out.line("#   (fix freeze, infinite mass in the contact), smooth walls as fix wall/gran (wall/gran/region off-axis).");
+  out.line("# Not the same:");
+  for (const std::string& a : approximations) out.line("#   - " + a);
+  out.line("");
+}
+
+// Units, atoms, the data file, groups and neighbour lists.
+void setup_section(const DeckPlan& plan, Script& out) {
+  out.line("units           si");
+  out.line("atom_style      sphere");
+  out.line("atom_modify     map array");
+  out.line("dimension       3");
+  out.line("boundary        m m m");
+  out.line("newton          off");
+  out.line(fmt::format("comm_modify     vel yes cutoff {}", num(plan.max_body_extent + 2 * plan.max_radius + plan.skin())));
+  out.line("fix             prop all property/atom mol ghost yes");
+  out.line("read_data       data.tetrasand fix prop NULL Molecules");
+  out.line(plan.pours.empty() ? "" : "molecule        grain grain.mol");
+  out.line("");
+  const std::int64_t first_frozen = static_cast<std::int64_t>(plan.dynamic_count) + 1;
+  const std::int64_t last_id = static_cast<std::int64_t>(plan.world.bodies.size());
+  out.line(plan.dynamic_count > 0 ? fmt::format("group           dynamic molecule <> 1 {}", plan.dynamic_count)
+                                  : "group           dynamic empty");
+  out.line(first_frozen <= last_id ? fmt::format("group           frozen molecule <> {} {}", first_frozen, last_id)
+                                   : "group           frozen empty");
+  out.line(fmt::format("neighbor        {} bin", num(plan.skin())));
+  out.line("neigh_modify    delay 0 every 1 check yes exclude molecule/intra all exclude group frozen frozen");
+  out.line("");
+}
+
+// One coefficient set per pair of atom types.
+void contact_section(const DeckPlan& plan, Script& out) {
+  const std::vector<AtomType>& types = plan.types;
+  const std::size_t materials = plan.world.materials.size();
+  out.line("# Contacts: one coefficient set per pair of materials (atom type = material index + 1).");
+  out.line("pair_style      granular");
+  for (std::size_t a = 0; a < types.size(); ++a) {
+    for (std::size_t b = a; b < types.size(); ++b) {
+      const PairModel m = pair_model(plan.scene, plan.world.materials[types[a].material],
+                                     plan.world.materials[types[b].material], plan.type_pair(a, b));
+      out.line(fmt::format("pair_coeff      {} {} {}   # {}{} - {}{}", a + 1, b + 1, granular_model(m),
+                           plan.material_name(types[a].material), a < materials ? "" : " (dynamic prop)",
+                           plan.material_name(types[b].material), b < materials ? "" : " (dynamic prop)"));
+    }
+  }
+  out.line("");
+}
+
+// Frozen particles, rigid bodies, gravity and kinematic moves.
+void bodies_section(const DeckPlan& plan, Script& out) {
+  const World& w = plan.world;
+  if (plan.frozen_particles > 0) out.line("fix             freeze frozen freeze");
+  const std::string rigid_mol = plan.pours.empty() ? "" : " mol grain";
+  out.line(fmt::format("fix             rb dynamic rigid/small molecule{}{}",
+                       plan.dynamic_count > 0 ? " infile bodies.rigid" : "", rigid_mol));
+  const double g = plan.scene.gravity.norm();
+  if (g > 0) {
+    out.line(fmt::format("fix             gravity dynamic gravity {} vector {}", num(g), vec(plan.scene.gravity / g)));
+  }
+  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+    if (w.bodies.motion[b] != MotionType::Kinematic) continue;
+    const std::int64_t id = plan.mol[b];
+    out.line(fmt::format("group           kinematic{} molecule {}", id, id));
+    const Eigen::Vector3d& omega = w.bodies.angular_velocity[b];
+    if (omega.norm() > 0) {
+      out.line(fmt::format("fix             move{} kinematic{} move rotate {} {} {} units box", id, id,
+                           vec(w.bodies.position[b]), vec(omega.normalized()), num(2 * std::numbers::pi / omega.norm())));
+    } else {
+      out.line(fmt::format("fix             move{} kinematic{} move linear {} units box", id, id,
+                           vec(w.bodies.linear_velocity[b])));
+    }
+  }
+  out.line("");
+}
+
+// The groups each wall acts on: all dynamic atoms, or one group per dynamic atom type (each has its
+// own coefficients against the wall).
+std::vector<std::pair<std::string, int>> wall_groups(const DeckPlan& plan, Script& out) {
+  std::vector<std::pair<std::string, int>> groups;
+  if (plan.dynamic_types.size() == 1) {
+    groups.emplace_back("dynamic", *plan.dynamic_types.begin());
+    return groups;
+  }
+  for (int t : plan.dynamic_types) {
+    out.line(fmt::format("group           type{} type {}", t, t));
+    out.line(fmt::format("group           dynamic{} intersect dynamic type{}", t, t));
+    groups.emplace_back(fmt::format("dynamic{}", t), t);
+  }
+  return groups;
+}
+
+// Smooth walls, one fix per wall and dynamic atom type.
+void walls_section(const DeckPlan& plan, Script& out) {
+  const auto groups = wall_groups(plan, out);
+  int wall_id = 0;
+  for (const PlaneWall& p : plan.world.walls.planes) {
+    ++wall_id;
+    int axis = 0;
+    const bool aligned = axis_aligned(p.normal, &axis);
+    if (!aligned) {
+      out.line(fmt::format("region          wall{} plane {} {} side in units box", wall_id, vec(p.point), vec(p.normal)));
+    }
+    for (const auto& [group, type] : groups) {
+      const std::string model = plan.wall_model(type, p.material);
+      if (aligned) {
+        const std::string at = num(p.point[axis]);
+        const std::string bounds = p.normal[axis] > 0 ? at + " NULL" : "NULL " + at;
+        out.line(fmt::format("fix             wall{}_{} {} wall/gran granular {} {}plane {}", wall_id, type, group,
+                             model, "xyz"[axis], bounds));
+      } else {
+        out.line(fmt::format("fix             wall{}_{} {} wall/gran/region granular {} region wall{}", wall_id,
+                             type, group, model, wall_id));
+      }
+    }
+  }
+  for (const CylinderWall& c : plan.world.walls.cylinders) {
+    ++wall_id;
+    auto bound = [](double z) { return std::abs(z) >= 1e29 ? std::string("INF") : num(z); };
+    out.line(fmt::format("region          wall{} cylinder z {} {} {} {} {} side in open 1 open 2 units box", wall_id,
+                         num(c.axis.x()), num(c.axis.y()), num(c.radius), bound(c.z_min), bound(c.z_max)));
+    for (const auto& [group, type] : groups) {
+      out.line(fmt::format("fix             wall{}_{} {} wall/gran/region granular {} region wall{}", wall_id,
+                           type, group, plan.wall_model(type, c.material), wall_id));
+    }
+  }
+  out.line("");
+}
+
+void output_section(const DeckPlan& plan, Script& out) {
+  out.line(fmt::format("timestep        {}", num(plan.dt)));
+  out.line("compute         ket dynamic ke/rigid rb");
+  out.line("compute         ker dynamic erotate/rigid rb");
+  out.line("thermo_style    custom step time atoms c_ket c_ker");
+  out.line("thermo_modify   norm no lost error");
+  out.line(fmt::format("thermo          {}", plan.scene.output.every));
+  out.line(fmt::format("dump            particles dynamic custom {} particles.dump id mol type x y z radius",
+                       plan.scene.output.every));
+  out.line("");
+}
+
+// The run, split where pour emitters start.
+void run_section(const DeckPlan& plan, Script& out) {
+  std::int64_t at = 0;
+  int pour_id = 0;
+  for (const PourEvent& p : plan.pours) {
+    const std::int64_t start = std::min(p.step, plan.steps);
+    if (start > at) out.line(fmt::format("run             {}", start - at));
+    at = std::max(at, start);
+    const Emitter& e = *p.emitter;
+    ++pour_id;
+    const auto every = std::max<std::int64_t>(1, std::llround(1.0 / (e.rate * plan.dt)));
+    out.line(fmt::format("region          pour{} block {} {} {} {} {} {} units box", pour_id, num(e.min.x()),
+                         num(e.max.x()), num(e.min.y()), num(e.max.y()), num(e.min.z()), num(e.max.z())));
+    out.line(fmt::format("fix             pour{} dynamic deposit {} 0 {} {} region pour{} mol grain rigid rb near {} "
+                         "attempt 100 vx {} {} vy {} {} vz {} {} units box",
+                         pour_id, e.count, every, 1000 + e.seed % 1000000, pour_id,
+                         num(2.02 * plan.grain.particle_radius), num(e.velocity.x()), num(e.velocity.x()),
+                         num(e.velocity.y()), num(e.velocity.y()), num(e.velocity.z()), num(e.velocity.z())));
+  }
+  if (plan.steps > at) out.line(fmt::format("run             {}", plan.steps - at));
+  out.line("write_dump      dynamic custom final.dump id mol type x y z radius");
+}
+
 }  // namespace
 
 double lammps_tsuji_alpha(double e) {
@@ -237,276 +581,30 @@ double lammps_restitution_for_alpha(double alpha) {
 }
 
 LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
-  const World w = make_world(scene);
-  check_exportable(scene, w);
+  const DeckPlan plan = make_plan(scene);
   LammpsDeck deck;
-  std::string warning;
-  deck.dt = resolve_time_step(scene, w, &warning);
-  deck.steps = static_cast<std::int64_t>(std::ceil(scene.simulation.duration / deck.dt - 1e-9));
-  const GrainShape grain = make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
-                                                  scene.materials[scene.grain.material].density);
-
-  std::size_t dynamic_count = 0;
-  const std::vector<std::int64_t> mol = molecule_ids(w, &dynamic_count);
-  deck.dynamic_bodies = dynamic_count;
-  double max_radius = grain.particle_radius, max_body_extent = 2 * grain.bounding_radius;  // m
-  Box box;
-  const std::vector<Eigen::Vector3d> x = particle_positions(w);
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    box.add(x[i], w.particles.radius[i]);
-    max_radius = std::max(max_radius, w.particles.radius[i]);
-    if (!is_dynamic(w, w.particles.body[i])) ++deck.frozen_particles;
-  }
-  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
-    if (is_dynamic(w, b)) max_body_extent = std::max(max_body_extent, 2 * w.bodies.bounding_radius[b]);
-  }
-  std::vector<PourEvent> pours;
-  for (const Emitter& e : scene.emitters) {
-    if (e.type != EmitterType::Pour) continue;
-    box.add(e.min, grain.bounding_radius);
-    box.add(e.max, grain.bounding_radius);
-    if (e.rate * deck.dt > 1.0) {
-      refuse(scene, fmt::format("a pour rate of {} grains/s is more than one grain per step of {:.3g} s (fix deposit "
-                                "inserts at most one)", e.rate, deck.dt));
-    }
-    pours.push_back({static_cast<std::int64_t>(std::llround(e.start / deck.dt)), &e});
-  }
-  if (dynamic_count == 0 && pours.empty()) refuse(scene, "the scene has no dynamic bodies and no pour emitter");
-  if (box.lo.x() > box.hi.x()) box.add(Eigen::Vector3d::Zero(), max_radius);
-  box.lo.array() -= 4 * max_radius;
-  box.hi.array() += 4 * max_radius;
-  std::stable_sort(pours.begin(), pours.end(), [](const PourEvent& a, const PourEvent& b) { return a.step < b.step; });
-
-  // Pair and wall coefficients (grain-grain and grain-wall reference contacts).
-  // Atom types: materials first (type = material + 1), then one per dynamic prop.
-  const double g_ref = std::max(scene.gravity.norm(), 1e-3);  // m/s^2, for the reference overlaps
-  std::vector<AtomType> types;
-  for (std::uint16_t m = 0; m < w.materials.size(); ++m) types.push_back({m, grain.mass, grain.particle_radius});
-  std::vector<int> body_type(w.bodies.size(), 0);  // 0: the material's type
-  std::set<int> dynamic_types{scene.grain.material + 1};
-  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
-    if (!is_dynamic(w, b)) continue;
-    const std::uint32_t first = w.bodies.first_particle[b];
-    const bool is_grain = w.bodies.particle_count[b] == 4 && w.particles.radius[first] == grain.particle_radius &&
-                          w.particles.material[first] == scene.grain.material;
-    if (is_grain) continue;
-    types.push_back({w.particles.material[first], 1.0 / w.bodies.inverse_mass[b], w.particles.radius[first]});
-    body_type[b] = static_cast<int>(types.size());
-    dynamic_types.insert(body_type[b]);
-  }
-  auto type_pair = [&](std::size_t a, std::size_t b) {
-    const AtomType &ta = types[a], &tb = types[b];
-    return ReferenceContact{ta.mass * tb.mass / (ta.mass + tb.mass), ta.radius * tb.radius / (ta.radius + tb.radius),
-                            std::min(ta.mass, tb.mass) * g_ref};
-  };
-  auto type_wall = [&](int t) {
-    const AtomType& ta = types[static_cast<std::size_t>(t - 1)];
-    return ReferenceContact{ta.mass, ta.radius, ta.mass * g_ref};
-  };
-  auto name = [&](std::uint16_t m) {
-    return scene.material_names.size() > m ? scene.material_names[m] : std::to_string(m);
-  };
-
-  std::string in;
-  auto line = [&](const std::string& s) { in += s + "\n"; };
-  const double skin = 0.3 * 2 * max_radius;  // m
-  deck.approximations = {
-      scene.simulation.step.tangential == TangentialModel::Spring
-          ? "tangential force: tetrasand's spring (k_t = 8 G* sqrt(R* delta)) becomes mindlin with the same k_t; its "
-            "viscous part gamma_s scales with the normal damping in LAMMPS (as delta^(1/4)), equal at the overlap of "
-            "one grain resting on another"
-          : "tangential force: tetrasand's constant viscous gamma_s becomes linear_nohistory, whose damping scales "
-            "with the normal damping (as delta^(1/4)); equal at the overlap of one grain resting on another",
-      "integrator: LAMMPS fix rigid/small is velocity Verlet with Richardson quaternion updates; tetrasand uses " +
-          std::string(scene.simulation.step.integrator == Integrator::ForwardEuler ? "forward Euler (thesis 3.44-3.50)"
-                                                                                   : "semi-implicit Euler"),
-      "no velocity (CFL) or overlap clamps in LAMMPS: results differ only where tetrasand reports clamps",
-  };
-  if (!w.walls.cylinders.empty()) {
-    deck.approximations.push_back(
-        "cylinder walls: LAMMPS uses the wall's curvature in the effective radius (R* = r R/(R - r) inside a "
-        "cylinder of radius R); tetrasand treats walls as flat (R* = r)");
-  }
-  if (std::any_of(scene.props.begin(), scene.props.end(), [](const Prop& p) { return p.motion == MotionType::Dynamic; })) {
-    deck.approximations.push_back(
-        "dynamic props: gravity acts on the atoms (weighted to the body's mass), whose centroid may sit slightly off "
-        "the mesh's centre of mass: a small gravity torque tetrasand does not have");
-    deck.approximations.push_back(
-        "dynamic props: each has its own atom type, so its tangential damping is matched at its own mass, at the "
-        "overlap its whole weight would make on one contact; spread over many contacts the overlaps are smaller "
-        "and LAMMPS's damping (~ delta^(1/4)) somewhat lower than tetrasand's gamma_s");
-  }
-  if (!pours.empty()) {
-    deck.approximations.push_back(
-        "pour emitters: fix deposit inserts one grain every round(1/(rate dt)) steps at random free sites of the same "
-        "region, with random orientations: the same statistics, not the same grains");
-  }
-
-  // Header: what this is, how to run it, what maps exactly and what does not.
-  line("# LAMMPS input deck written by `tetrasand export lammps` from " + scene.file.filename().string());
-  line("#");
-  line("# Run:      lmp -in in.tetrasand                 (serial)");
-  line("#           mpirun -np 64 lmp -in in.tetrasand   (MPI; LAMMPS 29 Sep 2021 or later with GRANULAR, RIGID, MOLECULE)");
-  line("# Files:    data.tetrasand  every particle of the initial state (grains, props, rough walls), molecule = body");
-  line("#           bodies.rigid    explicit mass, centre of mass, world-frame inertia, velocity, angular momentum");
-  line("#                           of every dynamic body (LAMMPS would sum the overlapping spheres instead)");
-  line("#           grain.mol       the grain template (used by fix deposit for pour emitters)");
-  line("# Output:   log.lammps (thermo every [output] every steps), particles.dump, final.dump (last state)");
-  line("# Units:    SI (m, kg, s, Pa), as the scene file.");
-  line(fmt::format("# Scene:    {} dynamic bodies, {} frozen particles (static/kinematic), {} smooth planes, {} "
-                   "smooth cylinders, {} pour emitters", dynamic_count, deck.frozen_particles, w.walls.planes.size(),
-                   w.walls.cylinders.size(), pours.size()));
-  line(fmt::format("#           dt = {:.6g} s, {} steps = {:.6g} s simulated", deck.dt, deck.steps,
-                   deck.dt * static_cast<double>(deck.steps)));
-  line("#");
-  line("# Same as tetrasand: positions, radii, body masses and inertia, gravity, dt, duration; Hertz stiffness");
-  line("#   (hertz/material with E = 2 E*, nu = 0, so LAMMPS's E_eff is tetrasand's mixed E*); Tsuji normal damping");
-  line("#   (the restitution given is the one whose LAMMPS Tsuji alpha(e) equals tetrasand's damping strength, which");
-  line("#   tetrasand calibrated so that the clamped contact rebounds with the scene's restitution; limit_damping is");
-  line("#   that clamp); Coulomb friction; damping by the rigid bodies' masses; rough walls as frozen particles");
-  line("#   (fix freeze, infinite mass in the contact), smooth walls as fix wall/gran (wall/gran/region off-axis).");
-  line("# Not the same:");
-  for (const std::string& a : deck.approximations) line("#   - " + a);
-  line("");
-
-  line("units           si");
-  line("atom_style      sphere");
-  line("atom_modify     map array");
-  line("dimension       3");
-  line("boundary        m m m");
-  line("newton          off");
-  line(fmt::format("comm_modify     vel yes cutoff {}", num(max_body_extent + 2 * max_radius + skin)));
-  line("fix             prop all property/atom mol ghost yes");
-  line("read_data       data.tetrasand fix prop NULL Molecules");
-  line(pours.empty() ? "" : "molecule        grain grain.mol");
-  line("");
-  const std::int64_t first_frozen = static_cast<std::int64_t>(dynamic_count) + 1;
-  const std::int64_t last_id = static_cast<std::int64_t>(w.bodies.size());
-  line(dynamic_count > 0 ? fmt::format("group           dynamic molecule <> 1 {}", dynamic_count)
-                         : "group           dynamic empty");
-  line(first_frozen <= last_id ? fmt::format("group           frozen molecule <> {} {}", first_frozen, last_id)
-                               : "group           frozen empty");
-  line(fmt::format("neighbor        {} bin", num(skin)));
-  line("neigh_modify    delay 0 every 1 check yes exclude molecule/intra all exclude group frozen frozen");
-  line("");
-  line("# Contacts: one coefficient set per pair of materials (atom type = material index + 1).");
-  line("pair_style      granular");
-  for (std::size_t a = 0; a < types.size(); ++a) {
-    for (std::size_t b = a; b < types.size(); ++b) {
-      const PairModel m = pair_model(scene, w.materials[types[a].material], w.materials[types[b].material], type_pair(a, b));
-      line(fmt::format("pair_coeff      {} {} {}   # {}{} - {}{}", a + 1, b + 1, granular_model(m),
-                       name(types[a].material), a < w.materials.size() ? "" : " (dynamic prop)",
-                       name(types[b].material), b < w.materials.size() ? "" : " (dynamic prop)"));
-    }
-  }
-  line("");
-  if (deck.frozen_particles > 0) line("fix             freeze frozen freeze");
-  const std::string rigid_mol = pours.empty() ? "" : " mol grain";
-  line(fmt::format("fix             rb dynamic rigid/small molecule{}{}", dynamic_count > 0 ? " infile bodies.rigid" : "",
-                   rigid_mol));
-  const double g = scene.gravity.norm();
-  if (g > 0) {
-    line(fmt::format("fix             gravity dynamic gravity {} vector {}", num(g), vec(scene.gravity / g)));
-  }
-  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
-    if (w.bodies.motion[b] != MotionType::Kinematic) continue;
-    line(fmt::format("group           kinematic{} molecule {}", mol[b], mol[b]));
-    const Eigen::Vector3d& omega = w.bodies.angular_velocity[b];
-    if (omega.norm() > 0) {
-      line(fmt::format("fix             move{} kinematic{} move rotate {} {} {} units box", mol[b], mol[b],
-                       vec(w.bodies.position[b]), vec(omega.normalized()), num(2 * std::numbers::pi / omega.norm())));
-    } else {
-      line(fmt::format("fix             move{} kinematic{} move linear {} units box", mol[b], mol[b],
-                       vec(w.bodies.linear_velocity[b])));
-    }
-  }
-  line("");
-
-  // Smooth walls, one fix per wall and dynamic atom type (each has its own coefficients).
-  std::vector<std::pair<std::string, int>> wall_groups;
-  if (dynamic_types.size() == 1) {
-    wall_groups.emplace_back("dynamic", *dynamic_types.begin());
-  } else {
-    for (int t : dynamic_types) {
-      line(fmt::format("group           type{} type {}", t, t));
-      line(fmt::format("group           dynamic{} intersect dynamic type{}", t, t));
-      wall_groups.emplace_back(fmt::format("dynamic{}", t), t);
-    }
-  }
-  int wall_id = 0;
-  for (const PlaneWall& p : w.walls.planes) {
-    ++wall_id;
-    int axis = 0;
-    const bool aligned = axis_aligned(p.normal, &axis);
-    if (!aligned) {
-      line(fmt::format("region          wall{} plane {} {} side in units box", wall_id, vec(p.point), vec(p.normal)));
-    }
-    for (const auto& [group, type] : wall_groups) {
-      const std::string model = granular_model(pair_model(scene, w.materials[types[static_cast<std::size_t>(type - 1)].material],
-                                                          w.materials[p.material], type_wall(type)));
-      if (aligned) {
-        const std::string at = num(p.point[axis]);
-        const std::string bounds = p.normal[axis] > 0 ? at + " NULL" : "NULL " + at;
-        line(fmt::format("fix             wall{}_{} {} wall/gran granular {} {}plane {}", wall_id, type, group,
-                         model, "xyz"[axis], bounds));
-      } else {
-        line(fmt::format("fix             wall{}_{} {} wall/gran/region granular {} region wall{}", wall_id,
-                         type, group, model, wall_id));
-      }
-    }
-  }
-  for (const CylinderWall& c : w.walls.cylinders) {
-    ++wall_id;
-    auto bound = [](double z) { return std::abs(z) >= 1e29 ? std::string("INF") : num(z); };
-    line(fmt::format("region          wall{} cylinder z {} {} {} {} {} side in open 1 open 2 units box", wall_id,
-                     num(c.axis.x()), num(c.axis.y()), num(c.radius), bound(c.z_min), bound(c.z_max)));
-    for (const auto& [group, type] : wall_groups) {
-      const std::string model = granular_model(pair_model(scene, w.materials[types[static_cast<std::size_t>(type - 1)].material],
-                                                          w.materials[c.material], type_wall(type)));
-      line(fmt::format("fix             wall{}_{} {} wall/gran/region granular {} region wall{}", wall_id,
-                       type, group, model, wall_id));
-    }
-  }
-  line("");
-  line(fmt::format("timestep        {}", num(deck.dt)));
-  line("compute         ket dynamic ke/rigid rb");
-  line("compute         ker dynamic erotate/rigid rb");
-  line("thermo_style    custom step time atoms c_ket c_ker");
-  line("thermo_modify   norm no lost error");
-  line(fmt::format("thermo          {}", scene.output.every));
-  line(fmt::format("dump            particles dynamic custom {} particles.dump id mol type x y z radius",
-                   scene.output.every));
-  line("");
-
-  // The run, split where pour emitters start.
-  std::int64_t at = 0;
-  int pour_id = 0;
-  for (const PourEvent& p : pours) {
-    const std::int64_t start = std::min(p.step, deck.steps);
-    if (start > at) line(fmt::format("run             {}", start - at));
-    at = std::max(at, start);
-    const Emitter& e = *p.emitter;
-    ++pour_id;
-    const auto every = std::max<std::int64_t>(1, std::llround(1.0 / (e.rate * deck.dt)));
-    line(fmt::format("region          pour{} block {} {} {} {} {} {} units box", pour_id, num(e.min.x()),
-                     num(e.max.x()), num(e.min.y()), num(e.max.y()), num(e.min.z()), num(e.max.z())));
-    line(fmt::format("fix             pour{} dynamic deposit {} 0 {} {} region pour{} mol grain rigid rb near {} "
-                     "attempt 100 vx {} {} vy {} {} vz {} {} units box",
-                     pour_id, e.count, every, 1000 + e.seed % 1000000, pour_id, num(2.02 * grain.particle_radius),
-                     num(e.velocity.x()), num(e.velocity.x()), num(e.velocity.y()), num(e.velocity.y()),
-                     num(e.velocity.z()), num(e.velocity.z())));
-  }
-  if (deck.steps > at) line(fmt::format("run             {}", deck.steps - at));
-  line("write_dump      dynamic custom final.dump id mol type x y z radius");
+  deck.dt = plan.dt;
+  deck.steps = plan.steps;
+  deck.dynamic_bodies = plan.dynamic_count;
+  deck.frozen_particles = plan.frozen_particles;
+  deck.approximations = approximations(plan);
+  Script in;
+  header_section(plan, deck.approximations, in);
+  setup_section(plan, in);
+  contact_section(plan, in);
+  bodies_section(plan, in);
+  walls_section(plan, in);
+  output_section(plan, in);
+  run_section(plan, in);
 
   fs::create_directories(dir);
   const std::vector<fs::path> inputs{scene.file};
   deck.input = dir / "in.tetrasand";
-  write_file_atomically(dir / "data.tetrasand", data_file(w, mol, body_type, types.size(), box), inputs);
-  write_file_atomically(dir / "bodies.rigid", bodies_file(w, mol, dynamic_count), inputs);
-  write_file_atomically(dir / "grain.mol",
-                        molecule_file(grain, scene.grain.material), inputs);
-  write_file_atomically(deck.input, in, inputs);
+  write_file_atomically(dir / "data.tetrasand", data_file(plan.world, plan.mol, plan.body_type, plan.types.size(), plan.box),
+                        inputs);
+  write_file_atomically(dir / "bodies.rigid", bodies_file(plan.world, plan.mol, plan.dynamic_count), inputs);
+  write_file_atomically(dir / "grain.mol", molecule_file(plan.grain, scene.grain.material), inputs);
+  write_file_atomically(deck.input, in.text(), inputs);
   deck.files = {deck.input, dir / "data.tetrasand", dir / "bodies.rigid", dir / "grain.mol"};
   return deck;
 }
