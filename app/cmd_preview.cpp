@@ -75,196 +75,254 @@ preview::Camera make_camera(const Options& o, const Aabb& box, double aspect) {
                             o.fov, o.turntable, up);
 }
 
+// Options are registered in the order --help lists them.
+void add_input_options(CLI::App* cmd, Options& o) {
+  cmd->add_option("INPUT", o.input, "Mesh (any format assimp reads; scan-converted here) or SDF.vdb level set");
+  cmd->add_option("-o,--output", o.output, "Output PNG")->required();
+  cmd->add_option("--particles", o.particles, "Particles over the surface: NAME.body.json or a PLY of centres");
+  cmd->add_option("--particle-radius", o.particle_radius,
+                  "Particle radius [m] (default: the body.json's, else half the median neighbour distance)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--size", o.size, "Image size WIDTHxHEIGHT [pixels]")->capture_default_str();
+}
+
+// Where the camera is and how it turns.
+void add_camera_options(CLI::App* cmd, Options& o) {
+  cmd->add_option("--view", o.view, "Named view relative to --up: front, side, top or iso")
+      ->check(CLI::IsMember({"front", "side", "top", "iso"}))
+      ->capture_default_str();
+  auto* eye = cmd->add_option("--eye", o.eye, "Camera position X,Y,Z [m] (instead of --view)")->delimiter(',')->expected(3);
+  cmd->add_option("--target", o.target, "Point looked at X,Y,Z [m] (default: the centre of what is drawn)")
+      ->delimiter(',')
+      ->expected(3)
+      ->needs(eye);
+  cmd->add_option("--up", o.up, "World up X,Y,Z: the ground's normal and the image's up (meshes: y up by default)")
+      ->delimiter(',')
+      ->expected(3)
+      ->capture_default_str();
+  cmd->add_option("--fov", o.fov, "Vertical field of view [degrees]")->capture_default_str();
+  cmd->add_flag("--ortho", o.ortho, "Orthographic lens (framed to fit)");
+  cmd->add_option("--turntable", o.turntable, "N views turning about --up: OUT_000.png ... (or one --contact-sheet)")
+      ->check(CLI::Range(1, 10000));
+  cmd->add_flag("--contact-sheet", o.contact_sheet, "With --turntable: tile all views into OUT.png");
+}
+
+void add_colour_options(CLI::App* cmd, Options& o) {
+  cmd->add_flag("--alpha", o.alpha, "Transparent background; the ground shows only its shadows");
+  cmd->add_option("--color-by", o.color_by,
+                  "Colour the surface by: none, error (distance from the mesh, voxels; MESH input) or "
+                  "particle-distance (distance to the nearest particle centre, in radii)")
+      ->check(CLI::IsMember({"none", "error", "particle-distance"}))
+      ->capture_default_str();
+  cmd->add_option("--color-max", o.color_max, "Value at the top of the colour map (default 0.25 voxel / 1.5 radii)")
+      ->check(CLI::PositiveNumber);
+}
+
+// How a MESH input is scan-converted.
+void add_sdf_options(CLI::App* cmd, Options& o) {
+  auto* voxel = cmd->add_option("--voxel", o.voxel, "MESH: SDF voxel size [m]")->check(CLI::PositiveNumber);
+  cmd->add_option("--resolution", o.resolution, "MESH: SDF voxels along the longest side")
+      ->check(CLI::PositiveNumber)
+      ->excludes(voxel)
+      ->capture_default_str();
+  cmd->add_option("--band", o.band, "MESH: narrow-band half-width [voxels], >= 2 for clean normals")->capture_default_str();
+  cmd->add_option("--scale", o.scale, "MESH and particles: multiply coordinates by this factor first")
+      ->check(CLI::PositiveNumber);
+}
+
+void add_lighting_options(CLI::App* cmd, Options& o) {
+  cmd->add_option("--light", o.light, "Direction towards the key light X,Y,Z (default: upper left, behind the camera)")
+      ->delimiter(',')
+      ->expected(3);
+  cmd->add_flag("--no-ground", o.no_ground, "No ground plane");
+  cmd->add_flag("--no-shadows", o.no_shadows, "No shadow map");
+  cmd->add_flag("--timings", o.timings, "Per-pass GPU times");
+}
+
+// Combinations CLI11 cannot check by itself.
+void check_options(const Options& o) {
+  if (o.input.empty() && o.particles.empty()) throw Error(ExitCode::Usage, "preview: give a MESH or an SDF.vdb, or --particles");
+  if (o.contact_sheet && o.turntable < 2) throw Error(ExitCode::Usage, "--contact-sheet needs --turntable N with N >= 2");
+  if (o.color_by == "error" && (o.input.empty() || is_vdb(o.input))) {
+    throw InputError("--color-by error needs a MESH input: the exact distance comes from the mesh");
+  }
+  if (o.color_by == "particle-distance" && o.particles.empty()) {
+    throw InputError("--color-by particle-distance needs --particles");
+  }
+}
+
+preview::SdfVolume volume_from_vdb(const Options& o, gpu::Context& context) {
+  preview::SdfVolume volume =
+      preview::volume_from_level_set(*sdf::read_level_set(o.input), o.input, context.limits().max_3d_texture_size);
+  if (volume.band < 2.0) {
+    log::warn("{}: the narrow band is {:.3g} voxels; below 2 the surface normals may show steps", o.input, volume.band);
+  }
+  return volume;
+}
+
+preview::SdfVolume volume_from_mesh_file(const Options& o, gpu::Context& context, std::optional<TriangleMesh>& mesh) {
+  mesh = load_mesh(o.input);
+  if (o.scale != 1.0) scale_mesh(*mesh, o.scale);
+  ReportOptions report_options;
+  report_options.self_intersections = false;
+  const MeshReport report = analyze_mesh(*mesh, report_options);
+  if (!report.closed()) {
+    log::warn("{}: the mesh is not closed ({}); the SDF's signs may be wrong near the holes", o.input,
+              closed_solid_problems(report));
+  }
+  if (o.band < 2.0) throw InputError(fmt::format("--band {}: the preview needs a band of at least 2 voxels", o.band));
+  sdf::SdfSettings grid;
+  grid.voxel_size = o.voxel;
+  grid.resolution = o.resolution;
+  grid.band = o.band;
+  return preview::volume_from_mesh(context, *mesh, grid);
+}
+
+// What the picture shows and how it is coloured, kept alive while it renders.
+struct Content {
+  std::optional<TriangleMesh> mesh;  // MESH input only
+  double voxel_size = 0.0;           // m, of the SDF (0 without one)
+  std::string field;                 // what the SDF is, for the summary
+  preview::LoadedParticles loaded;
+  std::unique_ptr<sdf::ExactDistance> exact;
+  std::unique_ptr<sampler::PointGrid> particle_grid;
+  std::string scalar_name;
+  std::vector<std::filesystem::path> inputs;
+};
+
+void load_field(const Options& o, gpu::Context& context, preview::Renderer& renderer, Content& content) {
+  if (o.input.empty()) return;
+  content.inputs.emplace_back(o.input);
+  const preview::SdfVolume volume = is_vdb(o.input) ? volume_from_vdb(o, context) : volume_from_mesh_file(o, context, content.mesh);
+  content.voxel_size = volume.spec.voxel_size;
+  content.field = fmt::format("SDF {} x {} x {} voxels of {:.4g} m (band {:.3g})", volume.spec.dims.x(), volume.spec.dims.y(),
+                            volume.spec.dims.z(), content.voxel_size, volume.band);
+  renderer.set_volume(volume);
+}
+
+void load_particles(const Options& o, preview::Renderer& renderer, Content& content) {
+  if (o.particles.empty()) return;
+  content.inputs.emplace_back(o.particles);
+  content.loaded = preview::load_particles(o.particles, o.particle_radius);
+  if (o.scale != 1.0) {
+    for (auto& c : content.loaded.particles.centers) c *= o.scale;
+    if (o.particle_radius <= 0.0) content.loaded.particles.radii[0] *= static_cast<float>(o.scale);
+  }
+  renderer.set_particles(content.loaded.particles);
+}
+
+// --color-by: the scalar each visible surface pixel is coloured by.
+void set_surface_colouring(const Options& o, Content& content, preview::RenderSettings& settings) {
+  if (o.color_by == "error") {
+    content.exact = std::make_unique<sdf::ExactDistance>(*content.mesh);
+    settings.surface_scalar.value = [exact = content.exact.get(), voxel_size = content.voxel_size](const Eigen::Vector3d& p) {
+      return exact->closest(p).distance / voxel_size;
+    };
+    settings.surface_scalar.max_value = o.color_max > 0 ? o.color_max : 0.25;
+    content.scalar_name = "distance from the rendered surface to the mesh [voxels]";
+  } else if (o.color_by == "particle-distance") {
+    const double r = content.loaded.particles.radii[0];
+    content.particle_grid = std::make_unique<sampler::PointGrid>(content.loaded.particles.centers, 2.0 * r);
+    settings.surface_scalar.value = [grid = content.particle_grid.get(), r](const Eigen::Vector3d& p) {
+      return grid->nearest(p).distance / r;
+    };
+    settings.surface_scalar.max_value = o.color_max > 0 ? o.color_max : 1.5;
+    content.scalar_name = "distance from the surface to the nearest particle centre [radii]";
+  }
+}
+
+void set_lighting(const Options& o, const Eigen::Vector2i& size, preview::RenderSettings& settings) {
+  settings.width = size.x();
+  settings.height = size.y();
+  settings.up = vec3(o.up);
+  if (!(settings.up.norm() > 0.0)) throw InputError("--up must not be the zero vector");
+  if (!o.light.empty()) settings.light = vec3(o.light);
+  settings.alpha = o.alpha;
+  settings.ground = !o.no_ground;
+  settings.shadows = !o.no_shadows;
+}
+
+struct Views {
+  double seconds = 0.0;  // s, GPU render time of all views
+  preview::ScalarSummary scalar;
+};
+
+// The turntable's views, written one PNG each or tiled into one contact sheet.
+Views render_views(const Options& o, preview::Renderer& renderer, preview::RenderSettings& settings,
+                   const preview::Camera& camera, const std::vector<std::filesystem::path>& inputs) {
+  std::vector<preview::Image> sheet;
+  Views views;
+  for (int k = 0; k < o.turntable; ++k) {
+    settings.camera = preview::orbit(camera, settings.up, 2.0 * std::numbers::pi * k / o.turntable);
+    preview::RenderResult result = renderer.render(settings);
+    views.seconds += result.seconds;
+    views.scalar.pixels += result.scalar.pixels;
+    views.scalar.mean += result.scalar.mean * static_cast<double>(result.scalar.pixels);
+    views.scalar.max = std::max(views.scalar.max, result.scalar.max);
+    if (o.contact_sheet) {
+      sheet.push_back(std::move(result.image));
+    } else {
+      const std::filesystem::path out = o.turntable > 1 ? numbered(o.output, k, o.turntable) : std::filesystem::path(o.output);
+      preview::write_png(out, result.image, inputs);
+    }
+  }
+  if (o.contact_sheet) preview::write_png(o.output, preview::contact_sheet(sheet), inputs);
+  return views;
+}
+
+void print_summary(const Options& o, const Eigen::Vector2i& size, const Content& content, const Views& views,
+                   const preview::RenderSettings& settings, const gpu::Context& context) {
+  std::string what = content.field;
+  const preview::Particles& particles = content.loaded.particles;
+  if (!particles.centers.empty()) {
+    what += fmt::format("{}{} particles of radius {:.4g} m ({})", what.empty() ? "" : ", ", particles.centers.size(),
+                        particles.radii[0], content.loaded.radius_source);
+  }
+  const std::string files = o.turntable > 1 && !o.contact_sheet
+                                ? fmt::format("{} .. {}", numbered(o.output, 0, o.turntable).string(),
+                                              numbered(o.output, o.turntable - 1, o.turntable).string())
+                                : o.output;
+  fmt::print("{} -> {} ({} x {}{})\n", o.input.empty() ? o.particles : o.input, files, size.x(), size.y(),
+             o.turntable > 1 ? fmt::format(", {} views", o.turntable) : "");
+  fmt::print("  drawn            {}\n", what);
+  if (views.scalar.pixels) {
+    fmt::print("  colour           {}: mean {:.4g}, max {:.4g} over {} pixels (colour map 0 .. {:.3g})\n", content.scalar_name,
+               views.scalar.mean / static_cast<double>(views.scalar.pixels), views.scalar.max, views.scalar.pixels,
+               settings.surface_scalar.max_value);
+  }
+  fmt::print("  render           {:.3f} s on {}\n", views.seconds, context.summary());
+}
+
+int run_preview(const Options& o, const GlobalOptions& global) {
+  check_options(o);
+  const Eigen::Vector2i size = parse_size(o.size);
+  gpu::Context context(context_options(global));
+  preview::Renderer renderer(context, o.timings);
+  renderer.check_image_size(size.x(), size.y());
+  Content content;
+  load_field(o, context, renderer, content);
+  load_particles(o, renderer, content);
+  preview::RenderSettings settings;
+  set_surface_colouring(o, content, settings);
+  set_lighting(o, size, settings);
+  const preview::Camera camera = make_camera(o, renderer.content_box(), static_cast<double>(size.x()) / size.y());
+  const Views views = render_views(o, renderer, settings, camera, content.inputs);
+  print_summary(o, size, content, views, settings, context);
+  if (o.timings) fmt::print("{}", renderer.timing_report());
+  return 0;
+}
+
 }  // namespace
 
 Runner add_preview_command(CLI::App& app, const GlobalOptions& global) {
   auto* cmd = app.add_subcommand("preview", "Off-screen preview: ray-cast SDF (of a mesh or a .vdb level set) with particles as sphere impostors, to PNG");
   auto o = std::make_shared<Options>();
-  cmd->add_option("INPUT", o->input, "Mesh (any format assimp reads; scan-converted here) or SDF.vdb level set");
-  cmd->add_option("-o,--output", o->output, "Output PNG")->required();
-  cmd->add_option("--particles", o->particles, "Particles over the surface: NAME.body.json or a PLY of centres");
-  cmd->add_option("--particle-radius", o->particle_radius,
-                  "Particle radius [m] (default: the body.json's, else half the median neighbour distance)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT [pixels]")->capture_default_str();
-  cmd->add_option("--view", o->view, "Named view relative to --up: front, side, top or iso")
-      ->check(CLI::IsMember({"front", "side", "top", "iso"}))
-      ->capture_default_str();
-  auto* eye = cmd->add_option("--eye", o->eye, "Camera position X,Y,Z [m] (instead of --view)")->delimiter(',')->expected(3);
-  cmd->add_option("--target", o->target, "Point looked at X,Y,Z [m] (default: the centre of what is drawn)")
-      ->delimiter(',')
-      ->expected(3)
-      ->needs(eye);
-  cmd->add_option("--up", o->up, "World up X,Y,Z: the ground's normal and the image's up (meshes: y up by default)")
-      ->delimiter(',')
-      ->expected(3)
-      ->capture_default_str();
-  cmd->add_option("--fov", o->fov, "Vertical field of view [degrees]")->capture_default_str();
-  cmd->add_flag("--ortho", o->ortho, "Orthographic lens (framed to fit)");
-  cmd->add_option("--turntable", o->turntable, "N views turning about --up: OUT_000.png ... (or one --contact-sheet)")
-      ->check(CLI::Range(1, 10000));
-  cmd->add_flag("--contact-sheet", o->contact_sheet, "With --turntable: tile all views into OUT.png");
-  cmd->add_flag("--alpha", o->alpha, "Transparent background; the ground shows only its shadows");
-  cmd->add_option("--color-by", o->color_by,
-                  "Colour the surface by: none, error (distance from the mesh, voxels; MESH input) or "
-                  "particle-distance (distance to the nearest particle centre, in radii)")
-      ->check(CLI::IsMember({"none", "error", "particle-distance"}))
-      ->capture_default_str();
-  cmd->add_option("--color-max", o->color_max, "Value at the top of the colour map (default 0.25 voxel / 1.5 radii)")
-      ->check(CLI::PositiveNumber);
-  auto* voxel = cmd->add_option("--voxel", o->voxel, "MESH: SDF voxel size [m]")->check(CLI::PositiveNumber);
-  cmd->add_option("--resolution", o->resolution, "MESH: SDF voxels along the longest side")
-      ->check(CLI::PositiveNumber)
-      ->excludes(voxel)
-      ->capture_default_str();
-  cmd->add_option("--band", o->band, "MESH: narrow-band half-width [voxels], >= 2 for clean normals")->capture_default_str();
-  cmd->add_option("--scale", o->scale, "MESH and particles: multiply coordinates by this factor first")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--light", o->light, "Direction towards the key light X,Y,Z (default: upper left, behind the camera)")
-      ->delimiter(',')
-      ->expected(3);
-  cmd->add_flag("--no-ground", o->no_ground, "No ground plane");
-  cmd->add_flag("--no-shadows", o->no_shadows, "No shadow map");
-  cmd->add_flag("--timings", o->timings, "Per-pass GPU times");
-  return [o, &global] {
-    if (o->input.empty() && o->particles.empty()) throw Error(ExitCode::Usage, "preview: give a MESH or an SDF.vdb, or --particles");
-    if (o->contact_sheet && o->turntable < 2) throw Error(ExitCode::Usage, "--contact-sheet needs --turntable N with N >= 2");
-    if (o->color_by == "error" && (o->input.empty() || is_vdb(o->input))) {
-      throw InputError("--color-by error needs a MESH input: the exact distance comes from the mesh");
-    }
-    if (o->color_by == "particle-distance" && o->particles.empty()) {
-      throw InputError("--color-by particle-distance needs --particles");
-    }
-    const Eigen::Vector2i size = parse_size(o->size);
-    std::vector<std::filesystem::path> inputs;
-
-    gpu::ContextOptions context_options;
-    context_options.device = global.device;
-    context_options.debug = global.gl_debug;
-    gpu::Context context(context_options);
-    preview::Renderer renderer(context, o->timings);
-    renderer.check_image_size(size.x(), size.y());
-
-    // The SDF.
-    std::optional<TriangleMesh> mesh;
-    double voxel_size = 0.0;
-    std::string field;
-    if (!o->input.empty()) {
-      inputs.emplace_back(o->input);
-      preview::SdfVolume volume;
-      if (is_vdb(o->input)) {
-        volume = preview::volume_from_level_set(*sdf::read_level_set(o->input), o->input,
-                                                context.limits().max_3d_texture_size);
-        if (volume.band < 2.0) {
-          log::warn("{}: the narrow band is {:.3g} voxels; below 2 the surface normals may show steps", o->input, volume.band);
-        }
-      } else {
-        mesh = load_mesh(o->input);
-        if (o->scale != 1.0) scale_mesh(*mesh, o->scale);
-        ReportOptions report_options;
-        report_options.self_intersections = false;
-        const MeshReport report = analyze_mesh(*mesh, report_options);
-        if (!report.closed()) {
-          log::warn("{}: the mesh is not closed ({}); the SDF's signs may be wrong near the holes", o->input,
-                    closed_solid_problems(report));
-        }
-        if (o->band < 2.0) throw InputError(fmt::format("--band {}: the preview needs a band of at least 2 voxels", o->band));
-        sdf::SdfSettings grid;
-        grid.voxel_size = o->voxel;
-        grid.resolution = o->resolution;
-        grid.band = o->band;
-        volume = preview::volume_from_mesh(context, *mesh, grid);
-      }
-      voxel_size = volume.spec.voxel_size;
-      field = fmt::format("SDF {} x {} x {} voxels of {:.4g} m (band {:.3g})", volume.spec.dims.x(), volume.spec.dims.y(),
-                          volume.spec.dims.z(), voxel_size, volume.band);
-      renderer.set_volume(volume);
-    }
-
-    // The particles.
-    preview::LoadedParticles loaded;
-    std::unique_ptr<sampler::PointGrid> particle_grid;
-    if (!o->particles.empty()) {
-      inputs.emplace_back(o->particles);
-      loaded = preview::load_particles(o->particles, o->particle_radius);
-      if (o->scale != 1.0) {
-        for (auto& c : loaded.particles.centers) c *= o->scale;
-        if (o->particle_radius <= 0.0) loaded.particles.radii[0] *= static_cast<float>(o->scale);
-      }
-      renderer.set_particles(loaded.particles);
-    }
-
-    // Surface colouring.
-    preview::RenderSettings settings;
-    std::unique_ptr<sdf::ExactDistance> exact;
-    std::string scalar_name;
-    if (o->color_by == "error") {
-      exact = std::make_unique<sdf::ExactDistance>(*mesh);
-      settings.surface_scalar.value = [&exact, voxel_size](const Eigen::Vector3d& p) {
-        return exact->closest(p).distance / voxel_size;
-      };
-      settings.surface_scalar.max_value = o->color_max > 0 ? o->color_max : 0.25;
-      scalar_name = "distance from the rendered surface to the mesh [voxels]";
-    } else if (o->color_by == "particle-distance") {
-      const double r = loaded.particles.radii[0];
-      particle_grid = std::make_unique<sampler::PointGrid>(loaded.particles.centers, 2.0 * r);
-      settings.surface_scalar.value = [&particle_grid, r](const Eigen::Vector3d& p) {
-        return particle_grid->nearest(p).distance / r;
-      };
-      settings.surface_scalar.max_value = o->color_max > 0 ? o->color_max : 1.5;
-      scalar_name = "distance from the surface to the nearest particle centre [radii]";
-    }
-
-    settings.width = size.x();
-    settings.height = size.y();
-    settings.up = vec3(o->up);
-    if (!(settings.up.norm() > 0.0)) throw InputError("--up must not be the zero vector");
-    if (!o->light.empty()) settings.light = vec3(o->light);
-    settings.alpha = o->alpha;
-    settings.ground = !o->no_ground;
-    settings.shadows = !o->no_shadows;
-    const preview::Camera camera = make_camera(*o, renderer.content_box(), static_cast<double>(size.x()) / size.y());
-
-    std::vector<preview::Image> sheet;
-    double seconds = 0.0;
-    preview::ScalarSummary scalar;
-    for (int k = 0; k < o->turntable; ++k) {
-      settings.camera = preview::orbit(camera, settings.up, 2.0 * std::numbers::pi * k / o->turntable);
-      preview::RenderResult result = renderer.render(settings);
-      seconds += result.seconds;
-      scalar.pixels += result.scalar.pixels;
-      scalar.mean += result.scalar.mean * static_cast<double>(result.scalar.pixels);
-      scalar.max = std::max(scalar.max, result.scalar.max);
-      if (o->contact_sheet) {
-        sheet.push_back(std::move(result.image));
-      } else {
-        const std::filesystem::path out = o->turntable > 1 ? numbered(o->output, k, o->turntable) : std::filesystem::path(o->output);
-        preview::write_png(out, result.image, inputs);
-      }
-    }
-    if (o->contact_sheet) preview::write_png(o->output, preview::contact_sheet(sheet), inputs);
-
-    std::string what = field;
-    if (!loaded.particles.centers.empty()) {
-      what += fmt::format("{}{} particles of radius {:.4g} m ({})", what.empty() ? "" : ", ", loaded.particles.centers.size(),
-                          loaded.particles.radii[0], loaded.radius_source);
-    }
-    const std::string files = o->turntable > 1 && !o->contact_sheet
-                                  ? fmt::format("{} .. {}", numbered(o->output, 0, o->turntable).string(),
-                                                numbered(o->output, o->turntable - 1, o->turntable).string())
-                                  : o->output;
-    fmt::print("{} -> {} ({} x {}{})\n", o->input.empty() ? o->particles : o->input, files, size.x(), size.y(),
-               o->turntable > 1 ? fmt::format(", {} views", o->turntable) : "");
-    fmt::print("  drawn            {}\n", what);
-    if (scalar.pixels) {
-      fmt::print("  colour           {}: mean {:.4g}, max {:.4g} over {} pixels (colour map 0 .. {:.3g})\n", scalar_name,
-                 scalar.mean / static_cast<double>(scalar.pixels), scalar.max, scalar.pixels,
-                 settings.surface_scalar.max_value);
-    }
-    fmt::print("  render           {:.3f} s on {}\n", seconds, context.summary());
-    if (o->timings) fmt::print("{}", renderer.timing_report());
-    return 0;
-  };
+  add_input_options(cmd, *o);
+  add_camera_options(cmd, *o);
+  add_colour_options(cmd, *o);
+  add_sdf_options(cmd, *o);
+  add_lighting_options(cmd, *o);
+  return [o, &global] { return run_preview(*o, global); };
 }
 
 }  // namespace ts::app

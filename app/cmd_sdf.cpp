@@ -23,132 +23,172 @@
 
 namespace ts::app {
 
-Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
-  auto* cmd = app.add_subcommand("sdf", "Narrow-band signed distance field by GPU scan conversion (OpenVDB level set)");
-  struct Options {
-    std::string mesh, output;
-    double voxel = 0;
-    int resolution = 128;
-    double band = 3.0;
-    int padding = -1;
-    std::string sign = "pseudonormal";
-    double scale = 1.0;
-    double slab_mb = 1024;
-    bool timings = false, compare = false;
-  };
-  auto o = std::make_shared<Options>();
-  cmd->add_option("MESH", o->mesh, "Closed triangle mesh (any format assimp reads)")->required();
-  cmd->add_option("-o,--output", o->output, "Output .vdb file")->required();
-  auto* voxel = cmd->add_option("--voxel", o->voxel, "Voxel size [world units, m]")->check(CLI::PositiveNumber);
-  cmd->add_option("--resolution", o->resolution, "Voxels along the longest side (instead of --voxel)")
+namespace {
+
+struct Options {
+  std::string mesh, output;
+  double voxel = 0;
+  int resolution = 128;
+  double band = 3.0;
+  int padding = -1;
+  std::string sign = "pseudonormal";
+  double scale = 1.0;
+  double slab_mb = 1024;
+  bool timings = false, compare = false;
+};
+
+void add_options(CLI::App* cmd, Options& o) {
+  cmd->add_option("MESH", o.mesh, "Closed triangle mesh (any format assimp reads)")->required();
+  cmd->add_option("-o,--output", o.output, "Output .vdb file")->required();
+  auto* voxel = cmd->add_option("--voxel", o.voxel, "Voxel size [world units, m]")->check(CLI::PositiveNumber);
+  cmd->add_option("--resolution", o.resolution, "Voxels along the longest side (instead of --voxel)")
       ->check(CLI::PositiveNumber)
       ->excludes(voxel)
       ->capture_default_str();
-  cmd->add_option("--band", o->band, "Half-width of the narrow band [voxels], >= 1")->capture_default_str();
-  cmd->add_option("--padding", o->padding, "Voxels beyond the bounding box (default: band + 1)");
-  cmd->add_option("--sign", o->sign, "Sign method: pseudonormal (closed meshes) or winding (robust to holes)")
+  cmd->add_option("--band", o.band, "Half-width of the narrow band [voxels], >= 1")->capture_default_str();
+  cmd->add_option("--padding", o.padding, "Voxels beyond the bounding box (default: band + 1)");
+  cmd->add_option("--sign", o.sign, "Sign method: pseudonormal (closed meshes) or winding (robust to holes)")
       ->check(CLI::IsMember({"pseudonormal", "winding"}))
       ->capture_default_str();
-  cmd->add_option("--scale", o->scale, "Multiply coordinates by this factor first (e.g. 1000: metres -> mm)")
+  cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor first (e.g. 1000: metres -> mm)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--max-slab-mb", o->slab_mb, "GPU memory for one z-slab of the grid [MiB]")
+  cmd->add_option("--max-slab-mb", o.slab_mb, "GPU memory for one z-slab of the grid [MiB]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_flag("--timings", o->timings, "Per-kernel GPU times and peak GPU memory");
-  cmd->add_flag("--compare-openvdb", o->compare,
+  cmd->add_flag("--timings", o.timings, "Per-kernel GPU times and peak GPU memory");
+  cmd->add_flag("--compare-openvdb", o.compare,
                 "Also build OpenVDB's meshToLevelSet and the exact SDF; print how both compare with exact distance");
-  return [o, &global] {
-    const auto start = std::chrono::steady_clock::now();
-    TriangleMesh mesh = load_mesh(o->mesh);
-    if (o->scale != 1.0) scale_mesh(mesh, o->scale);
-    ReportOptions report_options;
-    report_options.self_intersections = false;  // signs only need closedness and orientation
-    const MeshReport report = analyze_mesh(mesh, report_options);
-    const bool winding = o->sign == "winding";
-    if (!report.closed() && !winding) {
-      log::warn("{}: the mesh is not closed ({}); pseudonormal signs may be wrong near the holes: use --sign winding",
-                o->mesh, closed_solid_problems(report));
-    }
-    if (report.closed() && report.signed_volume < 0) {
-      log::warn("{}: the mesh is inside out (negative volume): inside and outside are swapped", o->mesh);
-    }
-    sdf::SdfSettings settings;
-    settings.voxel_size = o->voxel;
-    settings.resolution = o->resolution;
-    settings.band = o->band;
-    settings.padding = o->padding;
-    const sdf::GridSpec spec = sdf::make_grid(bounding_box(mesh), settings);
-    if (o->padding >= 0 && o->padding < o->band) {
-      log::warn("{}: --padding {} is below the band half-width {}: the band is cut where the mesh comes within {} "
-                "voxels of the grid border",
-                o->mesh, o->padding, o->band, o->band);
-    }
+}
 
-    gpu::ContextOptions context_options;
-    context_options.device = global.device;
-    context_options.debug = global.gl_debug;
-    gpu::Context context(context_options);
-    sdf::ScanConvertOptions scan;
-    scan.band = o->band;
-    scan.timings = o->timings;
-    scan.max_slab_bytes = static_cast<std::size_t>(o->slab_mb * 1048576.0);
-    // Progress: a live line on a terminal; otherwise (logs, CI) a line per tenth of a grid that takes
-    // several slabs, so a long run shows it is alive.
-    const bool terminal = ::isatty(STDERR_FILENO) != 0;
-    int reported_tenths = 0;
-    scan.progress = [&](double done) {
-      if (terminal) {
-        std::fprintf(stderr, "\rscan conversion %5.1f %%", 100.0 * done);
-      } else if (done < 1.0 && static_cast<int>(10.0 * done) > reported_tenths) {
-        reported_tenths = static_cast<int>(10.0 * done);
-        log::info("scan conversion {:.0f} %", 100.0 * done);
-      }
-    };
-    const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
-    sdf::ScanConvertResult result = sdf::scan_convert(context, mesh, normals, spec, scan);
-    if (terminal) std::fprintf(stderr, "\n");
-    std::unique_ptr<sdf::ExactDistance> exact;
-    if (winding || o->compare) exact = std::make_unique<sdf::ExactDistance>(mesh);
-    if (winding) sdf::resign_by_winding_number(*result.grid, *exact);
+// The mesh, scaled, with a warning where its signs cannot be trusted.
+TriangleMesh load_sdf_mesh(const Options& o) {
+  TriangleMesh mesh = load_mesh(o.mesh);
+  if (o.scale != 1.0) scale_mesh(mesh, o.scale);
+  ReportOptions report_options;
+  report_options.self_intersections = false;  // signs only need closedness and orientation
+  const MeshReport report = analyze_mesh(mesh, report_options);
+  if (!report.closed() && o.sign != "winding") {
+    log::warn("{}: the mesh is not closed ({}); pseudonormal signs may be wrong near the holes: use --sign winding",
+              o.mesh, closed_solid_problems(report));
+  }
+  if (report.closed() && report.signed_volume < 0) {
+    log::warn("{}: the mesh is inside out (negative volume): inside and outside are swapped", o.mesh);
+  }
+  return mesh;
+}
 
-    const std::map<std::string, std::string> metadata{
-        {"tetrasand:source", o->mesh},
-        {"tetrasand:source_sha256", sha256_file(o->mesh)},
-        {"tetrasand:band_voxels", fmt::format("{}", o->band)},
-        {"tetrasand:sign", o->sign},
-        {"tetrasand:renderer", context.summary()}};
-    sdf::write_vdb(o->output, result.grid, metadata, {o->mesh});
-    const auto& st = result.stats;
-    fmt::print("{}: {} triangles -> {} ({} x {} x {} voxels of {:.6g}, band {} voxels, {} band voxels)\n", o->mesh,
-               mesh.triangle_count(), o->output, spec.dims.x(), spec.dims.y(), spec.dims.z(), spec.voxel_size, o->band,
-               st.band_voxels);
-    if (st.degenerate_triangles || st.needle_triangles) {
-      fmt::print("{} degenerate triangles skipped, {} needle triangles bounded by rectangles\n", st.degenerate_triangles,
-                 st.needle_triangles);
+sdf::GridSpec grid_of(const Options& o, const TriangleMesh& mesh) {
+  sdf::SdfSettings settings;
+  settings.voxel_size = o.voxel;
+  settings.resolution = o.resolution;
+  settings.band = o.band;
+  settings.padding = o.padding;
+  const sdf::GridSpec spec = sdf::make_grid(bounding_box(mesh), settings);
+  if (o.padding >= 0 && o.padding < o.band) {
+    log::warn("{}: --padding {} is below the band half-width {}: the band is cut where the mesh comes within {} "
+              "voxels of the grid border",
+              o.mesh, o.padding, o.band, o.band);
+  }
+  return spec;
+}
+
+// Progress: a live line on a terminal; otherwise (logs, CI) a line per tenth of a grid that takes
+// several slabs, so a long run shows it is alive.
+class ScanProgress {
+ public:
+  ScanProgress() : terminal_(::isatty(STDERR_FILENO) != 0) {}
+  void operator()(double done) {
+    if (terminal_) {
+      std::fprintf(stderr, "\rscan conversion %5.1f %%", 100.0 * done);
+    } else if (done < 1.0 && static_cast<int>(10.0 * done) > reported_tenths_) {
+      reported_tenths_ = static_cast<int>(10.0 * done);
+      log::info("scan conversion {:.0f} %", 100.0 * done);
     }
-    if (o->timings) {
-      fmt::print("{} slabs of {} layers, {} draws, peak GPU memory {:.1f} MiB, {:.3f} s\n{}", st.slabs,
-                 st.layers_per_slab, st.draws, st.peak_gpu_bytes / 1048576.0, st.seconds, st.timing_report);
-    }
-    if (o->compare) {
-      auto lap = std::chrono::steady_clock::now();
-      const auto exact_grid = sdf::exact_sdf_grid(mesh, spec, o->band, winding ? sdf::SignMethod::Winding
-                                                                               : sdf::SignMethod::Pseudonormal);
-      const double exact_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lap).count();
-      lap = std::chrono::steady_clock::now();
-      const auto vdb = sdf::openvdb_level_set(mesh, spec.voxel_size, o->band);
-      const double vdb_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lap).count();
-      fmt::print("times: tetrasand GPU {:.3f} s, CPU exact {:.3f} s, OpenVDB meshToLevelSet {:.3f} s\n", st.seconds,
-                 exact_seconds, vdb_seconds);
-      const double band_world = o->band * spec.voxel_size;
-      fmt::print("{}", sdf::format_comparison(sdf::compare_grids(*result.grid, *exact_grid, spec.voxel_size, band_world),
-                                              sdf::compare_grids(*vdb, *exact_grid, spec.voxel_size, band_world),
-                                              sdf::compare_grids(*result.grid, *vdb, spec.voxel_size, band_world)));
-    }
-    fmt::print("total {:.2f} s on {}\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-               context.summary());
-    return 0;
-  };
+  }
+  void end() const {
+    if (terminal_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool terminal_;
+  int reported_tenths_ = 0;
+};
+
+void write_level_set(const Options& o, const sdf::ScanConvertResult& result, const gpu::Context& context) {
+  const std::map<std::string, std::string> metadata{
+      {"tetrasand:source", o.mesh},
+      {"tetrasand:source_sha256", sha256_file(o.mesh)},
+      {"tetrasand:band_voxels", fmt::format("{}", o.band)},
+      {"tetrasand:sign", o.sign},
+      {"tetrasand:renderer", context.summary()}};
+  sdf::write_vdb(o.output, result.grid, metadata, {o.mesh});
+}
+
+void print_summary(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
+                   const sdf::ScanConvertStats& st) {
+  fmt::print("{}: {} triangles -> {} ({} x {} x {} voxels of {:.6g}, band {} voxels, {} band voxels)\n", o.mesh,
+             mesh.triangle_count(), o.output, spec.dims.x(), spec.dims.y(), spec.dims.z(), spec.voxel_size, o.band,
+             st.band_voxels);
+  if (st.degenerate_triangles || st.needle_triangles) {
+    fmt::print("{} degenerate triangles skipped, {} needle triangles bounded by rectangles\n", st.degenerate_triangles,
+               st.needle_triangles);
+  }
+  if (o.timings) {
+    fmt::print("{} slabs of {} layers, {} draws, peak GPU memory {:.1f} MiB, {:.3f} s\n{}", st.slabs,
+               st.layers_per_slab, st.draws, st.peak_gpu_bytes / 1048576.0, st.seconds, st.timing_report);
+  }
+}
+
+// --compare-openvdb: the exact SDF and OpenVDB's meshToLevelSet on the same grid, timed, and all
+// three fields compared.
+void print_comparison(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
+                      const sdf::ScanConvertResult& result) {
+  auto lap = std::chrono::steady_clock::now();
+  const auto exact_grid = sdf::exact_sdf_grid(mesh, spec, o.band, o.sign == "winding" ? sdf::SignMethod::Winding
+                                                                                       : sdf::SignMethod::Pseudonormal);
+  const double exact_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lap).count();
+  lap = std::chrono::steady_clock::now();
+  const auto vdb = sdf::openvdb_level_set(mesh, spec.voxel_size, o.band);
+  const double vdb_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lap).count();
+  fmt::print("times: tetrasand GPU {:.3f} s, CPU exact {:.3f} s, OpenVDB meshToLevelSet {:.3f} s\n", result.stats.seconds,
+             exact_seconds, vdb_seconds);
+  const double band_world = o.band * spec.voxel_size;
+  fmt::print("{}", sdf::format_comparison(sdf::compare_grids(*result.grid, *exact_grid, spec.voxel_size, band_world),
+                                          sdf::compare_grids(*vdb, *exact_grid, spec.voxel_size, band_world),
+                                          sdf::compare_grids(*result.grid, *vdb, spec.voxel_size, band_world)));
+}
+
+int run_sdf(const Options& o, const GlobalOptions& global) {
+  const auto start = std::chrono::steady_clock::now();
+  const TriangleMesh mesh = load_sdf_mesh(o);
+  const sdf::GridSpec spec = grid_of(o, mesh);
+  gpu::Context context(context_options(global));
+  sdf::ScanConvertOptions scan;
+  scan.band = o.band;
+  scan.timings = o.timings;
+  scan.max_slab_bytes = static_cast<std::size_t>(o.slab_mb * 1048576.0);
+  ScanProgress progress;
+  scan.progress = [&progress](double done) { progress(done); };
+  const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
+  sdf::ScanConvertResult result = sdf::scan_convert(context, mesh, normals, spec, scan);
+  progress.end();
+  // The winding-number signs replace the pseudonormal ones where the mesh cannot give them.
+  if (o.sign == "winding") sdf::resign_by_winding_number(*result.grid, sdf::ExactDistance(mesh));
+  write_level_set(o, result, context);
+  print_summary(o, mesh, spec, result.stats);
+  if (o.compare) print_comparison(o, mesh, spec, result);
+  fmt::print("total {:.2f} s on {}\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+             context.summary());
+  return 0;
+}
+
+}  // namespace
+
+Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
+  auto* cmd = app.add_subcommand("sdf", "Narrow-band signed distance field by GPU scan conversion (OpenVDB level set)");
+  auto o = std::make_shared<Options>();
+  add_options(cmd, *o);
+  return [o, &global] { return run_sdf(*o, global); };
 }
 
 }  // namespace ts::app
