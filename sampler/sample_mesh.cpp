@@ -218,160 +218,241 @@ ThinFeatures find_thin_features(const TriangleMesh& mesh, const sdf::ExactDistan
   return thin;
 }
 
-}  // namespace
+// What is decided before any GPU work: the particle size, and the mass properties of the solid.
+struct SamplingPlan {
+  double area = 0.0;  // m^2
+  Sizing z;
+  MassProperties mass;
+  double mass_cell = 0.0;  // m, finest octree cell of MassMethod::WindingCells (else 0)
+};
 
-SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const SampleSettings& settings,
-                         const std::function<void(const SampleProgress&)>& progress) {
-  const auto start = std::chrono::steady_clock::now();
-  SampleResult result;
-  const double area = surface_area(mesh);
-  if (!(area > 0.0)) throw InputError("the mesh has no surface area");
-  // A closed mesh's mass properties come first, so a zero-volume mesh is refused before any GPU work;
-  // the winding-number solid's need the exact distance below.
-  std::optional<MassProperties> mass;
-  if (settings.mass_method == MassMethod::ClosedMesh) mass = compute_mass_properties(mesh, settings.density);
-  const Sizing z = size_particles(area, settings);
-  check_sizes(z, settings, area);
-  if (settings.fill && mass) check_filled_size(z, *mass, settings.max_particles);
-  result.estimated_count = z.count;
+// Validates the mesh and sizes the body. A closed mesh's mass properties come first, so a
+// zero-volume mesh is refused before anything else; every size check happens here, before the SDF.
+SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& exact, const SampleSettings& settings,
+                           SampleResult& result) {
+  SamplingPlan plan;
+  plan.area = surface_area(mesh);
+  const bool closed = settings.mass_method == MassMethod::ClosedMesh;
+  if (closed) plan.mass = compute_mass_properties(mesh, settings.density);
+  plan.z = size_particles(plan.area, settings);
+  check_sizes(plan.z, settings, plan.area);
+  if (!closed) {
+    const WindingSolid solid = winding_mass_properties(mesh, exact, settings.density, settings.mass_cell);
+    plan.mass = solid.mass;
+    plan.mass_cell = solid.cell;
+  }
+  if (settings.fill) check_filled_size(plan.z, plan.mass, settings.max_particles);
+  result.estimated_count = plan.z.count;
+  if (settings.fill) {
+    result.estimated_interior =
+        std::max(plan.mass.volume - plan.area * plan.z.radius, 0.0) * interior_lattice_density(plan.z.radius);
+  }
+  return plan;
+}
 
-  // 1. SDF, kept on the GPU as a dense texture.
-  const sdf::GridSpec spec = choose_grid(mesh, z.radius, settings, result.warnings);
+// The SDF, left on the GPU as a dense texture for the relaxation.
+sdf::ScanConvertResult scan_field(gpu::Context& context, const TriangleMesh& mesh, const sdf::GridSpec& spec,
+                                  const SampleSettings& settings) {
   const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
   sdf::ScanConvertOptions scan;
   scan.band = kBandVoxels;
   scan.keep_texture = true;
   scan.build_grid = false;
   scan.timings = settings.timings;
-  sdf::ScanConvertResult field = sdf::scan_convert(context, mesh, normals, spec, scan);
-  const sdf::ExactDistance exact(mesh);
-  double mass_cell = 0.0;
-  if (!mass) {
-    const WindingSolid solid = winding_mass_properties(mesh, exact, settings.density, settings.mass_cell);
-    mass = solid.mass;
-    mass_cell = solid.cell;
-  }
-  if (settings.fill && settings.mass_method == MassMethod::WindingCells) check_filled_size(z, *mass, settings.max_particles);
-  if (settings.fill) {
-    result.estimated_interior = std::max(mass->volume - area * z.radius, 0.0) * interior_lattice_density(z.radius);
-  }
+  return sdf::scan_convert(context, mesh, normals, spec, scan);
+}
 
-  // 2. Seeds.
-  std::mt19937_64 rng(settings.seed);
-  std::vector<Eigen::Vector3d> particles = sample_surface_points(mesh, z.count, rng).positions;
-
-  // 3-4. Relax, project, measure coverage, inject, relax locally, repeat.
-  GpuRelaxer relaxer(context, std::move(field.texture), settings.timings);
-  RelaxSettings relax = settings.relax;
-  relax.spacing = z.spacing;
-  relax.band_limit = 0.95 * kBandVoxels * spec.voxel_size;
-  const double target = settings.coverage * z.radius;
+// The particle arrangement as the hole-closing rounds leave it.
+struct Arrangement {
+  std::vector<Eigen::Vector3d> particles;  // m, on the surface
+  std::vector<Eigen::Vector3d> normals;    // unit outward normals
+  CoverageResult coverage;                 // of the last full probe pass
   int iterations = 0, rounds = 0;
-  bool converged = true;
-  std::vector<Eigen::Vector3d> particle_normals;
-  std::vector<std::uint8_t> mobile(particles.size(), 1);
-  CoverageResult coverage;
-  bool relax_round = true;
-  for (;;) {
-    if (relax_round) {
-    std::vector<Eigen::Vector3f> local = to_local(particles, spec.origin);
-    const RelaxStats stats = relaxer.relax(local, relax, [&](int it, std::size_t n, double residual) {
-      if (progress) progress({rounds, iterations + it, n, residual});
-    }, &mobile);
-    iterations += stats.iterations;
+  bool converged = true;                   // the global (first) relaxation's verdict
+};
+
+// Relax, project, measure coverage, inject at the deepest holes, relax locally, repeat (sample_mesh.h
+// step 4), until the covering radius meets the target over the full probe set or the round limit.
+class HoleClosing {
+ public:
+  HoleClosing(GpuRelaxer& relaxer, const TriangleMesh& mesh, const sdf::ExactDistance& exact,
+              const sdf::GridSpec& spec, const SamplingPlan& plan, const SampleSettings& settings,
+              const std::function<void(const SampleProgress&)>& progress)
+      : relaxer_(relaxer), mesh_(mesh), exact_(exact), spec_(spec), plan_(plan), settings_(settings),
+        progress_(progress), target_(settings.coverage * plan.z.radius) {
+    relax_ = settings.relax;
+    relax_.spacing = plan.z.spacing;
+    relax_.band_limit = 0.95 * kBandVoxels * spec.voxel_size;
+  }
+
+  Arrangement run(std::vector<Eigen::Vector3d> seeds) {
+    out_.particles = std::move(seeds);
+    mobile_.assign(out_.particles.size(), 1);
+    bool relax_round = true;
+    for (;;) {
+      if (relax_round) relax();
+      project_and_thin();
+      measure();
+      if (out_.coverage.covering_radius <= target_ || out_.rounds >= settings_.max_rounds) break;
+      // The first rounds relax the new particles with their neighbours (better spacing). Later ones
+      // only place them: a particle at the deepest point of a hole, on the surface and at least r
+      // from every other one, can only shrink holes, never open one elsewhere, so the rounds converge.
+      relax_round = out_.rounds < kNeighbourRounds;
+      inject();
+    }
+    return std::move(out_);
+  }
+
+ private:
+  void relax() {
+    std::vector<Eigen::Vector3f> local = to_local(out_.particles, spec_.origin);
+    const RelaxStats stats = relaxer_.relax(local, relax_, [&](int it, std::size_t n, double residual) {
+      if (progress_) progress_({out_.rounds, out_.iterations + it, n, residual});
+    }, &mobile_);
+    out_.iterations += stats.iterations;
     // "Converged" is the global relaxation's verdict; the local ones after an injection stop at
     // kLocalIterations (their residual, logged, sits near 1.5 x the tolerance: the compressed rim).
-    if (rounds == 0) converged = stats.converged;
-    log::debug("sampler round {}: {} iterations, residual {:.3g}, {} of {} particles mobile", rounds, stats.iterations,
-               stats.mean_move_over_spacing, std::count(mobile.begin(), mobile.end(), 1), mobile.size());
-    particles.clear();
-    for (const auto& p : local) particles.push_back(p.cast<double>() + spec.origin);
-    }
-    project_exactly(exact, particles, particle_normals);
-    const std::size_t dropped = drop_crowded(particles, particle_normals, kCrowdedOverSpacing * z.spacing);
-    if (dropped > 0) log::debug("sampler round {}: dropped {} crowded particles", rounds, dropped);
-    // Holes are hunted with a quarter of the probes (a 1M-probe pass costs more than a local
-    // relaxation on llvmpipe); the reported figure always comes from a full pass, and when that one
-    // still finds holes its worst points feed the next injection.
-    CoverageSettings probe;
-    probe.seed = settings.seed + 1000u * static_cast<unsigned>(rounds + 1);
-    probe.worst_k = std::max<std::size_t>(1, particles.size() / 10);
-    probe.min_depth = target;  // only real holes
-    probe.probes = std::max<std::size_t>(settings.probes / kScoutProbeFraction, 1);
-    coverage = measure_coverage(mesh, std::span<const Eigen::Vector3d>(particles), probe);
-    if (coverage.covering_radius <= target || rounds >= settings.max_rounds) {
-      probe.probes = settings.probes;
-      probe.seed += 500u;
-      coverage = measure_coverage(mesh, std::span<const Eigen::Vector3d>(particles), probe);
-    }
-    log::debug("sampler round {}: covering radius {:.4f} r over {} probes, {} holes deeper than the target", rounds,
-               coverage.covering_radius / z.radius, probe.probes, coverage.worst.size());
-    if (coverage.covering_radius <= target || rounds >= settings.max_rounds) break;
-    // Inject at the worst uncovered surface points (already on the surface); only they and the
-    // particles near them relax again, so the rest of the arrangement (and its holes, already
-    // measured) stays as it is.
-    // The first rounds relax the new particles with their neighbours (better spacing). Later ones
-    // only place them: a particle at the deepest point of a hole, on the surface and at least r from
-    // every other one, can only shrink holes, never open one elsewhere, so the rounds converge.
-    relax_round = rounds < kNeighbourRounds;
-    mobile = mobile_near_injections(particles, coverage.worst, kMobileRadiusOverSpacing * z.spacing);
-    for (const auto& hole : coverage.worst) particles.push_back(hole.position);
-    relax.max_iterations = std::min(relax.max_iterations, kLocalIterations);
-    ++rounds;
-  }
-  if (coverage.covering_radius > target) {
-    result.warnings.push_back(fmt::format("coverage target not reached after {} rounds: covering radius {:.4g} m = {:.3f} r "
-                                          "(target {:.3f} r)",
-                                          rounds, coverage.covering_radius, coverage.covering_radius / z.radius,
-                                          settings.coverage));
+    if (out_.rounds == 0) out_.converged = stats.converged;
+    log::debug("sampler round {}: {} iterations, residual {:.3g}, {} of {} particles mobile", out_.rounds,
+               stats.iterations, stats.mean_move_over_spacing, std::count(mobile_.begin(), mobile_.end(), 1),
+               mobile_.size());
+    out_.particles.clear();
+    for (const auto& p : local) out_.particles.push_back(p.cast<double>() + spec_.origin);
   }
 
-  // 5. Quality and the body.
-  const SpacingStatistics spacing = spacing_statistics(area, std::span<const Eigen::Vector3d>(particles));
-  const double max_phi = max_distance_to_surface(mesh, std::span<const Eigen::Vector3d>(particles));
-  result.thin = find_thin_features(mesh, exact, z.spacing);
-  if (result.thin.triangles > 0) {
+  void project_and_thin() {
+    project_exactly(exact_, out_.particles, out_.normals);
+    const std::size_t dropped = drop_crowded(out_.particles, out_.normals, kCrowdedOverSpacing * plan_.z.spacing);
+    if (dropped > 0) log::debug("sampler round {}: dropped {} crowded particles", out_.rounds, dropped);
+  }
+
+  // Holes are hunted with a quarter of the probes (a 1M-probe pass costs more than a local
+  // relaxation on llvmpipe); the reported figure always comes from a full pass, and when that one
+  // still finds holes its worst points feed the next injection.
+  void measure() {
+    CoverageSettings probe;
+    probe.seed = settings_.seed + 1000u * static_cast<unsigned>(out_.rounds + 1);
+    probe.worst_k = std::max<std::size_t>(1, out_.particles.size() / 10);
+    probe.min_depth = target_;  // only real holes
+    probe.probes = std::max<std::size_t>(settings_.probes / kScoutProbeFraction, 1);
+    const std::span<const Eigen::Vector3d> particles(out_.particles);
+    out_.coverage = measure_coverage(mesh_, particles, probe);
+    if (out_.coverage.covering_radius <= target_ || out_.rounds >= settings_.max_rounds) {
+      probe.probes = settings_.probes;
+      probe.seed += 500u;
+      out_.coverage = measure_coverage(mesh_, particles, probe);
+    }
+    log::debug("sampler round {}: covering radius {:.4f} r over {} probes, {} holes deeper than the target",
+               out_.rounds, out_.coverage.covering_radius / plan_.z.radius, probe.probes, out_.coverage.worst.size());
+  }
+
+  // New particles at the worst uncovered surface points (already on the surface); only they and the
+  // particles near them relax again, so the rest of the arrangement (and its holes, already
+  // measured) stays as it is.
+  void inject() {
+    mobile_ = mobile_near_injections(out_.particles, out_.coverage.worst, kMobileRadiusOverSpacing * plan_.z.spacing);
+    for (const auto& hole : out_.coverage.worst) out_.particles.push_back(hole.position);
+    relax_.max_iterations = std::min(relax_.max_iterations, kLocalIterations);
+    ++out_.rounds;
+  }
+
+  GpuRelaxer& relaxer_;
+  const TriangleMesh& mesh_;
+  const sdf::ExactDistance& exact_;
+  const sdf::GridSpec& spec_;
+  const SamplingPlan& plan_;
+  const SampleSettings& settings_;
+  const std::function<void(const SampleProgress&)>& progress_;
+  const double target_;  // m, the covering radius to reach
+  RelaxSettings relax_;
+  std::vector<std::uint8_t> mobile_;
+  Arrangement out_;
+};
+
+void warn_about_quality(const Arrangement& a, const SamplingPlan& plan, const SampleSettings& settings,
+                        SampleResult& result) {
+  const double r = plan.z.radius;
+  if (a.coverage.covering_radius > settings.coverage * r) {
+    result.warnings.push_back(fmt::format("coverage target not reached after {} rounds: covering radius {:.4g} m = "
+                                          "{:.3f} r (target {:.3f} r)",
+                                          a.rounds, a.coverage.covering_radius, a.coverage.covering_radius / r,
+                                          settings.coverage));
+  }
+  const ThinFeatures& thin = result.thin;
+  if (thin.triangles > 0) {
     result.warnings.push_back(fmt::format("{} triangles belong to features thinner than the particle spacing {:.4g} m "
                                           "(within [{:.4g}, {:.4g}, {:.4g}] .. [{:.4g}, {:.4g}, {:.4g}] m): particles of "
                                           "both sides overlap there",
-                                          result.thin.triangles, z.spacing, result.thin.where.min.x(),
-                                          result.thin.where.min.y(), result.thin.where.min.z(), result.thin.where.max.x(),
-                                          result.thin.where.max.y(), result.thin.where.max.z()));
+                                          thin.triangles, plan.z.spacing, thin.where.min.x(), thin.where.min.y(),
+                                          thin.where.min.z(), thin.where.max.x(), thin.where.max.y(), thin.where.max.z()));
   }
-  if (settings.sign == sdf::SignMethod::Winding) orient_normals_by_winding(exact, particles, particle_normals, z.radius);
-  ParticleBody& body = result.body;
-  for (std::size_t i = 0; i < particles.size(); ++i) {
-    body.positions.push_back(particles[i].cast<float>());
-    body.normals.push_back(particle_normals[i].cast<float>());
+}
+
+// The particles (surface, then the interior fill), their radius and the solid's mass properties.
+void fill_body(const Arrangement& a, const sdf::ExactDistance& exact, const TriangleMesh& mesh,
+               const SamplingPlan& plan, const SampleSettings& settings, ParticleBody& body) {
+  for (std::size_t i = 0; i < a.particles.size(); ++i) {
+    body.positions.push_back(a.particles[i].cast<float>());
+    body.normals.push_back(a.normals[i].cast<float>());
   }
   if (settings.fill) {
-    // Surface quality figures above are of the surface layer alone.
-    const std::vector<Eigen::Vector3d> interior = fill_interior(exact, bounding_box(mesh), mass->center_of_mass, z.radius,
-                                                               settings.sign);
+    const std::vector<Eigen::Vector3d> interior =
+        fill_interior(exact, bounding_box(mesh), plan.mass.center_of_mass, plan.z.radius, settings.sign);
     for (const auto& p : interior) {
       body.positions.push_back(p.cast<float>());
       body.normals.push_back(Eigen::Vector3f::Zero());
     }
     body.interior_count = interior.size();
   }
-  body.particle_radius = z.radius;
-  set_mass_properties(body, *mass);
+  body.particle_radius = plan.z.radius;
+  set_mass_properties(body, plan.mass);
   if (settings.mass_method == MassMethod::WindingCells) {
     body.mass_method = MassMethod::WindingCells;
-    body.mass_cell = mass_cell;
+    body.mass_cell = plan.mass_cell;
   }
+}
+
+// Quality figures of the surface particles alone (docs/body-format.md).
+ParticleBody::Quality measure_quality(const Arrangement& a, const TriangleMesh& mesh, const SamplingPlan& plan,
+                                      const SampleSettings& settings) {
+  const std::span<const Eigen::Vector3d> particles(a.particles);
+  const SpacingStatistics spacing = spacing_statistics(plan.area, particles);
+  const double r = plan.z.radius;
+  ParticleBody::Quality q;
+  q.relative_radius = spacing.relative_radius;
+  q.cv = spacing.cv_nn;
+  q.covering_radius = a.coverage.covering_radius;
+  q.covering_over_r = a.coverage.covering_radius / r;
+  if (settings.grain_radius > 0.0) q.covering_over_r_plus_grain = a.coverage.covering_radius / (r + settings.grain_radius);
+  q.max_abs_phi_over_r = max_distance_to_surface(mesh, particles) / r;
+  q.iterations = a.iterations;
+  q.injection_rounds = a.rounds;
+  q.converged = a.converged;
+  return q;
+}
+
+}  // namespace
+
+SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const SampleSettings& settings,
+                         const std::function<void(const SampleProgress&)>& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  SampleResult result;
+  if (!(surface_area(mesh) > 0.0)) throw InputError("the mesh has no surface area");
+  const sdf::ExactDistance exact(mesh);
+  const SamplingPlan plan = plan_sampling(mesh, exact, settings, result);                   // validate, size
+  const sdf::GridSpec spec = choose_grid(mesh, plan.z.radius, settings, result.warnings);
+  sdf::ScanConvertResult field = scan_field(context, mesh, spec, settings);                 // field
+  std::mt19937_64 rng(settings.seed);
+  std::vector<Eigen::Vector3d> seeds = sample_surface_points(mesh, plan.z.count, rng).positions;
+  GpuRelaxer relaxer(context, std::move(field.texture), settings.timings);
+  Arrangement a = HoleClosing(relaxer, mesh, exact, spec, plan, settings, progress).run(std::move(seeds));  // relax, close holes
+  ParticleBody& body = result.body;                                                            // measure, write
+  body.quality = measure_quality(a, mesh, plan, settings);
+  result.thin = find_thin_features(mesh, exact, plan.z.spacing);
+  warn_about_quality(a, plan, settings, result);
+  if (settings.sign == sdf::SignMethod::Winding) orient_normals_by_winding(exact, a.particles, a.normals, plan.z.radius);
+  fill_body(a, exact, mesh, plan, settings, body);
   body.sdf_voxel_size = spec.voxel_size;
-  body.quality.relative_radius = spacing.relative_radius;
-  body.quality.cv = spacing.cv_nn;
-  body.quality.covering_radius = coverage.covering_radius;
-  body.quality.covering_over_r = coverage.covering_radius / z.radius;
-  if (settings.grain_radius > 0.0) {
-    body.quality.covering_over_r_plus_grain = coverage.covering_radius / (z.radius + settings.grain_radius);
-  }
-  body.quality.max_abs_phi_over_r = max_phi / z.radius;
-  body.quality.iterations = iterations;
-  body.quality.injection_rounds = rounds;
-  body.quality.converged = converged;
   body.quality.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (settings.timings) result.timing_report = field.stats.timing_report + relaxer.timing_report();
   return result;
