@@ -229,7 +229,7 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   // A closed mesh's mass properties come first, so a zero-volume mesh is refused before any GPU work;
   // the winding-number solid's need the exact distance below.
   std::optional<MassProperties> mass;
-  if (settings.mass_method == MassMethod::ClosedMesh) mass = compute_mass_properties(mesh, settings.density);
+  if (settings.mass_method == body::MassMethod::ClosedMesh) mass = compute_mass_properties(mesh, settings.density);
   const Sizing z = size_particles(area, settings);
   check_sizes(z, settings, area);
   if (settings.fill && mass) check_filled_size(z, *mass, settings.max_particles);
@@ -251,7 +251,7 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
     mass = solid.mass;
     mass_cell = solid.cell;
   }
-  if (settings.fill && settings.mass_method == MassMethod::WindingCells) check_filled_size(z, *mass, settings.max_particles);
+  if (settings.fill && settings.mass_method == body::MassMethod::WindingCells) check_filled_size(z, *mass, settings.max_particles);
   if (settings.fill) {
     result.estimated_interior = std::max(mass->volume - area * z.radius, 0.0) * interior_lattice_density(z.radius);
   }
@@ -339,7 +339,7 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
                                           result.thin.where.max.y(), result.thin.where.max.z()));
   }
   if (settings.sign == sdf::SignMethod::Winding) orient_normals_by_winding(exact, particles, particle_normals, z.radius);
-  ParticleBody& body = result.body;
+  body::ParticleBody& body = result.body;
   for (std::size_t i = 0; i < particles.size(); ++i) {
     body.positions.push_back(particles[i].cast<float>());
     body.normals.push_back(particle_normals[i].cast<float>());
@@ -356,8 +356,8 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   }
   body.particle_radius = z.radius;
   set_mass_properties(body, *mass);
-  if (settings.mass_method == MassMethod::WindingCells) {
-    body.mass_method = MassMethod::WindingCells;
+  if (settings.mass_method == body::MassMethod::WindingCells) {
+    body.mass_method = body::MassMethod::WindingCells;
     body.mass_cell = mass_cell;
   }
   body.sdf_voxel_size = spec.voxel_size;
