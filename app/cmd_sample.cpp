@@ -11,13 +11,13 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "body/body_file.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mesh_io.h"
 #include "core/mesh_report.h"
 #include "preview/body_preview.h"
-#include "sampler/particle_body.h"
 #include "sampler/sample_mesh.h"
 
 namespace ts::app {
@@ -45,7 +45,7 @@ struct BatchRow {
   std::string mesh, status = "ok", error, body_json;
   int exit_code = 0;
   std::size_t particles = 0;
-  sampler::ParticleBody::Quality quality;
+  body::ParticleBody::Quality quality;
   double radius = 0.0;
 };
 
@@ -243,7 +243,7 @@ int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& 
       log::warn("{}: not a closed solid ({}): sampled with winding-number signs; the particles cover the mesh's own "
                 "surface only (holes stay open), mass properties come from the winding-number solid",
                 o->mesh, closed_solid_problems(report));
-      settings.mass_method = sampler::MassMethod::WindingCells;
+      settings.mass_method = body::MassMethod::WindingCells;
     }
     settings.radius = o->radius;
     settings.count = o->count;
@@ -269,11 +269,11 @@ int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& 
     if (terminal) std::fprintf(stderr, "\n");
     for (const auto& warning : result.warnings) log::warn("{}", warning);
 
-    sampler::ParticleBody& body = result.body;
+    body::ParticleBody& body = result.body;
     body.source_path = o->mesh;
     body.source_sha256 = sha256_file(o->mesh);
     const std::string name = std::filesystem::path(o->mesh).stem().string();
-    const std::filesystem::path json = sampler::write_body(o->output, name, body);
+    const std::filesystem::path json = body::write_body(o->output, name, body);
     const auto& q = body.quality;
     row.status = "ok", row.body_json = json.string(), row.particles = body.positions.size();
     row.quality = q, row.radius = body.particle_radius;
@@ -299,7 +299,7 @@ int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& 
                  q.injection_rounds, q.converged ? "converged" : "NOT converged", q.seconds, context.summary());
       fmt::print("  mass properties  {:.6g} kg, volume {:.6g} m^3, centre of mass ({:.6g}, {:.6g}, {:.6g}) m, {}\n", body.mass,
                  body.volume, body.center_of_mass.x(), body.center_of_mass.y(), body.center_of_mass.z(),
-                 body.mass_method == sampler::MassMethod::WindingCells
+                 body.mass_method == body::MassMethod::WindingCells
                      ? fmt::format("from the winding-number solid (cells of {:.3g} m)", body.mass_cell)
                      : std::string("from the closed mesh"));
     }

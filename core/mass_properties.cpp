@@ -83,6 +83,13 @@ double signed_volume(const TriangleMesh& mesh) {
   return volume_integrals(mesh, reference_point(mesh))[0];
 }
 
+PrincipalFrame principal_frame(const Eigen::Matrix3d& inertia) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(inertia);
+  PrincipalFrame frame{eigen.eigenvalues(), eigen.eigenvectors()};
+  if (frame.axes.determinant() < 0.0) frame.axes.col(2) *= -1.0;
+  return frame;
+}
+
 MassProperties compute_mass_properties(const TriangleMesh& mesh, double density) {
   if (!(density > 0.0) || !std::isfinite(density)) {
     throw InputError(fmt::format("density must be positive (got {} kg/m^3)", density));
@@ -117,10 +124,9 @@ MassProperties compute_mass_properties(const TriangleMesh& mesh, double density)
   i(0, 2) = i(2, 0) = -(integral[9] - volume * c.z() * c.x());
   out.inertia = density * i;
   out.center_of_mass = origin + c;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(out.inertia);
-  out.principal_moments = eigen.eigenvalues();
-  out.principal_axes = eigen.eigenvectors();
-  if (out.principal_axes.determinant() < 0.0) out.principal_axes.col(2) *= -1.0;
+  const PrincipalFrame principal = principal_frame(out.inertia);
+  out.principal_moments = principal.moments;
+  out.principal_axes = principal.axes;
   return out;
 }
 

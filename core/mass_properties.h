@@ -17,6 +17,15 @@ struct MassProperties {
   Eigen::Matrix3d principal_axes = Eigen::Matrix3d::Identity();  // columns: unit axes, right-handed
 };
 
+struct PrincipalFrame {
+  Eigen::Vector3d moments = Eigen::Vector3d::Zero();   // kg m^2, ascending
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  // columns: unit axes, moment k about column k, right-handed
+};
+
+// Eigen-decomposition of a symmetric inertia tensor [kg m^2]; the third axis is flipped where the
+// eigenvectors came out left-handed, so the axes are a rotation of the mesh axes.
+PrincipalFrame principal_frame(const Eigen::Matrix3d& inertia);
+
 // Volume integrals only (signed: negative for an inside-out mesh), no validation.
 double signed_volume(const TriangleMesh& mesh);
 

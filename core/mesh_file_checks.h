@@ -3,8 +3,8 @@
 // hurts: an OFF or PLY header that declares billions of elements makes them reserve memory for all
 // of them (the machine swaps or the process is killed), and face indices out of range are silently
 // clamped or replaced, so a broken file loads as a plausible but wrong mesh. These checks stream
-// through the file, never trusting a declared count for an allocation, and throw ts::InputError
-// naming the file, the line (text files) and the problem.
+// through the file (a PLY through the one PLY parser, core/ply.h), never trusting a declared count
+// for an allocation, and throw ts::InputError naming the file, the line (text files) and the problem.
 #include <filesystem>
 #include <string_view>
 

@@ -4,7 +4,7 @@
 
 namespace ts::preview {
 
-void write_body_preview(gpu::Context& context, const TriangleMesh& mesh, const sampler::ParticleBody& body,
+void write_body_preview(gpu::Context& context, const TriangleMesh& mesh, const body::ParticleBody& body,
                         const std::filesystem::path& png, const std::vector<std::filesystem::path>& inputs,
                         const BodyPreviewSettings& settings) {
   Renderer renderer(context);

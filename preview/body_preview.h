@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <vector>
 
+#include "body/particle_body.h"
 #include "core/mesh.h"
 #include "gpu/context.h"
-#include "sampler/particle_body.h"
 
 namespace ts::preview {
 
@@ -17,7 +17,7 @@ struct BodyPreviewSettings {
 
 // Scan-converts `mesh` and renders it with `body`'s particles; writes `png` atomically, never over
 // one of `inputs`.
-void write_body_preview(gpu::Context& context, const TriangleMesh& mesh, const sampler::ParticleBody& body,
+void write_body_preview(gpu::Context& context, const TriangleMesh& mesh, const body::ParticleBody& body,
                         const std::filesystem::path& png, const std::vector<std::filesystem::path>& inputs = {},
                         const BodyPreviewSettings& settings = {});
 

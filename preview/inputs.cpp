@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "body/body_file.h"
+#include "body/particles_ply.h"
 #include "core/error.h"
-#include "sampler/particle_body.h"
 #include "sampler/point_grid.h"
 
 namespace ts::preview {
@@ -45,19 +46,19 @@ LoadedParticles load_particles(const std::filesystem::path& file, double radius)
   LoadedParticles out;
   const std::string name = file.filename().string();
   if (ends_with(name, ".json")) {
-    const sampler::ParticleBody body = sampler::read_body(file);
+    const body::ParticleBody body = body::read_body(file);
     out.particles.centers = to_double(body.positions);
     out.particles.radii = {static_cast<float>(radius > 0.0 ? radius : body.particle_radius)};
     out.radius_source = radius > 0.0 ? "--particle-radius" : "body.json";
     return out;
   }
-  out.particles.centers = to_double(sampler::read_particles_ply(file).positions);
+  out.particles.centers = to_double(body::read_particles_ply(file).positions);
   if (out.particles.centers.empty()) throw InputError(file, "holds no particles");
   if (radius > 0.0) {
     out.radius_source = "--particle-radius";
   } else if (ends_with(name, ".particles.ply") &&
              std::filesystem::exists(file.parent_path() / (name.substr(0, name.size() - 14) + ".body.json"))) {
-    radius = sampler::read_body(file.parent_path() / (name.substr(0, name.size() - 14) + ".body.json")).particle_radius;
+    radius = body::read_body(file.parent_path() / (name.substr(0, name.size() - 14) + ".body.json")).particle_radius;
     out.radius_source = "body.json";
   } else {
     radius = estimate_radius(out.particles.centers);

@@ -12,8 +12,8 @@ struct LoadedParticles {
   std::string radius_source;  // "body.json", "--particle-radius", "estimated from spacing"
 };
 
-// NAME.body.json (particles and radius), or a PLY of particle centres (sampler/particle_body.h
-// readers). A PLY's radius is `radius` when positive, else that of the NAME.body.json beside a
+// NAME.body.json (particles and radius), or a PLY of particle centres (the readers of body/). A
+// PLY's radius is `radius` when positive, else that of the NAME.body.json beside a
 // NAME.particles.ply, else half the median nearest-neighbour distance. ts::InputError naming the file.
 LoadedParticles load_particles(const std::filesystem::path& file, double radius = 0.0);
 

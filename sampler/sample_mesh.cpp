@@ -223,7 +223,7 @@ struct SamplingPlan {
   double area = 0.0;  // m^2
   Sizing z;
   MassProperties mass;
-  double mass_cell = 0.0;  // m, finest octree cell of MassMethod::WindingCells (else 0)
+  double mass_cell = 0.0;  // m, finest octree cell of body::MassMethod::WindingCells (else 0)
 };
 
 // Validates the mesh and sizes the body. A closed mesh's mass properties come first, so a
@@ -232,7 +232,7 @@ SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& e
                            SampleResult& result) {
   SamplingPlan plan;
   plan.area = surface_area(mesh);
-  const bool closed = settings.mass_method == MassMethod::ClosedMesh;
+  const bool closed = settings.mass_method == body::MassMethod::ClosedMesh;
   if (closed) plan.mass = compute_mass_properties(mesh, settings.density);
   plan.z = size_particles(plan.area, settings);
   check_sizes(plan.z, settings, plan.area);
@@ -390,7 +390,7 @@ void warn_about_quality(const Arrangement& a, const SamplingPlan& plan, const Sa
 
 // The particles (surface, then the interior fill), their radius and the solid's mass properties.
 void fill_body(const Arrangement& a, const sdf::ExactDistance& exact, const TriangleMesh& mesh,
-               const SamplingPlan& plan, const SampleSettings& settings, ParticleBody& body) {
+               const SamplingPlan& plan, const SampleSettings& settings, body::ParticleBody& body) {
   for (std::size_t i = 0; i < a.particles.size(); ++i) {
     body.positions.push_back(a.particles[i].cast<float>());
     body.normals.push_back(a.normals[i].cast<float>());
@@ -406,19 +406,19 @@ void fill_body(const Arrangement& a, const sdf::ExactDistance& exact, const Tria
   }
   body.particle_radius = plan.z.radius;
   set_mass_properties(body, plan.mass);
-  if (settings.mass_method == MassMethod::WindingCells) {
-    body.mass_method = MassMethod::WindingCells;
+  if (settings.mass_method == body::MassMethod::WindingCells) {
+    body.mass_method = body::MassMethod::WindingCells;
     body.mass_cell = plan.mass_cell;
   }
 }
 
 // Quality figures of the surface particles alone (docs/body-format.md).
-ParticleBody::Quality measure_quality(const Arrangement& a, const TriangleMesh& mesh, const SamplingPlan& plan,
+body::ParticleBody::Quality measure_quality(const Arrangement& a, const TriangleMesh& mesh, const SamplingPlan& plan,
                                       const SampleSettings& settings) {
   const std::span<const Eigen::Vector3d> particles(a.particles);
   const SpacingStatistics spacing = spacing_statistics(plan.area, particles);
   const double r = plan.z.radius;
-  ParticleBody::Quality q;
+  body::ParticleBody::Quality q;
   q.relative_radius = spacing.relative_radius;
   q.cv = spacing.cv_nn;
   q.covering_radius = a.coverage.covering_radius;
@@ -437,16 +437,20 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
                          const std::function<void(const SampleProgress&)>& progress) {
   const auto start = std::chrono::steady_clock::now();
   SampleResult result;
+  // Validate and size (every check before the GPU work).
   if (!(surface_area(mesh) > 0.0)) throw InputError("the mesh has no surface area");
   const sdf::ExactDistance exact(mesh);
-  const SamplingPlan plan = plan_sampling(mesh, exact, settings, result);                   // validate, size
+  const SamplingPlan plan = plan_sampling(mesh, exact, settings, result);
+  // The field, and seeds spread over the surface.
   const sdf::GridSpec spec = choose_grid(mesh, plan.z.radius, settings, result.warnings);
-  sdf::ScanConvertResult field = scan_field(context, mesh, spec, settings);                 // field
+  sdf::ScanConvertResult field = scan_field(context, mesh, spec, settings);
   std::mt19937_64 rng(settings.seed);
   std::vector<Eigen::Vector3d> seeds = sample_surface_points(mesh, plan.z.count, rng).positions;
+  // Relax and close holes.
   GpuRelaxer relaxer(context, std::move(field.texture), settings.timings);
-  Arrangement a = HoleClosing(relaxer, mesh, exact, spec, plan, settings, progress).run(std::move(seeds));  // relax, close holes
-  ParticleBody& body = result.body;                                                            // measure, write
+  Arrangement a = HoleClosing(relaxer, mesh, exact, spec, plan, settings, progress).run(std::move(seeds));
+  // Measure and make the body.
+  body::ParticleBody& body = result.body;
   body.quality = measure_quality(a, mesh, plan, settings);
   result.thin = find_thin_features(mesh, exact, plan.z.spacing);
   warn_about_quality(a, plan, settings, result);

@@ -16,7 +16,7 @@
 #include "core/mesh.h"
 #include "gpu/context.h"
 #include "sampler/gpu_relaxer.h"
-#include "sampler/particle_body.h"
+#include "body/particle_body.h"
 #include "sdf/settings.h"
 
 namespace ts::sampler {
@@ -39,7 +39,7 @@ struct SampleSettings {
   sdf::SignMethod sign = sdf::SignMethod::Pseudonormal;
   // Mass, centre of mass and inertia: of the closed mesh (divergence theorem), or integrated over the
   // winding-number solid (octree, sampler/winding_solid.h) when the mesh encloses no volume by itself.
-  MassMethod mass_method = MassMethod::ClosedMesh;
+  body::MassMethod mass_method = body::MassMethod::ClosedMesh;
   double mass_cell = 0.0;              // finest octree cell of MassMethod::WindingCells [m]; 0: longest side / 128
   // Also interior particles on a lattice (sampler/interior_fill.h: FCC, spacing 2 r, centres at
   // phi <= -r), appended after the surface ones with zero normals. Default: surface only.
@@ -61,7 +61,7 @@ struct ThinFeatures {
 };
 
 struct SampleResult {
-  ParticleBody body;
+  body::ParticleBody body;
   ThinFeatures thin;
   std::size_t estimated_count = 0;  // surface particles, from the area and the coverage target
   double estimated_interior = 0.0;  // with `fill`: lattice points in V(phi <= -r) ~ V - A r, / (4 sqrt(2) r^3)

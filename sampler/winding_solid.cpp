@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -97,10 +96,9 @@ MassProperties from_moments(const Moments& m, const Eigen::Vector3d& reference, 
   out.inertia = density * (second.trace() * Eigen::Matrix3d::Identity() - second);
   out.inertia = 0.5 * (out.inertia + out.inertia.transpose());
   out.center_of_mass = reference + c;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(out.inertia);
-  out.principal_moments = eigen.eigenvalues();
-  out.principal_axes = eigen.eigenvectors();
-  if (out.principal_axes.determinant() < 0.0) out.principal_axes.col(2) *= -1.0;
+  const PrincipalFrame principal = principal_frame(out.inertia);
+  out.principal_moments = principal.moments;
+  out.principal_axes = principal.axes;
   return out;
 }
 

@@ -120,16 +120,5 @@ Scene load_scene(const std::filesystem::path& file);
 // The same from text (`file` is only used in messages and to resolve relative paths).
 Scene parse_scene(std::string_view text, const std::filesystem::path& file);
 
-// A particle rigid body as the sampler writes it (NAME.body.json + NAME.particles.ply): particles in
-// mesh coordinates, mass properties about the centre of mass in mesh axes.
-struct ParticleBody {
-  std::vector<Eigen::Vector3d> particles;  // m, mesh coordinates
-  double particle_radius = 0;              // m
-  double mass = 0;                         // kg
-  Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();  // m, mesh coordinates
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();         // kg m^2, about the centre of mass
-};
-// Reads body.json and the PLY it names (binary little-endian, float x y z [nx ny nz ...]).
-ParticleBody load_particle_body(const std::filesystem::path& body_json);
 
 }  // namespace ts::sim

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "body/body_file.h"
 #include "core/error.h"
 #include "sim/scene_world.h"
 
@@ -128,10 +129,13 @@ void add_boundary(World& world, const Boundary& b) {
 }
 
 void add_prop(World& world, const Prop& p) {
-  const ParticleBody body = load_particle_body(p.body_file);
+  // A prop needs only the physical keys: hand-written bodies give no provenance or sampling quality.
+  const body::ParticleBody body = body::read_body(p.body_file, body::BodyKeys::Physical);
   std::vector<Eigen::Vector3d> offsets;
-  offsets.reserve(body.particles.size());
-  for (const Eigen::Vector3d& x : body.particles) offsets.push_back(x - body.center_of_mass);
+  offsets.reserve(body.positions.size());
+  for (const Eigen::Vector3f& x : body.positions) {
+    offsets.push_back(Eigen::Vector3d(x.x(), x.y(), x.z()) - body.center_of_mass);
+  }
   BodyDesc desc;
   desc.position = p.position + p.orientation * body.center_of_mass;
   desc.orientation = p.orientation;

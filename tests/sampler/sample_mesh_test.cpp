@@ -45,7 +45,7 @@ TriangleMesh load_case(const std::string& name) {
 }
 
 void expect_meets_quality_targets(const TriangleMesh& mesh, const SampleResult& result, double density) {
-  const ParticleBody& body = result.body;
+  const body::ParticleBody& body = result.body;
   const double r = body.particle_radius;
   std::vector<Eigen::Vector3d> points;
   for (const auto& p : body.positions) points.push_back(p.cast<double>());
@@ -116,9 +116,9 @@ TEST(SampleMesh, OpenMeshWithWindingSignsStaysOnTheSurfaceWithTheClosedMassPrope
   settings.count = 300;
   settings.probes = 200'000;
   settings.sign = sdf::SignMethod::Winding;
-  settings.mass_method = MassMethod::WindingCells;
+  settings.mass_method = body::MassMethod::WindingCells;
   const SampleResult result = sample_mesh(shared_context(), open, settings);
-  const ParticleBody& body = result.body;
+  const body::ParticleBody& body = result.body;
   const double r = body.particle_radius;
   std::vector<Eigen::Vector3d> points;
   for (const auto& p : body.positions) points.push_back(p.cast<double>());
@@ -133,7 +133,7 @@ TEST(SampleMesh, OpenMeshWithWindingSignsStaysOnTheSurfaceWithTheClosedMassPrope
   }
   EXPECT_GE(static_cast<double>(outward), 0.99 * static_cast<double>(points.size()));
 
-  EXPECT_EQ(body.mass_method, MassMethod::WindingCells);
+  EXPECT_EQ(body.mass_method, body::MassMethod::WindingCells);
   EXPECT_GT(body.mass_cell, 0.0);
   const MassProperties m = compute_mass_properties(closed, settings.density);
   EXPECT_NEAR(body.volume, m.volume, 0.015 * m.volume);
@@ -146,7 +146,7 @@ TEST(SampleMesh, OpenMeshWithWindingSignsStaysOnTheSurfaceWithTheClosedMassPrope
 // phi <= -r. Checked independently: none outside or closer than r to the surface, none closer than
 // r to a surface particle, none closer than 2 r to each other, zero normals, and the count.
 void expect_a_valid_fill(const TriangleMesh& mesh, const SampleResult& result) {
-  const ParticleBody& body = result.body;
+  const body::ParticleBody& body = result.body;
   const double r = body.particle_radius;
   const std::size_t surface = body.positions.size() - body.interior_count;
   ASSERT_GT(body.interior_count, 0u);
@@ -229,7 +229,7 @@ TEST(SampleMesh, IsDeterministicForAFixedSeed) {
 
 TEST(SampleMesh, TinyAndHugeCopiesOfAMeshGiveTheSameQualityFigures) {
   const TriangleMesh unit = load_mesh(test::asset("torus.obj"));
-  std::vector<ParticleBody::Quality> figures;
+  std::vector<body::ParticleBody::Quality> figures;
   for (const double factor : {1e-4 / 0.1, 1e4 / 0.1}) {  // the torus is about 0.1 m across
     TriangleMesh mesh = unit;
     scale_mesh(mesh, factor);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "body/body_file.h"
 #include "core/error.h"
 #include "sim/cpu_reference.h"
 #include "sim/gpu_stepper.h"
@@ -162,7 +163,7 @@ TEST(Keyframes, SceneKeyframesBecomeACentreOfMassTrack) {
   ASSERT_EQ(scene.props[0].keyframes.size(), 2u);
   const World w = make_world(scene);
   ASSERT_EQ(w.tracks.size(), 1u);
-  const ParticleBody body = load_particle_body(scene.props[0].body_file);
+  const body::ParticleBody body = body::read_body(scene.props[0].body_file, body::BodyKeys::Physical);
   const Keyframe& last = scene.props[0].keyframes[1];
   const KinematicState end = sample_track(w.tracks[0].keys, 0.5);
   EXPECT_LT((end.position - (last.position + last.orientation * body.center_of_mass)).norm(), 1e-12);

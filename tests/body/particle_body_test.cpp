@@ -1,4 +1,4 @@
-#include "sampler/particle_body.h"
+#include "body/particle_body.h"
 
 #include <gtest/gtest.h>
 
@@ -6,15 +6,17 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "body/body_file.h"
+#include "body/particles_ply.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/mass_properties.h"
 #include "sampler/surface_points.h"
-#include "sim/scene.h"
+#include "tests/input_error.h"
 #include "tests/test_meshes.h"
 #include "tests/test_support.h"
 
-namespace ts::sampler {
+namespace ts::body {
 namespace {
 
 namespace fs = std::filesystem;
@@ -23,17 +25,7 @@ void write_text(const fs::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 
-// The message of the InputError `f` throws ("" and a test failure when it throws none).
-template <typename F>
-std::string input_error(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError";
-  return "";
-}
+using test::input_error;
 
 std::vector<Eigen::Vector3f> random_vectors(std::size_t n, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
@@ -49,7 +41,7 @@ ParticleBody box_body() {
   ParticleBody body;
   set_mass_properties(body, compute_mass_properties(box, 1500.0));
   std::mt19937_64 rng(1);
-  const SurfacePoints points = sample_surface_points(box, 300, rng);
+  const sampler::SurfacePoints points = sampler::sample_surface_points(box, 300, rng);
   for (std::size_t i = 0; i < points.positions.size(); ++i) {
     body.positions.push_back(points.positions[i].cast<float>());
     body.normals.push_back(points.normals[i].cast<float>());
@@ -321,10 +313,10 @@ TEST(ParticleBody, InvalidBodiesAreNotWritten) {
 
 TEST(ParticleBody, SimulatorLoadsWhatTheSamplerWrites) {
   const ParticleBody body = box_body();
-  const sim::ParticleBody loaded = sim::load_particle_body(write_body(test::temp_dir(), "box", body));
-  ASSERT_EQ(loaded.particles.size(), body.positions.size());
+  const ParticleBody loaded = read_body(write_body(test::temp_dir(), "box", body), BodyKeys::Physical);
+  ASSERT_EQ(loaded.positions.size(), body.positions.size());
   for (std::size_t i = 0; i < body.positions.size(); ++i) {
-    EXPECT_EQ(loaded.particles[i], body.positions[i].cast<double>());
+    EXPECT_EQ(loaded.positions[i].cast<double>(), body.positions[i].cast<double>());
   }
   EXPECT_EQ(loaded.particle_radius, body.particle_radius);
   EXPECT_EQ(loaded.mass, body.mass);
@@ -333,4 +325,136 @@ TEST(ParticleBody, SimulatorLoadsWhatTheSamplerWrites) {
 }
 
 }  // namespace
-}  // namespace ts::sampler
+}  // namespace ts::body
+
+namespace ts::body {
+namespace {
+
+// A hand-written prop as the simulator's scenes use them: the physical keys only, 8 particles on the
+// corners of a unit cube (normals (0, 0, 1), or none), plus `extra` keys.
+fs::path write_physical_body(const fs::path& dir, const std::string& extra = "", bool normals = true) {
+  std::vector<Eigen::Vector3f> corners;
+  for (int i = 0; i < 8; ++i) corners.emplace_back(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1));
+  write_particles_ply(dir / "cube.particles.ply", corners,
+                      normals ? std::vector<Eigen::Vector3f>(8, Eigen::Vector3f::UnitZ()) : std::vector<Eigen::Vector3f>{});
+  write_text(dir / "cube.body.json", R"({"particle_radius": 0.1, "particle_count": 8,
+    "particles": "cube.particles.ply", "mass": 2.0, "center_of_mass": [0.5, 0.5, 0.5],
+    "inertia": [[0.5, 0, 0], [0, 0.5, 0], [0, 0, 0.5]])" + extra + "}");
+  return dir / "cube.body.json";
+}
+
+std::string physical_error(const std::string& extra) {
+  const fs::path json = write_physical_body(test::temp_dir(), extra);
+  return input_error([&] { read_body(json, BodyKeys::Physical); });
+}
+
+TEST(Body, PhysicalKeysAreEnoughForTheSimulator) {
+  const fs::path json = write_physical_body(test::temp_dir());
+  const ParticleBody body = read_body(json, BodyKeys::Physical);
+  ASSERT_EQ(body.positions.size(), 8u);
+  EXPECT_EQ(body.positions[7], Eigen::Vector3f(1, 1, 1));
+  EXPECT_EQ(body.normals.size(), 8u);
+  EXPECT_EQ(body.particle_radius, 0.1);
+  EXPECT_EQ(body.mass, 2.0);
+  EXPECT_EQ(body.center_of_mass, Eigen::Vector3d(0.5, 0.5, 0.5));
+  EXPECT_EQ(body.inertia, 0.5 * Eigen::Matrix3d::Identity());
+  // What the file does not give keeps the defaults.
+  EXPECT_EQ(body.density, 0.0);
+  EXPECT_EQ(body.interior_count, 0u);
+  EXPECT_EQ(body.mass_method, MassMethod::ClosedMesh);
+  EXPECT_TRUE(body.source_path.empty());
+  // The sampler's bodies need every key: the first one missing is named.
+  EXPECT_EQ(input_error([&] { read_body(json); }), json.string() + ": format_version: missing");
+  // particle_count is optional; so are the normals.
+  EXPECT_EQ(read_body(write_physical_body(test::temp_dir(), "", false), BodyKeys::Physical).normals.size(), 0u);
+}
+
+TEST(Body, PhysicalKeysMustAllBeThere) {
+  for (const char* key : {"particle_radius", "mass", "center_of_mass", "inertia", "particles"}) {
+    const fs::path json = write_physical_body(test::temp_dir());
+    auto j = nlohmann::ordered_json::parse(read_file(json));
+    j.erase(key);
+    write_text(json, j.dump());
+    EXPECT_EQ(input_error([&] { read_body(json, BodyKeys::Physical); }), json.string() + ": " + key + ": missing");
+  }
+}
+
+TEST(Body, PhysicalKeysStillCheckEveryOtherKeyThatIsGiven) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"(, "density": -1)", "density: must be > 0, not -1"},
+      {R"(, "density": 1000, "volume": 0.001)", "mass: 2 kg differs from density * volume = 1 kg"},
+      {R"(, "units": {"length": "mm", "mass": "kg", "time": "s"})", "units.length: must be \"m\""},
+      {R"(, "quality": {"cv": 0.1})", "quality.relative_radius: missing"},
+      {R"(, "source": {"path": "cube.obj", "sha256": "abc"})", "source.sha256: must be 64 lowercase hex digits"},
+      {R"(, "principal_axes": [[2, 0, 0], [0, 1, 0], [0, 0, 1]])", "principal_axes: must be three orthonormal"},
+      {R"(, "principal_axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "principal_moments": [0.5, 0.5, 0.7])",
+       "principal_axes: axis 2 is not an eigenvector"},
+      {R"(, "mass_properties_cell": 0.01)", "mass_properties_cell: must be null for closed_mesh"},
+      {R"(, "mass_properties_method": "winding_cells")", "mass_properties_cell: missing"},
+      {R"(, "interior_particle_count": 2)", "interior_particle_count: 2 interior particles, but particle 6 has a non-zero normal"},
+      {R"(, "format_version": 3)", "format_version: 3 is not supported"},
+      {R"(, "sdf_voxel_size": "small")", "sdf_voxel_size: must be a number"},
+  };
+  for (const auto& [extra, expected] : cases) {
+    const std::string error = physical_error(extra);
+    EXPECT_NE(error.find("cube.body.json: " + expected), std::string::npos) << extra << "\n" << error;
+  }
+  // Given in full and consistent, they are read.
+  const ParticleBody body = read_body(write_physical_body(test::temp_dir(), R"(, "density": 2000, "volume": 0.001,
+      "principal_moments": [0.5, 0.5, 0.5], "principal_axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+      "mass_properties_method": "closed_mesh", "mass_properties_cell": null, "sdf_voxel_size": 0.05)"),
+                                      BodyKeys::Physical);
+  EXPECT_EQ(body.density, 2000.0);
+  EXPECT_EQ(body.sdf_voxel_size, 0.05);
+}
+
+TEST(Body, UnknownKeysAreErrorsWithPhysicalKeysToo) {
+  // A misspelt key never passes silently, whatever the mode.
+  EXPECT_NE(physical_error(R"(, "centre_of_mass": [0, 0, 0])").find("cube.body.json: centre_of_mass: unknown key"),
+            std::string::npos);
+  // Version 1 has no mass_properties_method.
+  EXPECT_NE(physical_error(R"(, "format_version": 1, "mass_properties_method": "closed_mesh")")
+                .find("cube.body.json: mass_properties_method: unknown key"),
+            std::string::npos);
+}
+
+TEST(Body, SimulatorChecksHoldWithPhysicalKeys) {
+  const fs::path dir = test::temp_dir();
+  const fs::path json = write_physical_body(dir);
+  const auto original = nlohmann::ordered_json::parse(read_file(json));
+  auto error_after = [&](const std::function<void(nlohmann::ordered_json&)>& edit) {
+    auto j = original;
+    edit(j);
+    write_text(json, j.dump());
+    return input_error([&] { read_body(json, BodyKeys::Physical); });
+  };
+  const std::string prefix = json.string() + ": ";
+  EXPECT_EQ(error_after([](auto& j) { j["inertia"][0][1] = 0.2; }), prefix + "inertia: must be symmetric");
+  EXPECT_EQ(error_after([](auto& j) { j["inertia"][2][2] = -0.5; }), prefix + "inertia: must be positive definite (kg m^2)");
+  EXPECT_EQ(error_after([](auto& j) { j["particle_count"] = 9; }), prefix + "particle_count: 9 but cube.particles.ply holds 8 particles");
+  EXPECT_EQ(error_after([](auto& j) { j["mass"] = 0; }), prefix + "mass: must be > 0, not 0");
+  EXPECT_EQ(error_after([&](auto& j) { j["particles"] = (dir / "cube.particles.ply").string(); }),
+            prefix + "particles: must be a PLY file name relative to the body file");
+  write_particles_ply(dir / "empty.particles.ply", {}, {});
+  EXPECT_EQ(error_after([](auto& j) {
+              j["particles"] = "empty.particles.ply";
+              j.erase("particle_count");
+            }),
+            prefix + "particles: the body has no particles");
+}
+
+TEST(Body, BundledBodiesReadAlikeWithEitherKeys) {
+  for (const char* name : {"bodies/cube.body.json", "bodies/plate.body.json"}) {
+    const ParticleBody all = read_body(test::asset(name));
+    const ParticleBody physical = read_body(test::asset(name), BodyKeys::Physical);
+    EXPECT_EQ(physical.positions, all.positions) << name;
+    EXPECT_EQ(physical.normals, all.normals) << name;
+    EXPECT_EQ(physical.mass, all.mass) << name;
+    EXPECT_EQ(physical.inertia, all.inertia) << name;
+    EXPECT_EQ(physical.principal_axes, all.principal_axes) << name;
+    EXPECT_EQ(physical.quality.cv, all.quality.cv) << name;
+  }
+}
+
+}  // namespace
+}  // namespace ts::body

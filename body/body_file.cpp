@@ -1,0 +1,345 @@
+#include "body/body_file.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <vector>
+
+#include "body/json_fields.h"
+#include "body/particles_ply.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace ts::body {
+namespace {
+
+namespace fs = std::filesystem;
+using detail::Fields;
+using detail::Json;
+
+// What the simulator needs of a body (BodyKeys::Physical).
+const std::vector<std::string> kPhysicalKeys = {"particle_radius", "mass", "center_of_mass", "inertia",
+                                                "particles"};
+
+// ---------------------------------------------------------------------------------------------
+// Checks shared by the writer and the reader
+
+bool is_sha256(const std::string& s) {
+  return s.size() == 64 && std::all_of(s.begin(), s.end(), [](char c) {
+           return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+         });
+}
+
+// Which of the mass-property keys beyond mass and inertia a file gave (a written body has all).
+struct GivenMassKeys {
+  bool density_and_volume = true;
+  bool principal_axes = true;
+  bool principal_moments = true;
+};
+
+// Mass properties must describe one solid: mass = density * volume, a symmetric positive definite
+// inertia, and principal axes that are an orthonormal eigenbasis of it with the given moments.
+void check_mass_properties(const Fields& f, const ParticleBody& b, const GivenMassKeys& given = {}) {
+  if (given.density_and_volume && std::abs(b.mass - b.density * b.volume) > 1e-9 * b.mass) {
+    f.fail("mass", fmt::format("{} kg differs from density * volume = {} kg", b.mass, b.density * b.volume));
+  }
+  const double scale = b.inertia.norm();
+  if ((b.inertia - b.inertia.transpose()).norm() > 1e-9 * scale) f.fail("inertia", "must be symmetric");
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(b.inertia);
+  if (!(eigen.eigenvalues().minCoeff() > 0.0)) f.fail("inertia", "must be positive definite (kg m^2)");
+  if (given.principal_axes &&
+      (b.principal_axes.transpose() * b.principal_axes - Eigen::Matrix3d::Identity()).norm() > 1e-6) {
+    f.fail("principal_axes", "must be three orthonormal unit vectors");
+  }
+  if (!given.principal_axes || !given.principal_moments) return;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d a = b.principal_axes.col(k);
+    if ((b.inertia * a - b.principal_moments[k] * a).norm() > 1e-6 * scale) {
+      f.fail("principal_axes",
+             fmt::format("axis {} is not an eigenvector of inertia with moment principal_moments[{}]", k, k));
+    }
+  }
+}
+
+// At least one particle, a normal for each or none, and (when `interior_normals`) interior
+// particles exactly where the normals are zero.
+void check_particles(const Fields& f, const ParticleBody& b, bool interior_normals = true) {
+  if (b.positions.empty()) f.fail("particles", "the body has no particles");
+  if (!b.normals.empty() && b.normals.size() != b.positions.size()) {
+    f.fail("particles", fmt::format("{} normals for {} particles", b.normals.size(), b.positions.size()));
+  }
+  if (b.interior_count > b.positions.size()) {
+    f.fail("interior_particle_count",
+           fmt::format("{} for {} particles", b.interior_count, b.positions.size()));
+  }
+  if (!interior_normals) return;
+  // Interior particles are the last ones and carry the zero normal, surface ones a non-zero one.
+  for (std::size_t i = 0; i < b.normals.size(); ++i) {
+    const bool interior = i >= b.positions.size() - b.interior_count;
+    if (interior != (b.normals[i] == Eigen::Vector3f::Zero())) {
+      f.fail("interior_particle_count", fmt::format("{} interior particles, but particle {} has {} normal",
+                                                    b.interior_count, i, interior ? "a non-zero" : "a zero"));
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writing
+
+Json vector_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Json quality_json(const ParticleBody::Quality& q) {
+  Json quality;
+  quality["relative_radius"] = q.relative_radius;
+  quality["cv"] = q.cv;
+  quality["covering_radius"] = q.covering_radius;
+  quality["covering_over_r"] = q.covering_over_r;
+  quality["covering_over_r_plus_grain"] =
+      q.covering_over_r_plus_grain ? Json(*q.covering_over_r_plus_grain) : Json();
+  quality["max_abs_phi_over_r"] = q.max_abs_phi_over_r;
+  quality["iterations"] = q.iterations;
+  quality["seconds"] = q.seconds;
+  quality["converged"] = q.converged;
+  quality["injection_rounds"] = q.injection_rounds;
+  return quality;
+}
+
+// The keys in the order docs/body-format.md lists them.
+Json body_json(const ParticleBody& body, const std::string& ply_name) {
+  Json j;
+  j["format_version"] = kBodyFormatVersion;
+  j["units"] = {{"length", "m"}, {"mass", "kg"}, {"time", "s"}};
+  j["source"] = {{"path", body.source_path}, {"sha256", body.source_sha256}};
+  j["particle_radius"] = body.particle_radius;
+  j["particle_count"] = body.positions.size();
+  j["interior_particle_count"] = body.interior_count;
+  j["particles"] = ply_name;
+  j["density"] = body.density;
+  j["mass"] = body.mass;
+  j["volume"] = body.volume;
+  j["center_of_mass"] = vector_json(body.center_of_mass);
+  j["inertia"] = Json::array();
+  for (int r = 0; r < 3; ++r) j["inertia"].push_back(vector_json(body.inertia.row(r).transpose()));
+  j["principal_moments"] = vector_json(body.principal_moments);
+  j["principal_axes"] = Json::array();
+  for (int k = 0; k < 3; ++k) j["principal_axes"].push_back(vector_json(body.principal_axes.col(k)));
+  j["mass_properties_method"] = mass_method_name(body.mass_method);
+  j["mass_properties_cell"] = body.mass_method == MassMethod::WindingCells ? Json(body.mass_cell) : Json();
+  j["sdf_voxel_size"] = body.sdf_voxel_size;
+  j["quality"] = quality_json(body.quality);
+  return j;
+}
+
+void validate_for_writing(const fs::path& json_path, const ParticleBody& b) {
+  const Json no_keys = Json::object();  // only Fields' error messages are needed here
+  const Fields f(json_path, no_keys, "", {});
+  auto positive = [&](const char* key, double v) {
+    if (!(v > 0.0) || !std::isfinite(v)) f.fail(key, fmt::format("must be finite and > 0, not {}", v));
+  };
+  positive("particle_radius", b.particle_radius);
+  positive("density", b.density);
+  positive("mass", b.mass);
+  positive("volume", b.volume);
+  positive("sdf_voxel_size", b.sdf_voxel_size);
+  if (b.mass_method == MassMethod::WindingCells) positive("mass_properties_cell", b.mass_cell);
+  if (!is_sha256(b.source_sha256)) f.fail("source.sha256", "must be 64 lowercase hex digits");
+  check_particles(f, b);
+  check_mass_properties(f, b);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading
+
+Json parse_json(const fs::path& json_path) {
+  try {
+    return Json::parse(read_file(json_path));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(json_path, fmt::format("not valid JSON: {}", e.what()));
+  }
+}
+
+// The version decides which keys belong, so it is checked first; without one (a hand-written
+// physical body) the keys are those of the current version.
+std::int64_t format_version(const fs::path& json_path, const Json& j) {
+  const std::int64_t version =
+      j.is_object() && j.contains("format_version") && j["format_version"].is_number_integer()
+          ? j["format_version"].get<std::int64_t>()
+          : kBodyFormatVersion;  // Fields reports what is wrong with it
+  if (version < 1 || version > kBodyFormatVersion) {
+    throw InputError(
+        json_path, fmt::format("format_version: {} is not supported (this tetrasand reads versions 1 to {})",
+                               version, kBodyFormatVersion));
+  }
+  return version;
+}
+
+std::vector<std::string> body_keys(std::int64_t version) {
+  std::vector<std::string> keys = {"format_version", "units",          "source",  "particle_radius",
+                                   "particle_count", "particles",      "density", "mass",
+                                   "volume",         "center_of_mass", "inertia", "principal_moments",
+                                   "principal_axes", "sdf_voxel_size", "quality"};
+  if (version >= 2) {
+    keys.insert(keys.begin() + 5, "interior_particle_count");
+    keys.insert(keys.end() - 2, {"mass_properties_method", "mass_properties_cell"});
+  }
+  return keys;
+}
+
+void read_units(const fs::path& file, const Json& node) {
+  const Fields f(file, node, "units.", {"length", "mass", "time"});
+  const std::pair<const char*, const char*> expected[] = {{"length", "m"}, {"mass", "kg"}, {"time", "s"}};
+  for (const auto& [key, unit] : expected) {
+    if (f.string(key) != unit)
+      f.fail(key, fmt::format("must be \"{}\" (bodies are stored in SI units)", unit));
+  }
+}
+
+void read_source(const fs::path& file, const Json& node, ParticleBody& b) {
+  const Fields source(file, node, "source.", {"path", "sha256"});
+  b.source_path = source.string("path");
+  b.source_sha256 = source.string("sha256");
+  if (!is_sha256(b.source_sha256)) source.fail("sha256", "must be 64 lowercase hex digits");
+}
+
+ParticleBody::Quality read_quality(const fs::path& file, const Json& node) {
+  const Fields f(file, node, "quality.",
+                 {"relative_radius", "cv", "covering_radius", "covering_over_r", "covering_over_r_plus_grain",
+                  "max_abs_phi_over_r", "iterations", "seconds", "converged", "injection_rounds"});
+  ParticleBody::Quality q;
+  q.relative_radius = f.non_negative("relative_radius");
+  q.cv = f.non_negative("cv");
+  q.covering_radius = f.non_negative("covering_radius");
+  q.covering_over_r = f.non_negative("covering_over_r");
+  if (!f.at("covering_over_r_plus_grain").is_null()) {
+    q.covering_over_r_plus_grain = f.non_negative("covering_over_r_plus_grain");
+  }
+  q.max_abs_phi_over_r = f.non_negative("max_abs_phi_over_r");
+  q.iterations = f.small_count("iterations");
+  q.seconds = f.non_negative("seconds");
+  q.converged = f.boolean("converged");
+  q.injection_rounds = f.small_count("injection_rounds");
+  return q;
+}
+
+// density to principal_axes; returns which of the keys that may be absent were given.
+GivenMassKeys read_mass_properties(const Fields& f, ParticleBody& b) {
+  GivenMassKeys given;
+  const bool density = f.has("density");
+  if (density) b.density = f.positive("density");
+  b.mass = f.positive("mass");
+  const bool volume = f.has("volume");
+  if (volume) b.volume = f.positive("volume");
+  given.density_and_volume = density && volume;
+  b.center_of_mass = f.vector("center_of_mass");
+  b.inertia = f.rows("inertia");
+  given.principal_moments = f.has("principal_moments");
+  if (given.principal_moments) b.principal_moments = f.vector("principal_moments");
+  given.principal_axes = f.has("principal_axes");
+  if (given.principal_axes)
+    b.principal_axes = f.rows("principal_axes").transpose();  // stored one axis per array
+  return given;
+}
+
+// Version 2: mass_properties_method and its cell (absent, in a physical body: closed_mesh).
+void read_mass_method(const Fields& f, ParticleBody& b) {
+  const std::string method = f.has("mass_properties_method") ? f.string("mass_properties_method")
+                                                             : mass_method_name(MassMethod::ClosedMesh);
+  if (method == mass_method_name(MassMethod::WindingCells)) {
+    b.mass_method = MassMethod::WindingCells;
+    b.mass_cell = f.positive("mass_properties_cell");
+  } else if (method != mass_method_name(MassMethod::ClosedMesh)) {
+    f.fail("mass_properties_method",
+           fmt::format("must be \"closed_mesh\" or \"winding_cells\", not \"{}\"", method));
+  } else if (f.has("mass_properties_cell") && !f.at("mass_properties_cell").is_null()) {
+    f.fail("mass_properties_cell", "must be null for closed_mesh");
+  }
+}
+
+// The PLY's name: relative to the body file, so a body folder can move.
+fs::path particles_file(const Fields& f) {
+  const fs::path ply = f.string("particles");
+  if (ply.empty() || ply.is_absolute())
+    f.fail("particles", "must be a PLY file name relative to the body file");
+  return ply;
+}
+
+// particle_count and interior_particle_count as the file gives them (both >= 0), or kNotGiven.
+struct Counts {
+  static constexpr std::int64_t kNotGiven = -1;
+  std::int64_t particles = kNotGiven;
+  std::int64_t interior = kNotGiven;
+};
+
+// Reads the PLY and checks it against the counts the file gives.
+void read_particles(const Fields& f, const fs::path& dir, const fs::path& ply, const Counts& counts,
+                    bool interior_normals, ParticleBody& b) {
+  ParticlesPly particles = read_particles_ply(dir / ply);
+  b.positions = std::move(particles.positions);
+  b.normals = std::move(particles.normals);
+  const bool given = counts.particles != Counts::kNotGiven;
+  if (given && counts.interior > counts.particles) {
+    f.fail("interior_particle_count",
+           fmt::format("{} is more than particle_count {}", counts.interior, counts.particles));
+  }
+  b.interior_count = static_cast<std::size_t>(std::max<std::int64_t>(counts.interior, 0));
+  if (given && static_cast<std::uint64_t>(counts.particles) != b.positions.size()) {
+    f.fail("particle_count",
+           fmt::format("{} but {} holds {} particles", counts.particles, ply.string(), b.positions.size()));
+  }
+  check_particles(f, b, interior_normals);
+}
+
+}  // namespace
+
+fs::path write_body(const fs::path& dir, const std::string& name, const ParticleBody& body) {
+  if (name.empty() || name.find_first_of("/\\") != std::string::npos || name == "." || name == "..") {
+    throw InputError(dir / name, "a body name must be a plain file name");
+  }
+  const std::string ply_name = name + ".particles.ply";
+  const fs::path json_path = dir / (name + ".body.json");
+  validate_for_writing(json_path, body);
+  // Replaced only as a whole: the JSON is written to its temporary file first, then the PLY is
+  // written and renamed into place, then the JSON. Any failure before that last rename (disk full, a
+  // directory in the way, an interrupted write) leaves the previous pair as it was and removes the
+  // temporary files; and a reader that finds the new JSON finds the PLY it names.
+  const std::string json_text = body_json(body, ply_name).dump(2) + "\n";
+  write_atomically(json_path, [&](const fs::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(json_text.data(), static_cast<std::streamsize>(json_text.size()));
+    out.close();
+    if (!out) throw InputError(json_path, "cannot write file (disk full or no permission?)");
+    write_particles_ply(dir / ply_name, body.positions, body.normals);
+  });
+  return json_path;
+}
+
+ParticleBody read_body(const fs::path& json_path, BodyKeys keys) {
+  const Json j = parse_json(json_path);
+  const std::int64_t version = format_version(json_path, j);
+  const std::vector<std::string> known = body_keys(version);
+  const Fields f(json_path, j, "", known, keys == BodyKeys::All ? known : kPhysicalKeys);
+  if (f.has("format_version")) f.count("format_version");
+  if (f.has("units")) read_units(json_path, f.at("units"));
+  ParticleBody b;
+  if (f.has("source")) read_source(json_path, f.at("source"), b);
+  b.particle_radius = f.positive("particle_radius");
+  Counts counts;
+  if (f.has("particle_count")) counts.particles = f.count("particle_count");
+  if (version < 2) counts.interior = 0;  // version 1 bodies have no interior particles
+  if (version >= 2 && f.has("interior_particle_count")) counts.interior = f.count("interior_particle_count");
+  const fs::path ply = particles_file(f);
+  const GivenMassKeys given = read_mass_properties(f, b);
+  if (f.has("sdf_voxel_size")) b.sdf_voxel_size = f.positive("sdf_voxel_size");
+  if (version >= 2) read_mass_method(f, b);
+  if (f.has("quality")) b.quality = read_quality(json_path, f.at("quality"));
+  check_mass_properties(f, b, given);
+  const bool interior_normals =
+      keys == BodyKeys::All || (version >= 2 && j.contains("interior_particle_count"));
+  read_particles(f, json_path.parent_path(), ply, counts, interior_normals, b);
+  return b;
+}
+
+}  // namespace ts::body
