@@ -85,8 +85,6 @@ TS_LAYOUT(SimSpringSlots64) {
 #endif
 
 // Buffer binding points, shared by host and kernels.
-#define TS_BINDING_SDF_TRIANGLES 0
-#define TS_BINDING_SDF_PRISMS 1
 
 // Simulator state, one vec4 (or uvec4) buffer per quantity (structure of arrays). The hashed grid
 // (gpu/hash_grid.h) uses bindings 0-5 while it builds and 2, 4, 5 when neighbour kernels read it.
