@@ -260,6 +260,8 @@ Context::~Context() {
   destroy(raw);
 }
 
+void Context::finish() const { glFinish(); }
+
 std::string Context::summary() const {
   return renderer_ + " / " + version_ + " (device " + std::to_string(device_index_) +
          (software_ ? ", software" : ", hardware") + ")";

@@ -57,6 +57,8 @@ class Context {
   const DeviceLimits& limits() const { return limits_; }
   // "llvmpipe (LLVM 15.0.6, 256 bits) / 4.5 (Core Profile) Mesa 22.3.6 (device 0, software)"
   std::string summary() const;
+  // Blocks until the GPU has finished all work issued on this context (benchmarks time with it).
+  void finish() const;
 
  private:
   void* display_ = nullptr;
