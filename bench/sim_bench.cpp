@@ -124,7 +124,8 @@ Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Optio
     row.contacts_per_grain = static_cast<double>(stats.contacts + stats.wall_contacts) / static_cast<double>(row.grains);
   }
   ts::sim::GpuStepper gpu(context, bed.world, bed.settings, options.precision);
-  row.gpu = measure([&](int n) { gpu.step(n); }, [] { glFinish(); }, options.seconds, options.min_steps, batch);
+  row.gpu = measure([&](int n) { gpu.step(n); }, [&] { context.finish(); }, options.seconds,
+                    options.min_steps, batch);
   row.gpu_bytes_per_grain = static_cast<double>(gpu.gpu_bytes()) / static_cast<double>(row.grains);
   return row;
 }

@@ -165,6 +165,11 @@ DeviceLimits read_limits() {
   glGetIntegerv(GL_MAX_GEOMETRY_OUTPUT_VERTICES, &l.max_geometry_output_vertices);
   glGetIntegerv(GL_MAX_GEOMETRY_TOTAL_OUTPUT_COMPONENTS, &l.max_geometry_total_output_components);
   for (GLuint i = 0; i < 3; ++i) glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, i, &l.max_compute_work_group_count[i]);
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &l.max_texture_size);
+  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, l.max_viewport_dims);
+  glGetIntegerv(GL_MAX_FRAMEBUFFER_WIDTH, &l.max_framebuffer_size[0]);
+  glGetIntegerv(GL_MAX_FRAMEBUFFER_HEIGHT, &l.max_framebuffer_size[1]);
+  glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &l.max_vertex_shader_storage_blocks);
   GLint64 ssbo = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &ssbo);
   l.max_ssbo_bytes = ssbo;
@@ -254,6 +259,8 @@ Context::~Context() {
   RawContext raw{display_, context_};
   destroy(raw);
 }
+
+void Context::finish() const { glFinish(); }
 
 std::string Context::summary() const {
   return renderer_ + " / " + version_ + " (device " + std::to_string(device_index_) +

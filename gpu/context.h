@@ -32,6 +32,10 @@ struct DeviceLimits {
   int max_geometry_output_vertices = 0;
   int max_geometry_total_output_components = 0;
   int max_compute_work_group_count[3] = {0, 0, 0};
+  int max_texture_size = 0;                  // texels per side of a 2D texture
+  int max_viewport_dims[2] = {0, 0};         // pixels
+  int max_framebuffer_size[2] = {0, 0};      // pixels, width and height
+  int max_vertex_shader_storage_blocks = 0;  // storage buffers one vertex shader may read
   long long max_ssbo_bytes = 0;
   long long dedicated_memory_kb = 0;  // 0 when the driver does not say (NVX_gpu_memory_info)
 };
@@ -53,6 +57,8 @@ class Context {
   const DeviceLimits& limits() const { return limits_; }
   // "llvmpipe (LLVM 15.0.6, 256 bits) / 4.5 (Core Profile) Mesa 22.3.6 (device 0, software)"
   std::string summary() const;
+  // Blocks until the GPU has finished all work issued on this context (benchmarks time with it).
+  void finish() const;
 
  private:
   void* display_ = nullptr;

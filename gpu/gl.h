@@ -122,6 +122,8 @@ class Queue {
   }
   void finish() const { glFinish(); }
   bool timings_enabled() const { return timings_; }
+  // Whether each kernel (and each draw of gpu/graphics.h) is followed by a GL error check.
+  bool checks_errors() const { return check_errors_; }
   // Resolves outstanding queries and returns totals per kernel, in first-use order.
   std::vector<KernelTiming> timings();
   // A table for --timings.

@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "gpu/gl.h"
+#include "gpu/graphics.h"
 #include "preview/colors.h"
 #include "shaders/preview/bindings.h"
 
@@ -20,48 +21,11 @@ namespace {
 
 constexpr std::size_t kMaxR32Bytes = std::size_t{256} << 20;  // larger volumes are stored as R16F
 
-// Owns one GL texture or framebuffer name.
-class GlName {
- public:
-  using Deleter = void (*)(GLsizei, const GLuint*);
-  explicit GlName(Deleter deleter) : deleter_(deleter) {}
-  ~GlName() { reset(); }
-  GlName(const GlName&) = delete;
-  GlName& operator=(const GlName&) = delete;
-  void reset(GLuint id = 0) {
-    if (id_) deleter_(1, &id_);
-    id_ = id;
-  }
-  GLuint get() const { return id_; }
-
- private:
-  Deleter deleter_;
-  GLuint id_ = 0;
-};
-
-void delete_textures(GLsizei n, const GLuint* ids) { glDeleteTextures(n, ids); }
-void delete_framebuffers(GLsizei n, const GLuint* ids) { glDeleteFramebuffers(n, ids); }
-
-GLuint make_texture_2d(GLenum format, int width, int height, GLenum filter, const char* what) {
-  GLuint id = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &id);
-  glTextureStorage2D(id, 1, format, width, height);
-  if (glGetError() == GL_OUT_OF_MEMORY) {
-    glDeleteTextures(1, &id);
-    throw GpuError(fmt::format("out of GPU memory for the preview's {} ({} x {})", what, width, height));
-  }
-  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, filter);
-  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, filter);
-  glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  return id;
-}
-
-void check_framebuffer(GLuint fbo, const char* what) {
-  const GLenum status = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER);
-  if (status != GL_FRAMEBUFFER_COMPLETE) {
-    throw GpuError(fmt::format("the preview's {} framebuffer is incomplete (status 0x{:x})", what, status));
-  }
+// A render target of the preview: one mip level, sampled with `filter`, clamped at the edges.
+gpu::Texture make_target(GLenum format, int width, int height, GLenum filter, const char* what) {
+  gpu::Texture texture = gpu::Texture::create_2d(format, width, height, what);
+  texture.set_sampling(filter);
+  return texture;
 }
 
 // The camera as every pass sees it: relative to the scene origin, in float.
@@ -128,6 +92,93 @@ Eigen::Vector3d any_perpendicular(const Eigen::Vector3d& v) {
   return v.cross(a).normalized();
 }
 
+// The lowest point of a box along the unit vector `up` [m].
+double lowest_along(const Aabb& box, const Eigen::Vector3d& up) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3d corner(i & 1 ? box.max.x() : box.min.x(), i & 2 ? box.max.y() : box.min.y(),
+                                 i & 4 ? box.max.z() : box.min.z());
+    lowest = std::min(lowest, up.dot(corner));
+  }
+  return lowest;
+}
+
+// What every pass of one frame reads: the scene's bounding sphere, the cameras, light and ground.
+struct Frame {
+  Aabb content;               // what is drawn [m, world]
+  Eigen::Vector3d origin;     // the sphere's centre; GPU positions are relative to it [m, world]
+  double radius = 0.0;        // everything drawn lies within it [m]
+  CameraState camera;         // the image's
+  Eigen::Vector3d up, light;  // unit, world; `light` points towards the key light
+  double ground_level = 0.0;  // the ground plane along `up`, relative to origin [m]
+  int shadow_size = 0;        // shadow-map texels per side; 0 without shadows
+  CameraState light_camera;   // with shadows: orthographic along the light, holding the sphere
+};
+
+// The key light's shadow map: an orthographic view along the light holding the bounding sphere.
+void plan_shadow(const RenderSettings& s, int max_texture, Frame& f) {
+  f.shadow_size =
+      std::min(s.shadow_map_size > 0 ? s.shadow_map_size : std::clamp(std::max(s.width, s.height), 512, 4096),
+               max_texture);
+  Camera lc;
+  lc.target = f.origin;
+  lc.eye = f.origin + f.light * (2.0 * f.radius);
+  lc.up = any_perpendicular(f.light);
+  lc.ortho = true;
+  lc.ortho_height = 2.02 * f.radius;
+  f.light_camera = camera_state(lc, f.shadow_size, f.shadow_size, f.origin, f.radius);
+}
+
+// ts::InputError for a bad camera, up vector or colour map, or nothing to draw.
+void check_settings(const RenderSettings& s, const Aabb& content) {
+  validate(s.camera);
+  if (!(s.up.norm() > 0.0) || !s.up.allFinite())
+    throw InputError("the up vector must be finite and non-zero");
+  if (!content.valid()) throw InputError("nothing to render: no SDF and no particles");
+  if (s.surface_scalar.value && !(s.surface_scalar.max_value > 0.0)) {
+    throw InputError("the colour map's top value must be positive");
+  }
+}
+
+// The SDF as a 3D texture with hardware trilinear filtering.
+gpu::Texture upload_volume(const SdfVolume& volume) {
+  const Eigen::Vector3i& d = volume.spec.dims;
+  const bool half = volume.spec.voxel_count() * sizeof(float) > kMaxR32Bytes;
+  gpu::Texture texture =
+      gpu::Texture::create_3d(half ? GL_R16F : GL_R32F, d.x(), d.y(), d.z(), "preview SDF");
+  // Upload in slabs of about 64 MiB so the driver's staging copy stays small.
+  const std::size_t slice = static_cast<std::size_t>(d.x()) * d.y();
+  const int slab = std::max(1, static_cast<int>((std::size_t{64} << 20) / (4 * slice)));
+  for (int z = 0; z < d.z(); z += slab) {
+    texture.upload(volume.distance.data() + slice * z, GL_RED, GL_FLOAT, z, std::min(slab, d.z() - z));
+  }
+  texture.set_sampling(GL_LINEAR);
+  return texture;
+}
+
+// The box of the surface: voxels at or inside the zero level, grown by half a voxel; `fallback`
+// when there are none.
+Aabb surface_box(const SdfVolume& volume, const Aabb& fallback) {
+  const Eigen::Vector3i& d = volume.spec.dims;
+  std::vector<Aabb> slices(static_cast<std::size_t>(d.z()));
+  tbb::parallel_for(0, d.z(), [&](int k) {
+    for (int j = 0; j < d.y(); ++j)
+      for (int i = 0; i < d.x(); ++i)
+        if (volume.distance[volume.spec.linear_index(i, j, k)] <= 0.0f)
+          slices[k].extend(volume.spec.voxel_center(i, j, k));
+  });
+  Aabb box;
+  for (const Aabb& s : slices) {
+    if (!s.valid()) continue;
+    box.extend(s.min);
+    box.extend(s.max);
+  }
+  if (!box.valid()) return fallback;
+  box.min.array() -= 0.5 * volume.spec.voxel_size;
+  box.max.array() += 0.5 * volume.spec.voxel_size;
+  return box;
+}
+
 }  // namespace
 
 Eigen::Vector3d default_light(const Camera& camera, const Eigen::Vector3d& up) {
@@ -148,34 +199,30 @@ struct Renderer::Impl {
   explicit Impl(gpu::Context& c, bool timings)
       : context(c),
         queue(timings, c.debug()),
-        particles_program(gpu::Program::graphics(library, "preview/particles.vert", "", "preview/particles.frag")),
+        particles_program(
+            gpu::Program::graphics(library, "preview/particles.vert", "", "preview/particles.frag")),
         raycast_program(gpu::Program::graphics(library, "preview/raycast.vert", "", "preview/raycast.frag")),
-        shade_program(gpu::Program::graphics(library, "preview/shade.vert", "", "preview/shade.frag")) {
-    glCreateVertexArrays(1, &vao);
-    GLint blocks = 0;
-    glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &blocks);
-    if (blocks < 2) throw GpuError("the preview needs shader storage buffers in vertex shaders, which this GPU lacks");
-    // Every sampler gets its own unit once: two samplers of different types left on unit 0 would
-    // make draws fail (GL_INVALID_OPERATION) whether or not the shader reads them.
-    raycast_program.set("volume", TS_PREVIEW_UNIT_VOLUME);
-    raycast_program.set("particle_depth", TS_PREVIEW_UNIT_PARTICLE_DEPTH);
-    shade_program.set("volume", TS_PREVIEW_UNIT_VOLUME);
-    shade_program.set("albedo_texture", TS_PREVIEW_UNIT_ALBEDO);
-    shade_program.set("normal_texture", TS_PREVIEW_UNIT_NORMAL);
-    shade_program.set("depth_texture", TS_PREVIEW_UNIT_DEPTH);
-    shade_program.set("shadow_map", TS_PREVIEW_UNIT_SHADOW);
-  }
-  ~Impl() {
-    if (vao) glDeleteVertexArrays(1, &vao);
+        shade_program(gpu::Program::graphics(library, "preview/shade.vert", "", "preview/shade.frag")),
+        vao(gpu::VertexArray::create()) {
+    if (c.limits().max_vertex_shader_storage_blocks < 2) {
+      throw GpuError("the preview needs shader storage buffers in vertex shaders, which this GPU lacks");
+    }
   }
 
+  Frame plan_frame(const RenderSettings& s, const Aabb& content, int max_texture) const;
   void ensure_targets(int w, int h);
   void ensure_shadow_map(int size);
   void upload_particles(const Eigen::Vector3d& new_origin);
   void bind_volume(const gpu::Program& p) const;
-  void draw_particles(const gpu::Program& p) const;
-  void draw_volume(const gpu::Program& p) const;
+  void draw_particles(const gpu::Program& p);
+  void draw_volume(const gpu::Program& p);
+  void shadow_pass(const Frame& f);
+  void particle_pass(const RenderSettings& s, const Frame& f);
+  void raycast_pass(const RenderSettings& s, const Frame& f);
   void colour_surface(const RenderSettings& s, const CameraState& camera, RenderResult& result);
+  void lighting_pass(const RenderSettings& s, const Frame& f);
+  void set_lighting_uniforms(const RenderSettings& s, const Frame& f) const;
+  void read_back(const RenderSettings& s, RenderResult& result) const;
   void check(const char* what) const {
     if (context.debug()) gpu::check_gl(what);
   }
@@ -184,10 +231,10 @@ struct Renderer::Impl {
   gpu::ShaderLibrary library;
   gpu::Queue queue;
   gpu::Program particles_program, raycast_program, shade_program;
-  GLuint vao = 0;
+  gpu::VertexArray vao;  // none of the passes reads vertex attributes, but GL draws need one bound
 
   // The SDF: texture, metadata, and the box of its surface.
-  GlName volume_texture{delete_textures};
+  gpu::Texture volume_texture;
   sdf::GridSpec volume_spec;
   double volume_band = 0.0;
   bool has_volume = false;
@@ -204,46 +251,58 @@ struct Renderer::Impl {
 
   // Targets.
   int width = 0, height = 0, shadow_size = 0;
-  GlName gbuffer{delete_framebuffers}, final_target{delete_framebuffers}, shadow_target{delete_framebuffers};
-  GlName albedo{delete_textures}, normal{delete_textures}, depth{delete_textures}, particle_depth{delete_textures},
-      final_color{delete_textures}, shadow_depth{delete_textures};
+  gpu::Texture albedo, normal, depth, particle_depth, final_color, shadow_depth;
+  gpu::Framebuffer gbuffer, final_target, shadow_target;
 };
+
+Frame Renderer::Impl::plan_frame(const RenderSettings& s, const Aabb& content, int max_texture) const {
+  Frame f;
+  f.content = content;
+  // Everything drawn lies in this sphere; positions go to the GPU relative to its centre.
+  Aabb all = content;
+  if (has_volume) {
+    all.extend(volume_box.min);
+    all.extend(volume_box.max);
+  }
+  f.origin = all.center();
+  f.radius = std::max(0.5 * all.size().norm(), 1e-12);
+  f.camera = camera_state(s.camera, s.width, s.height, f.origin, f.radius);
+  f.up = s.up.normalized();
+  f.light = s.light ? s.light->normalized() : default_light(s.camera, f.up);
+  if (!f.light.allFinite()) throw InputError("the light direction must be finite and non-zero");
+  f.ground_level = s.ground_level.value_or(lowest_along(content, f.up)) - f.up.dot(f.origin);
+  if (s.shadows) plan_shadow(s, max_texture, f);
+  return f;
+}
 
 void Renderer::Impl::ensure_targets(int w, int h) {
   if (w == width && h == height) return;
-  albedo.reset(make_texture_2d(GL_RGBA8, w, h, GL_NEAREST, "albedo buffer"));
-  normal.reset(make_texture_2d(GL_RGBA16F, w, h, GL_NEAREST, "normal buffer"));
-  depth.reset(make_texture_2d(GL_DEPTH_COMPONENT32F, w, h, GL_NEAREST, "depth buffer"));
-  particle_depth.reset(make_texture_2d(GL_DEPTH_COMPONENT32F, w, h, GL_NEAREST, "particle depth"));
-  final_color.reset(make_texture_2d(GL_RGBA8, w, h, GL_NEAREST, "image"));
-  GLuint fbo = 0;
-  glCreateFramebuffers(1, &fbo);
-  gbuffer.reset(fbo);
-  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, albedo.get(), 0);
-  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT1, normal.get(), 0);
-  glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, depth.get(), 0);
-  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glNamedFramebufferDrawBuffers(fbo, 2, buffers);
-  check_framebuffer(fbo, "G-buffer");
-  glCreateFramebuffers(1, &fbo);
-  final_target.reset(fbo);
-  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, final_color.get(), 0);
-  check_framebuffer(fbo, "image");
+  albedo = make_target(GL_RGBA8, w, h, GL_NEAREST, "preview albedo buffer");
+  normal = make_target(GL_RGBA16F, w, h, GL_NEAREST, "preview normal buffer");
+  depth = make_target(GL_DEPTH_COMPONENT32F, w, h, GL_NEAREST, "preview depth buffer");
+  particle_depth = make_target(GL_DEPTH_COMPONENT32F, w, h, GL_NEAREST, "preview particle depth");
+  final_color = make_target(GL_RGBA8, w, h, GL_NEAREST, "preview image");
+  gbuffer = gpu::Framebuffer("preview G-buffer");
+  gbuffer.attach_color(0, albedo);
+  gbuffer.attach_color(1, normal);
+  gbuffer.attach_depth(depth);
+  gbuffer.set_draw_buffers(2);
+  gbuffer.check_complete();
+  final_target = gpu::Framebuffer("preview image");
+  final_target.attach_color(0, final_color);
+  final_target.check_complete();
   width = w;
   height = h;
 }
 
 void Renderer::Impl::ensure_shadow_map(int size) {
   if (size == shadow_size) return;
-  shadow_depth.reset(make_texture_2d(GL_DEPTH_COMPONENT32F, size, size, GL_LINEAR, "shadow map"));
-  glTextureParameteri(shadow_depth.get(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-  glTextureParameteri(shadow_depth.get(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-  GLuint fbo = 0;
-  glCreateFramebuffers(1, &fbo);
-  shadow_target.reset(fbo);
-  glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, shadow_depth.get(), 0);
-  glNamedFramebufferDrawBuffer(fbo, GL_NONE);
-  check_framebuffer(fbo, "shadow map");
+  shadow_depth = make_target(GL_DEPTH_COMPONENT32F, size, size, GL_LINEAR, "preview shadow map");
+  shadow_depth.set_depth_compare(GL_LEQUAL);
+  shadow_target = gpu::Framebuffer("preview shadow map");
+  shadow_target.attach_depth(shadow_depth);
+  shadow_target.set_draw_buffers(0);
+  shadow_target.check_complete();
   shadow_size = size;
 }
 
@@ -266,7 +325,7 @@ void Renderer::Impl::upload_particles(const Eigen::Vector3d& new_origin) {
 }
 
 void Renderer::Impl::bind_volume(const gpu::Program& p) const {
-  glBindTextureUnit(TS_PREVIEW_UNIT_VOLUME, volume_texture.get());
+  volume_texture.bind_unit(TS_PREVIEW_UNIT_VOLUME);
   set_vec3(p, "volume_origin", Eigen::Vector3d(volume_spec.origin - origin));
   p.set("voxel_size", static_cast<float>(volume_spec.voxel_size));
   p.set("volume_dims", static_cast<float>(volume_spec.dims.x()), static_cast<float>(volume_spec.dims.y()),
@@ -274,38 +333,152 @@ void Renderer::Impl::bind_volume(const gpu::Program& p) const {
   p.set("band", static_cast<float>(volume_band));
 }
 
-void Renderer::Impl::draw_particles(const gpu::Program& p) const {
+void Renderer::Impl::draw_particles(const gpu::Program& p) {
   if (particle_count == 0) return;
-  p.use();
   spheres.bind(TS_PREVIEW_SPHERES);
   colors.bind(TS_PREVIEW_COLORS);
-  glDisable(GL_CULL_FACE);
-  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(6 * particle_count));
-  check("preview particles");
+  gpu::StateScope state;
+  state.no_cull();
+  gpu::draw_arrays(queue, p, GL_TRIANGLES, 0, 6 * particle_count);
 }
 
-void Renderer::Impl::draw_volume(const gpu::Program& p) const {
+void Renderer::Impl::draw_volume(const gpu::Program& p) {
   if (!has_volume) return;
-  p.use();
   bind_volume(p);
   const Eigen::Vector3i& d = volume_spec.dims;
   // Enough steps to cross the box at the band's stride, and many more for grazing rays.
   p.set("max_steps", static_cast<int>(4 * (d.x() + d.y() + d.z()) / std::max(1.0, volume_band)) + 512);
   p.set("min_step", 0.02f);
-  glEnable(GL_CULL_FACE);
-  glCullFace(GL_FRONT);
-  glDrawArrays(GL_TRIANGLES, 0, 36);
-  glDisable(GL_CULL_FACE);
-  check("preview ray cast");
+  // Front faces culled: one fragment per covered pixel, on the far face, also with the eye inside.
+  gpu::StateScope state;
+  state.cull(GL_FRONT);
+  gpu::draw_arrays(queue, p, GL_TRIANGLES, 0, 36);
+}
+
+// 1. The key light's shadow map: particles and the SDF, depth only.
+void Renderer::Impl::shadow_pass(const Frame& f) {
+  ensure_shadow_map(f.shadow_size);
+  queue.timed("preview/shadow map", [&] {
+    gpu::StateScope pass;
+    pass.framebuffer(shadow_target).viewport(f.shadow_size, f.shadow_size);
+    shadow_target.clear_depth(1.0f);
+    set_camera(particles_program, f.light_camera);
+    particles_program.set("per_particle_color", 0);
+    draw_particles(particles_program);
+    set_camera(raycast_program, f.light_camera);
+    raycast_program.set("use_particle_depth", 0);
+    raycast_program.set("depth_only", 1);
+    draw_volume(raycast_program);
+  });
+}
+
+// 2a. G-buffer: the particles, as sphere impostors with their true depth and normal.
+void Renderer::Impl::particle_pass(const RenderSettings& s, const Frame& f) {
+  queue.timed("preview/particles", [&] {
+    gpu::StateScope pass;
+    pass.framebuffer(gbuffer).viewport(s.width, s.height);
+    gbuffer.clear_color(0, {0.0f, 0.0f, 0.0f, 0.0f});
+    gbuffer.clear_color(1, {0.0f, 0.0f, 0.0f, 0.0f});
+    gbuffer.clear_depth(1.0f);
+    set_camera(particles_program, f.camera);
+    particles_program.set("per_particle_color", per_particle_color ? 1 : 0);
+    set_vec3(particles_program, "particle_color", s.particle_color);
+    draw_particles(particles_program);
+  });
+}
+
+// 2b. G-buffer: the SDF, each ray marched up to the particle already drawn at its pixel.
+void Renderer::Impl::raycast_pass(const RenderSettings& s, const Frame& f) {
+  queue.timed("preview/ray cast", [&] {
+    gpu::StateScope pass;
+    pass.framebuffer(gbuffer).viewport(s.width, s.height);
+    const bool limit = particle_count > 0;
+    // The ray cast reads the particle depth while the depth test writes the G-buffer's: a copy.
+    if (limit) depth.copy_to(particle_depth);
+    particle_depth.bind_unit(TS_PREVIEW_UNIT_PARTICLE_DEPTH);
+    raycast_program.set("use_particle_depth", limit ? 1 : 0);
+    raycast_program.set("depth_only", 0);
+    set_vec3(raycast_program, "surface_color", s.surface_color);
+    set_camera(raycast_program, f.camera);
+    draw_volume(raycast_program);
+  });
+}
+
+// 4. Lighting: one full-screen triangle over the G-buffer.
+void Renderer::Impl::lighting_pass(const RenderSettings& s, const Frame& f) {
+  queue.timed("preview/shade", [&] {
+    gpu::StateScope pass;
+    pass.no_depth_test().framebuffer(final_target).viewport(s.width, s.height);
+    albedo.bind_unit(TS_PREVIEW_UNIT_ALBEDO);
+    normal.bind_unit(TS_PREVIEW_UNIT_NORMAL);
+    depth.bind_unit(TS_PREVIEW_UNIT_DEPTH);
+    if (s.shadows) {
+      shadow_depth.bind_unit(TS_PREVIEW_UNIT_SHADOW);
+    } else {
+      gpu::Texture::unbind_unit(TS_PREVIEW_UNIT_SHADOW);
+    }
+    if (has_volume) bind_volume(shade_program);
+    set_lighting_uniforms(s, f);
+    gpu::draw_arrays(queue, shade_program, GL_TRIANGLES, 0, 3);
+  });
+}
+
+void Renderer::Impl::set_lighting_uniforms(const RenderSettings& s, const Frame& f) const {
+  const gpu::Program& p = shade_program;
+  set_camera(p, f.camera);
+  p.set("shadows", s.shadows ? 1 : 0);
+  if (s.shadows) {
+    set_matrix(p, "light_view_projection", f.light_camera.view_projection);
+    const double texel = 2.02 * f.radius / shadow_size;
+    p.set("shadow_texel", static_cast<float>(texel));
+    // Light depth is linear over the near-far range (about 2 radius): one texel of slack.
+    p.set("shadow_bias", static_cast<float>(texel / (2.0 * f.radius)));
+    p.set("shadow_texel_uv", 1.0f / shadow_size, 1.0f / shadow_size);
+  }
+  p.set("has_volume", has_volume ? 1 : 0);
+  set_vec3(p, "light_dir", f.light);
+  set_vec3(p, "world_up", f.up);
+  p.set("ground", s.ground ? 1 : 0);
+  p.set("ground_level", static_cast<float>(f.ground_level));
+  const Eigen::Vector3d center = f.content.center() - f.origin;
+  set_vec3(p, "ground_center", Eigen::Vector3d(center - (f.up.dot(center) - f.ground_level) * f.up));
+  p.set("ground_radius", static_cast<float>(2.5 * 0.5 * f.content.size().norm()));
+  set_vec3(p, "ground_color", Eigen::Vector3f(0.88f, 0.88f, 0.87f));
+  set_vec3(p, "background_top", Eigen::Vector3f(0.97f, 0.97f, 0.98f));
+  set_vec3(p, "background_bottom", Eigen::Vector3f(0.80f, 0.82f, 0.86f));
+  p.set("transparent", s.alpha ? 1 : 0);
+}
+
+// The image, and with keep_buffers each pixel's layer and normal, top row first.
+void Renderer::Impl::read_back(const RenderSettings& s, RenderResult& result) const {
+  const std::size_t pixels = static_cast<std::size_t>(s.width) * s.height;
+  std::vector<std::uint8_t> rgba(4 * pixels);
+  final_color.read(rgba.data(), rgba.size(), GL_RGBA, GL_UNSIGNED_BYTE);
+  result.image.width = s.width;
+  result.image.height = s.height;
+  result.image.alpha = s.alpha;
+  result.image.rgba = flip_rows(rgba, s.width, s.height, 4);
+  if (s.keep_buffers) {
+    std::vector<float> nl(4 * pixels);
+    normal.read(nl.data(), nl.size() * sizeof(float), GL_RGBA, GL_FLOAT);
+    nl = flip_rows(nl, s.width, s.height, 4);
+    result.layers.resize(pixels);
+    result.normals.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i) {
+      result.layers[i] = static_cast<Layer>(static_cast<int>(nl[4 * i + 3] + 0.5f));
+      result.normals[i] = Eigen::Vector3f(nl[4 * i], nl[4 * i + 1], nl[4 * i + 2]);
+    }
+  }
+  check("preview read back");
 }
 
 void Renderer::Impl::colour_surface(const RenderSettings& s, const CameraState& camera, RenderResult& result) {
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   std::vector<float> depths(pixels), normals(4 * pixels);
   std::vector<std::uint8_t> colours(4 * pixels);
-  glGetTextureImage(depth.get(), 0, GL_DEPTH_COMPONENT, GL_FLOAT, static_cast<GLsizei>(pixels * 4), depths.data());
-  glGetTextureImage(normal.get(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(pixels * 16), normals.data());
-  glGetTextureImage(albedo.get(), 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(pixels * 4), colours.data());
+  depth.read(depths.data(), pixels * 4, GL_DEPTH_COMPONENT, GL_FLOAT);
+  normal.read(normals.data(), pixels * 16, GL_RGBA, GL_FLOAT);
+  albedo.read(colours.data(), pixels * 4, GL_RGBA, GL_UNSIGNED_BYTE);
   std::vector<double> values(pixels, std::numeric_limits<double>::quiet_NaN());
   tbb::parallel_for(0, height, [&](int y) {
     for (int x = 0; x < width; ++x) {
@@ -320,7 +493,7 @@ void Renderer::Impl::colour_surface(const RenderSettings& s, const CameraState& 
       for (int k = 0; k < 3; ++k) colours[4 * i + k] = static_cast<std::uint8_t>(std::lround(255.0f * c[k]));
     }
   });
-  glTextureSubImage2D(albedo.get(), 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, colours.data());
+  albedo.upload(colours.data(), GL_RGBA, GL_UNSIGNED_BYTE);
   double sum = 0.0;
   for (double v : values) {
     if (std::isnan(v)) continue;
@@ -346,50 +519,13 @@ void Renderer::set_volume(const SdfVolume& volume) {
                                  "(use a lower --resolution or a larger --voxel)",
                                  d.x(), d.y(), d.z(), max_side));
   }
-  const bool half = volume.spec.voxel_count() * sizeof(float) > kMaxR32Bytes;
-  GLuint id = 0;
-  glCreateTextures(GL_TEXTURE_3D, 1, &id);
-  m.volume_texture.reset(id);
-  glTextureStorage3D(id, 1, half ? GL_R16F : GL_R32F, d.x(), d.y(), d.z());
-  if (glGetError() == GL_OUT_OF_MEMORY) {
-    m.volume_texture.reset();
-    m.has_volume = false;
-    throw GpuError(fmt::format("out of GPU memory for the preview's {} x {} x {} SDF texture", d.x(), d.y(), d.z()));
-  }
-  // Upload in slabs of about 64 MiB so the driver's staging copy stays small.
-  const std::size_t slice = static_cast<std::size_t>(d.x()) * d.y();
-  const int slab = std::max(1, static_cast<int>((std::size_t{64} << 20) / (4 * slice)));
-  for (int z = 0; z < d.z(); z += slab) {
-    const int n = std::min(slab, d.z() - z);
-    glTextureSubImage3D(id, 0, 0, 0, z, d.x(), d.y(), n, GL_RED, GL_FLOAT, volume.distance.data() + slice * z);
-  }
-  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  for (GLenum axis : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTextureParameteri(id, axis, GL_CLAMP_TO_EDGE);
+  m.volume_texture = upload_volume(volume);
   m.check("preview SDF upload");
   m.volume_spec = volume.spec;
   m.volume_band = volume.band;
   m.volume_box = volume.world_box();
   m.has_volume = true;
-
-  // The surface's box: voxels at or inside the zero level, grown by half a voxel.
-  std::vector<Aabb> slices(static_cast<std::size_t>(d.z()));
-  tbb::parallel_for(0, d.z(), [&](int k) {
-    for (int j = 0; j < d.y(); ++j)
-      for (int i = 0; i < d.x(); ++i)
-        if (volume.distance[volume.spec.linear_index(i, j, k)] <= 0.0f) slices[k].extend(volume.spec.voxel_center(i, j, k));
-  });
-  Aabb box;
-  for (const Aabb& s : slices) {
-    if (!s.valid()) continue;
-    box.extend(s.min);
-    box.extend(s.max);
-  }
-  if (box.valid()) {
-    box.min.array() -= 0.5 * volume.spec.voxel_size;
-    box.max.array() += 0.5 * volume.spec.voxel_size;
-  }
-  m.surface_box = box.valid() ? box : m.volume_box;
+  m.surface_box = surface_box(volume, m.volume_box);
 }
 
 void Renderer::set_particles(const Particles& particles) {
@@ -432,12 +568,9 @@ Aabb Renderer::content_box() const {
 }
 
 Eigen::Vector2i Renderer::max_image_size() const {
-  GLint viewport[2] = {0, 0}, texture = 0, fb_width = 0, fb_height = 0;
-  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, viewport);
-  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &texture);
-  glGetIntegerv(GL_MAX_FRAMEBUFFER_WIDTH, &fb_width);
-  glGetIntegerv(GL_MAX_FRAMEBUFFER_HEIGHT, &fb_height);
-  return {std::min({viewport[0], texture, fb_width}), std::min({viewport[1], texture, fb_height})};
+  const gpu::DeviceLimits& l = impl_->context.limits();
+  return {std::min({l.max_viewport_dims[0], l.max_texture_size, l.max_framebuffer_size[0]}),
+          std::min({l.max_viewport_dims[1], l.max_texture_size, l.max_framebuffer_size[1]})};
 }
 
 void Renderer::check_image_size(int width, int height) const {
@@ -455,164 +588,22 @@ RenderResult Renderer::render(const RenderSettings& s) {
   const auto start = std::chrono::steady_clock::now();
   Impl& m = *impl_;
   check_image_size(s.width, s.height);
-  const Eigen::Vector2i max_size = max_image_size();
-  validate(s.camera);
-  if (!(s.up.norm() > 0.0) || !s.up.allFinite()) throw InputError("the up vector must be finite and non-zero");
   const Aabb content = content_box();
-  if (!content.valid()) throw InputError("nothing to render: no SDF and no particles");
-  if (s.surface_scalar.value && !(s.surface_scalar.max_value > 0.0)) {
-    throw InputError("the colour map's top value must be positive");
-  }
-
-  // Everything drawn lies in this sphere; positions go to the GPU relative to its centre.
-  Aabb all = content;
-  if (m.has_volume) {
-    all.extend(m.volume_box.min);
-    all.extend(m.volume_box.max);
-  }
-  const Eigen::Vector3d origin = all.center();
-  const double radius = std::max(0.5 * all.size().norm(), 1e-12);
-  m.upload_particles(origin);
+  check_settings(s, content);
+  const Frame frame = m.plan_frame(s, content, max_image_size().maxCoeff());
+  m.upload_particles(frame.origin);
   m.ensure_targets(s.width, s.height);
-  const CameraState camera = camera_state(s.camera, s.width, s.height, origin, radius);
 
-  const Eigen::Vector3d up = s.up.normalized();
-  const Eigen::Vector3d light = s.light ? s.light->normalized() : default_light(s.camera, up);
-  if (!light.allFinite()) throw InputError("the light direction must be finite and non-zero");
-  double lowest = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < 8; ++i) {
-    const Eigen::Vector3d corner(i & 1 ? content.max.x() : content.min.x(), i & 2 ? content.max.y() : content.min.y(),
-                                 i & 4 ? content.max.z() : content.min.z());
-    lowest = std::min(lowest, up.dot(corner));
-  }
-  const double ground_level = s.ground_level.value_or(lowest) - up.dot(origin);
-
-  glBindVertexArray(m.vao);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
-  glDisable(GL_BLEND);
-
-  // 1. The key light's shadow map: an orthographic view along the light holding the sphere.
-  CameraState light_camera;
-  if (s.shadows) {
-    const GLint max_texture = max_size.maxCoeff();
-    const int size = std::min(s.shadow_map_size > 0 ? s.shadow_map_size : std::clamp(std::max(s.width, s.height), 512, 4096),
-                              static_cast<int>(max_texture));
-    m.ensure_shadow_map(size);
-    Camera lc;
-    lc.target = origin;
-    lc.eye = origin + light * (2.0 * radius);
-    lc.up = any_perpendicular(light);
-    lc.ortho = true;
-    lc.ortho_height = 2.02 * radius;
-    light_camera = camera_state(lc, size, size, origin, radius);
-    m.queue.timed("preview/shadow map", [&] {
-      glBindFramebuffer(GL_FRAMEBUFFER, m.shadow_target.get());
-      glViewport(0, 0, size, size);
-      const float one = 1.0f;
-      glClearNamedFramebufferfv(m.shadow_target.get(), GL_DEPTH, 0, &one);
-      set_camera(m.particles_program, light_camera);
-      m.particles_program.set("per_particle_color", 0);
-      m.draw_particles(m.particles_program);
-      set_camera(m.raycast_program, light_camera);
-      m.raycast_program.set("use_particle_depth", 0);
-      m.raycast_program.set("depth_only", 1);
-      m.draw_volume(m.raycast_program);
-    });
-  }
-
-  // 2. G-buffer: particles, then the SDF marched up to them.
-  m.queue.timed("preview/particles", [&] {
-    glBindFramebuffer(GL_FRAMEBUFFER, m.gbuffer.get());
-    glViewport(0, 0, s.width, s.height);
-    const float zero[4] = {0, 0, 0, 0}, one = 1.0f;
-    glClearNamedFramebufferfv(m.gbuffer.get(), GL_COLOR, 0, zero);
-    glClearNamedFramebufferfv(m.gbuffer.get(), GL_COLOR, 1, zero);
-    glClearNamedFramebufferfv(m.gbuffer.get(), GL_DEPTH, 0, &one);
-    set_camera(m.particles_program, camera);
-    m.particles_program.set("per_particle_color", m.per_particle_color ? 1 : 0);
-    set_vec3(m.particles_program, "particle_color", s.particle_color);
-    m.draw_particles(m.particles_program);
-  });
-  m.queue.timed("preview/ray cast", [&] {
-    const bool limit = m.particle_count > 0;
-    if (limit) {
-      glCopyImageSubData(m.depth.get(), GL_TEXTURE_2D, 0, 0, 0, 0, m.particle_depth.get(), GL_TEXTURE_2D, 0, 0, 0, 0,
-                         s.width, s.height, 1);
-    }
-    glBindTextureUnit(TS_PREVIEW_UNIT_PARTICLE_DEPTH, m.particle_depth.get());
-    m.raycast_program.set("use_particle_depth", limit ? 1 : 0);
-    m.raycast_program.set("depth_only", 0);
-    set_vec3(m.raycast_program, "surface_color", s.surface_color);
-    set_camera(m.raycast_program, camera);
-    m.draw_volume(m.raycast_program);
-  });
-
+  gpu::StateScope state;
+  state.vertex_array(m.vao).depth_test(GL_LESS).no_cull().no_blend();
+  if (s.shadows) m.shadow_pass(frame);
+  m.particle_pass(s, frame);
+  m.raycast_pass(s, frame);
   RenderResult result;
   // 3. CPU colouring of the surface.
-  if (s.surface_scalar.value && m.has_volume) m.colour_surface(s, camera, result);
-
-  // 4. Lighting.
-  m.queue.timed("preview/shade", [&] {
-    glDisable(GL_DEPTH_TEST);
-    glBindFramebuffer(GL_FRAMEBUFFER, m.final_target.get());
-    glViewport(0, 0, s.width, s.height);
-    const gpu::Program& p = m.shade_program;
-    p.use();
-    set_camera(p, camera);
-    glBindTextureUnit(TS_PREVIEW_UNIT_ALBEDO, m.albedo.get());
-    glBindTextureUnit(TS_PREVIEW_UNIT_NORMAL, m.normal.get());
-    glBindTextureUnit(TS_PREVIEW_UNIT_DEPTH, m.depth.get());
-    glBindTextureUnit(TS_PREVIEW_UNIT_SHADOW, s.shadows ? m.shadow_depth.get() : 0);
-    p.set("shadows", s.shadows ? 1 : 0);
-    if (s.shadows) {
-      set_matrix(p, "light_view_projection", light_camera.view_projection);
-      const double texel = 2.02 * radius / m.shadow_size;
-      p.set("shadow_texel", static_cast<float>(texel));
-      // Light depth is linear over the near-far range (about 2 radius): one texel of slack.
-      p.set("shadow_bias", static_cast<float>(texel / (2.0 * radius)));
-      p.set("shadow_texel_uv", 1.0f / m.shadow_size, 1.0f / m.shadow_size);
-    }
-    if (m.has_volume) m.bind_volume(p);
-    p.set("has_volume", m.has_volume ? 1 : 0);
-    set_vec3(p, "light_dir", light);
-    set_vec3(p, "world_up", up);
-    p.set("ground", s.ground ? 1 : 0);
-    p.set("ground_level", static_cast<float>(ground_level));
-    const Eigen::Vector3d center = content.center() - origin;
-    set_vec3(p, "ground_center", Eigen::Vector3d(center - (up.dot(center) - ground_level) * up));
-    p.set("ground_radius", static_cast<float>(2.5 * 0.5 * content.size().norm()));
-    set_vec3(p, "ground_color", Eigen::Vector3f(0.88f, 0.88f, 0.87f));
-    set_vec3(p, "background_top", Eigen::Vector3f(0.97f, 0.97f, 0.98f));
-    set_vec3(p, "background_bottom", Eigen::Vector3f(0.80f, 0.82f, 0.86f));
-    p.set("transparent", s.alpha ? 1 : 0);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    m.check("preview shade");
-  });
-
-  const std::size_t pixels = static_cast<std::size_t>(s.width) * s.height;
-  std::vector<std::uint8_t> rgba(4 * pixels);
-  glGetTextureImage(m.final_color.get(), 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(rgba.size()), rgba.data());
-  result.image.width = s.width;
-  result.image.height = s.height;
-  result.image.alpha = s.alpha;
-  result.image.rgba = flip_rows(rgba, s.width, s.height, 4);
-  if (s.keep_buffers) {
-    std::vector<float> nl(4 * pixels);
-    glGetTextureImage(m.normal.get(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(nl.size() * 4), nl.data());
-    nl = flip_rows(nl, s.width, s.height, 4);
-    result.layers.resize(pixels);
-    result.normals.resize(pixels);
-    for (std::size_t i = 0; i < pixels; ++i) {
-      result.layers[i] = static_cast<Layer>(static_cast<int>(nl[4 * i + 3] + 0.5f));
-      result.normals[i] = Eigen::Vector3f(nl[4 * i], nl[4 * i + 1], nl[4 * i + 2]);
-    }
-  }
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glBindVertexArray(0);
-  glUseProgram(0);
-  m.check("preview read back");
+  if (s.surface_scalar.value && m.has_volume) m.colour_surface(s, frame.camera, result);
+  m.lighting_pass(s, frame);
+  m.read_back(s, result);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

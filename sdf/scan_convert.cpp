@@ -5,14 +5,17 @@
 
 #include <algorithm>
 #include <chrono>
-#include <iterator>
-#include <optional>
 #include <cmath>
+#include <iterator>
+#include <memory>
+#include <span>
 
 #include "core/error.h"
 #include "core/log.h"
 #include "gpu/gl.h"
+#include "gpu/graphics.h"
 #include "gpu/layouts.h"
+#include "shaders/sdf/bindings.h"
 
 namespace ts::sdf {
 namespace {
@@ -172,37 +175,18 @@ DrawLists bucket_by_block(const GpuGeometry& g, int dims_z, int block) {
   return lists;
 }
 
-// A layered render target of `layers` z-slices: RGBA32F value + 32F depth.
-class SlabTarget {
- public:
-  SlabTarget(int width, int height, int layers) {
-    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &color_);
-    glTextureStorage3D(color_, 1, GL_RGBA32F, width, height, layers);
-    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &depth_);
-    glTextureStorage3D(depth_, 1, GL_DEPTH_COMPONENT32F, width, height, layers);
-    if (glGetError() == GL_OUT_OF_MEMORY) release(), throw GpuError("out of GPU memory for an SDF slab");
-    glCreateFramebuffers(1, &framebuffer_);
-    glNamedFramebufferTexture(framebuffer_, GL_COLOR_ATTACHMENT0, color_, 0);
-    glNamedFramebufferTexture(framebuffer_, GL_DEPTH_ATTACHMENT, depth_, 0);
-    if (glCheckNamedFramebufferStatus(framebuffer_, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      release();
-      throw GpuError("the layered SDF render target is incomplete on this GPU");
-    }
+// A layered render target of `layers` z-slices: RGBA32F value + 32F depth (|d|, for the depth test).
+struct SlabTarget {
+  SlabTarget(int width, int height, int layers)
+      : color(gpu::Texture::create_2d_array(GL_RGBA32F, width, height, layers, "SDF slab values")),
+        depth(gpu::Texture::create_2d_array(GL_DEPTH_COMPONENT32F, width, height, layers, "SDF slab depth")),
+        framebuffer("SDF slab") {
+    framebuffer.attach_color(0, color);
+    framebuffer.attach_depth(depth);
+    framebuffer.check_complete();
   }
-  ~SlabTarget() { release(); }
-  SlabTarget(const SlabTarget&) = delete;
-  SlabTarget& operator=(const SlabTarget&) = delete;
-  GLuint framebuffer() const { return framebuffer_; }
-  GLuint color() const { return color_; }
-
- private:
-  void release() {
-    if (framebuffer_) glDeleteFramebuffers(1, &framebuffer_);
-    if (color_) glDeleteTextures(1, &color_);
-    if (depth_) glDeleteTextures(1, &depth_);
-    framebuffer_ = color_ = depth_ = 0;
-  }
-  GLuint framebuffer_ = 0, color_ = 0, depth_ = 0;
+  gpu::Texture color, depth;
+  gpu::Framebuffer framebuffer;
 };
 
 openvdb::FloatGrid::Ptr make_level_set(const GridSpec& spec, float band) {
@@ -263,16 +247,15 @@ void finish_texture(gpu::Queue& queue, const gpu::ShaderLibrary& library, const 
   gpu::Buffer bits = gpu::Buffer::from<std::uint32_t>(inside);
   peak_bytes += bits.bytes();
   gpu::Program program = gpu::Program::compute(library, "sdf/finish_texture.comp");
-  program.use();
   program.set("dims", spec.dims.x(), spec.dims.y(), spec.dims.z());
   program.set("band", band);
   program.set("voxel_size", voxel_size);
-  bits.bind(0);
-  glBindImageTexture(0, texture.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+  bits.bind(TS_SDF_INSIDE_BITS);
+  const gpu::ImageBinding field(TS_SDF_FIELD_IMAGE, texture.texture(), GL_READ_WRITE);
   auto groups = [](int n, int local) { return static_cast<std::uint32_t>((n + local - 1) / local); };
-  queue.dispatch(program, groups(spec.dims.x(), 8), groups(spec.dims.y(), 8), groups(spec.dims.z(), 4),
-                 GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-  glBindImageTexture(0, 0, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+  queue.dispatch(
+      program, groups(spec.dims.x(), 8), groups(spec.dims.y(), 8), groups(spec.dims.z(), 4),
+      GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
 }
 
 int choose_slab_layers(const GridSpec& spec, std::size_t budget) {
@@ -288,6 +271,302 @@ int choose_slab_layers(const GridSpec& spec, std::size_t budget) {
   return wanted >= kLayersPerDraw ? wanted / kLayersPerDraw * kLayersPerDraw : wanted;
 }
 
+// Everything the slab loop needs that the CPU decides before the GPU is touched.
+struct ScanPlan {
+  double margin = 0.0;  // prism growth beyond the triangle [voxels]
+  int slab_layers = 0;  // z-layers per slab (render-target layers)
+  int block = 0;        // z-layers per draw
+  GpuGeometry geometry;
+  DrawLists lists;
+};
+
+ScanPlan plan_scan(const TriangleMesh& mesh, const Pseudonormals& normals, const GridSpec& spec,
+                   const ScanConvertOptions& options) {
+  ScanPlan plan;
+  // Every voxel with |d| < band lies inside the triangle's prism grown by the band; a quarter voxel
+  // more keeps rounding of the cross-sections (~1e-6 voxel) from losing one, and costs far fewer
+  // fragments than a whole voxel ((4.25/5)^3 for tiny triangles). The fragment shader drops what
+  // lies beyond depth_range.
+  plan.margin = options.band + 0.25;
+  plan.geometry = build_geometry(mesh, normals, spec, plan.margin);
+  plan.slab_layers = choose_slab_layers(spec, options.max_slab_bytes);
+  plan.block = std::min(kLayersPerDraw, plan.slab_layers);
+  plan.lists = bucket_by_block(plan.geometry, spec.dims.z(), plan.block);
+  return plan;
+}
+
+// The GPU half of scan conversion: both geometry-shader variants, the geometry buffers, the indexed
+// vertex array and the layered target, bound (with the depth test on |d|) while it exists. Draws
+// one slab at a time and reads it back.
+class SlabScanner {
+ public:
+  SlabScanner(const gpu::ShaderLibrary& library, gpu::Queue& queue, const GridSpec& spec,
+              const ScanPlan& plan);
+  // Clears the target and draws every prism touching grid layers [z0, z0 + layers); returns the
+  // number of draws.
+  int draw(int z0, int layers);
+  // The target's first `layers` layers read back: 4 floats per voxel, x fastest, then y, then layer.
+  std::span<const float> read(int layers);
+  const gpu::Texture& target() const { return target_.color; }
+  // Render target and geometry buffers [bytes].
+  std::size_t gpu_bytes() const {
+    return bytes_per_layer(spec_) * static_cast<std::size_t>(plan_.slab_layers) + triangles_.bytes() +
+           prisms_.bytes() + indices_.bytes();
+  }
+
+ private:
+  const GridSpec& spec_;
+  const ScanPlan& plan_;
+  gpu::Queue& queue_;
+  std::vector<gpu::Program> programs_;  // one per kVariantInvocations
+  std::vector<std::string> timer_names_;
+  gpu::Buffer triangles_, prisms_, indices_;
+  gpu::VertexArray vertices_;
+  SlabTarget target_;
+  std::vector<float> readback_;
+  gpu::StateScope state_;  // last: restores the state before the target is released
+};
+
+SlabScanner::SlabScanner(const gpu::ShaderLibrary& library, gpu::Queue& queue, const GridSpec& spec,
+                         const ScanPlan& plan)
+    : spec_(spec),
+      plan_(plan),
+      queue_(queue),
+      triangles_(gpu::Buffer::from<SdfTriangle>(plan.geometry.triangles)),
+      prisms_(gpu::Buffer::from<SdfPrism>(plan.geometry.prisms)),
+      indices_(gpu::Buffer::from<std::uint32_t>(plan.lists.indices)),
+      vertices_(gpu::VertexArray::create()),
+      target_(spec.dims.x(), spec.dims.y(), plan.slab_layers),
+      readback_(4 * static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y()) *
+                static_cast<std::size_t>(plan.slab_layers)) {
+  for (int invocations : kVariantInvocations) {
+    gpu::Program& program = programs_.emplace_back(
+        gpu::Program::graphics(library, "sdf/scan_convert.vert", "sdf/scan_convert.geom",
+                               "sdf/scan_convert.frag", {"INVOCATIONS " + std::to_string(invocations)}));
+    program.set("grid_xy", static_cast<float>(spec.dims.x()), static_cast<float>(spec.dims.y()));
+    program.set("slab_layers", plan.slab_layers);
+    program.set("depth_range", static_cast<float>(plan.margin));
+    program.set("draw_layers", plan.block);
+    timer_names_.push_back(fmt::format("sdf/scan_convert ({} GS invocations)", invocations));
+  }
+  triangles_.bind(TS_SDF_TRIANGLES);
+  prisms_.bind(TS_SDF_PRISMS);
+  vertices_.set_element_buffer(indices_);
+  state_.framebuffer(target_.framebuffer).viewport(spec.dims.x(), spec.dims.y()).vertex_array(vertices_);
+  state_.depth_test(GL_LESS).no_cull().no_blend();
+}
+
+int SlabScanner::draw(int z0, int layers) {
+  target_.framebuffer.clear_color(0, {0.0f, 0.0f, 0.0f, kUntouched});
+  target_.framebuffer.clear_depth(1.0f);
+  int draws = 0;
+  for (int first = 0; first < layers; first += plan_.block) {
+    for (std::size_t variant = 0; variant < kVariants; ++variant) {
+      const std::size_t list = kVariants * static_cast<std::size_t>((z0 + first) / plan_.block) + variant;
+      const std::size_t begin = plan_.lists.begin[list], end = plan_.lists.begin[list + 1];
+      if (begin == end) continue;
+      const gpu::Program& program = programs_[variant];
+      program.set("slab_first_z", z0);
+      program.set("draw_first_layer", first);
+      gpu::draw_elements(queue_, program, GL_LINES_ADJACENCY, begin, end - begin, timer_names_[variant]);
+      ++draws;
+    }
+  }
+  return draws;
+}
+
+std::span<const float> SlabScanner::read(int layers) {
+  const std::size_t floats =
+      readback_.size() / static_cast<std::size_t>(plan_.slab_layers) * static_cast<std::size_t>(layers);
+  queue_.timed("sdf/readback", [&] {
+    target_.color.read(readback_.data(), floats * sizeof(float), GL_RGBA, GL_FLOAT, 0, layers);
+  });
+  return {readback_.data(), floats};
+}
+
+// A finished slab: grid layers [z0, z0 + layers), read back, and still in the render target.
+struct Slab {
+  const GridSpec& spec;
+  int z0 = 0, layers = 0;
+  std::span<const float> values;      // 4 per voxel (slab order): unit gradient, signed distance [voxels]
+  std::span<const std::size_t> band;  // the voxels with |distance| < band, ascending slab order
+  const gpu::Texture& target;         // layers [0, layers) hold the slab
+
+  std::size_t layer_voxels() const {
+    return static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y());
+  }
+  // Slab order is grid order (x fastest, then y, then z) from layer z0 on.
+  std::size_t grid_index(std::size_t voxel) const {
+    return static_cast<std::size_t>(z0) * layer_voxels() + voxel;
+  }
+  openvdb::Coord vdb_coord(std::size_t voxel) const {
+    const std::size_t nx = static_cast<std::size_t>(spec.dims.x());
+    const int i = static_cast<int>(voxel % nx);
+    const int j = static_cast<int>((voxel / nx) % static_cast<std::size_t>(spec.dims.y()));
+    const int k = z0 + static_cast<int>(voxel / layer_voxels());
+    return {spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k};
+  }
+};
+
+void find_band_voxels(std::span<const float> values, float band, std::vector<std::size_t>& out) {
+  out.clear();
+  for (std::size_t voxel = 0; voxel < values.size() / 4; ++voxel)
+    if (std::abs(values[4 * voxel + 3]) < band) out.push_back(voxel);
+}
+
+// One output of scan conversion: fed every finished slab in z order, then finished once.
+class SlabConsumer {
+ public:
+  virtual ~SlabConsumer() = default;
+  virtual void consume(const Slab& slab) = 0;
+  virtual void finish() = 0;
+};
+
+// The OpenVDB level set: band voxels in world units, then a signed flood fill for the rest.
+class LevelSetOutput final : public SlabConsumer {
+ public:
+  LevelSetOutput(const GridSpec& spec, float band, openvdb::FloatGrid::Ptr& grid)
+      : voxel_size_(static_cast<float>(spec.voxel_size)),
+        grid_(grid = make_level_set(spec, band)),
+        accessor_(grid_->getAccessor()) {}
+  void consume(const Slab& slab) override {
+    for (std::size_t voxel : slab.band)
+      accessor_.setValue(slab.vdb_coord(voxel), slab.values[4 * voxel + 3] * voxel_size_);
+  }
+  void finish() override { openvdb::tools::signedFloodFill(grid_->tree()); }
+
+ private:
+  float voxel_size_;
+  openvdb::FloatGrid::Ptr grid_;
+  openvdb::FloatGrid::Accessor accessor_;
+};
+
+// Which voxels the band holds and, after the last slab, which of the others lie outside: the signs
+// off the band for the dense copy and the texture (one flood fill for both).
+class BandSigns final : public SlabConsumer {
+ public:
+  explicit BandSigns(const GridSpec& spec) : spec_(spec), state_(spec.voxel_count(), kOffBand) {}
+  void consume(const Slab& slab) override {
+    for (std::size_t voxel : slab.band) state_[slab.grid_index(voxel)] = kInBand;
+  }
+  void finish() override { flood_fill_outside(spec_, state_); }
+  const std::vector<std::uint8_t>& state() const { return state_; }
+
+ private:
+  const GridSpec& spec_;
+  std::vector<std::uint8_t> state_;  // VoxelState per voxel, spec.linear_index order
+};
+
+// The dense host copy: band voxels as read back (distance in world units), the rest +-band.
+class DenseOutput final : public SlabConsumer {
+ public:
+  DenseOutput(const GridSpec& spec, float band, const BandSigns& signs, DenseSdf& dense)
+      : voxel_size_(static_cast<float>(spec.voxel_size)), band_(band), signs_(signs), dense_(dense) {
+    dense_.spec = spec;
+    dense_.values.assign(spec.voxel_count(), Eigen::Vector4f(0, 0, 0, kUntouched));
+  }
+  void consume(const Slab& slab) override {
+    for (std::size_t voxel : slab.band) {
+      const float* v = &slab.values[4 * voxel];
+      dense_.values[slab.grid_index(voxel)] = {v[0], v[1], v[2], v[3] * voxel_size_};
+    }
+  }
+  void finish() override { fill_dense_off_band(dense_, signs_.state(), band_ * voxel_size_); }
+
+ private:
+  float voxel_size_, band_;
+  const BandSigns& signs_;
+  DenseSdf& dense_;
+};
+
+// The GPU texture: each slab copied in on the GPU, finished by one compute pass (finish_texture).
+class TextureOutput final : public SlabConsumer {
+ public:
+  TextureOutput(const GridSpec& spec, float band, int max_3d_texture_size, const BandSigns& signs,
+                gpu::Queue& queue, const gpu::ShaderLibrary& library, SdfTexture& texture,
+                std::size_t& peak_bytes)
+      : band_(band),
+        signs_(signs),
+        queue_(queue),
+        library_(library),
+        texture_(texture),
+        peak_bytes_(peak_bytes) {
+    texture_ = SdfTexture(spec, max_3d_texture_size);
+    peak_bytes_ += texture_.bytes();
+  }
+  void consume(const Slab& slab) override {
+    queue_.timed("sdf/copy to texture",
+                 [&] { slab.target.copy_to(texture_.texture(), slab.z0, slab.layers); });
+  }
+  void finish() override {
+    finish_texture(queue_, library_, texture_, signs_.state(), band_,
+                   static_cast<float>(texture_.spec().voxel_size), peak_bytes_);
+  }
+
+ private:
+  float band_;
+  const BandSigns& signs_;
+  gpu::Queue& queue_;
+  const gpu::ShaderLibrary& library_;
+  SdfTexture& texture_;
+  std::size_t& peak_bytes_;
+};
+
+// The outputs the options choose, in the order they finish (the signs before the dense copy and the
+// texture that read them).
+std::vector<std::unique_ptr<SlabConsumer>> make_outputs(const gpu::Context& context, const GridSpec& spec,
+                                                        const ScanConvertOptions& options, gpu::Queue& queue,
+                                                        const gpu::ShaderLibrary& library,
+                                                        ScanConvertResult& result) {
+  const float band = static_cast<float>(options.band);
+  std::vector<std::unique_ptr<SlabConsumer>> outputs;
+  if (options.build_grid) outputs.push_back(std::make_unique<LevelSetOutput>(spec, band, result.grid));
+  if (!options.keep_dense && !options.keep_texture) return outputs;
+  auto signs = std::make_unique<BandSigns>(spec);
+  const BandSigns& shared_signs = *signs;
+  outputs.push_back(std::move(signs));
+  if (options.keep_dense)
+    outputs.push_back(std::make_unique<DenseOutput>(spec, band, shared_signs, result.dense));
+  if (options.keep_texture) {
+    outputs.push_back(std::make_unique<TextureOutput>(spec, band, context.limits().max_3d_texture_size,
+                                                      shared_signs, queue, library, result.texture,
+                                                      result.stats.peak_gpu_bytes));
+  }
+  return outputs;
+}
+
+// Draws, reads back and hands on each slab in z order.
+void scan_slabs(SlabScanner& scanner, const std::vector<std::unique_ptr<SlabConsumer>>& outputs,
+                const GridSpec& spec, const ScanConvertOptions& options, bool check_errors,
+                ScanConvertStats& stats) {
+  const float band = static_cast<float>(options.band);
+  std::vector<std::size_t> band_voxels;
+  for (int z0 = 0; z0 < spec.dims.z(); z0 += stats.layers_per_slab) {
+    const int layers = std::min(stats.layers_per_slab, spec.dims.z() - z0);
+    stats.draws += scanner.draw(z0, layers);
+    const std::span<const float> values = scanner.read(layers);
+    find_band_voxels(values, band, band_voxels);
+    const Slab slab{spec, z0, layers, values, band_voxels, scanner.target()};
+    for (const auto& output : outputs) output->consume(slab);
+    if (check_errors) gpu::check_gl("SDF scan conversion (shaders sdf/scan_convert.*)");
+    stats.band_voxels += band_voxels.size();
+    ++stats.slabs;
+    if (options.progress) options.progress(static_cast<double>(z0 + layers) / spec.dims.z());
+  }
+}
+
+void check_request(const gpu::Context& context, const GridSpec& spec, const ScanConvertOptions& options) {
+  if (options.band < 1.0) {
+    throw InputError("SDF band half-width must be at least 1 voxel (got " + std::to_string(options.band) +
+                     ")");
+  }
+  const int max_size = context.limits().max_3d_texture_size;
+  if (spec.dims.x() > max_size || spec.dims.y() > max_size) {
+    throw GpuError("SDF grid " + std::to_string(spec.dims.x()) + " x " + std::to_string(spec.dims.y()) +
+                   " exceeds this GPU's largest render target side (" + std::to_string(max_size) + ")");
+  }
+}
+
 }  // namespace
 
 std::size_t bytes_per_layer(const GridSpec& spec) {
@@ -297,153 +576,24 @@ std::size_t bytes_per_layer(const GridSpec& spec) {
 ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, const Pseudonormals& normals,
                                const GridSpec& spec, const ScanConvertOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  if (options.band < 1.0) throw InputError("SDF band half-width must be at least 1 voxel (got " + std::to_string(options.band) + ")");
-  const int max_size = context.limits().max_3d_texture_size;
-  if (spec.dims.x() > max_size || spec.dims.y() > max_size) {
-    throw GpuError("SDF grid " + std::to_string(spec.dims.x()) + " x " + std::to_string(spec.dims.y()) +
-                   " exceeds this GPU's largest render target side (" + std::to_string(max_size) + ")");
-  }
-  // Every voxel with |d| < band lies inside the triangle's prism grown by the band; a quarter voxel
-  // more keeps rounding of the cross-sections (~1e-6 voxel) from losing one, and costs far fewer
-  // fragments than a whole voxel ((4.25/5)^3 for tiny triangles). The fragment shader drops what
-  // lies beyond depth_range.
-  const double margin = options.band + 0.25;
-  const GpuGeometry geometry = build_geometry(mesh, normals, spec, margin);
-  const int slab_layers = choose_slab_layers(spec, options.max_slab_bytes);
-  const int block = std::min(kLayersPerDraw, slab_layers);
-  const DrawLists lists = bucket_by_block(geometry, spec.dims.z(), block);
-
+  check_request(context, spec, options);
+  const ScanPlan plan = plan_scan(mesh, normals, spec, options);
   gpu::ShaderLibrary library;
-  std::vector<gpu::Program> programs;
-  for (int invocations : kVariantInvocations) {
-    programs.push_back(gpu::Program::graphics(library, "sdf/scan_convert.vert", "sdf/scan_convert.geom",
-                                              "sdf/scan_convert.frag", {"INVOCATIONS " + std::to_string(invocations)}));
-  }
-  std::vector<std::string> timer_names;
-  for (int invocations : kVariantInvocations)
-    timer_names.push_back(fmt::format("sdf/scan_convert ({} GS invocations)", invocations));
-  gpu::Buffer triangles = gpu::Buffer::from<SdfTriangle>(geometry.triangles);
-  gpu::Buffer prisms = gpu::Buffer::from<SdfPrism>(geometry.prisms);
-  gpu::Buffer indices = gpu::Buffer::from<std::uint32_t>(lists.indices);
-  triangles.bind(TS_BINDING_SDF_TRIANGLES);
-  prisms.bind(TS_BINDING_SDF_PRISMS);
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  glVertexArrayElementBuffer(vao, indices.id());
-
-  SlabTarget target(spec.dims.x(), spec.dims.y(), slab_layers);
   gpu::Queue queue(options.timings, context.debug());
+  SlabScanner scanner(library, queue, spec, plan);
 
   ScanConvertResult result;
   ScanConvertStats& stats = result.stats;
-  stats.layers_per_slab = slab_layers;
-  stats.degenerate_triangles = geometry.degenerate;
-  stats.needle_triangles = geometry.needles;
-  stats.peak_gpu_bytes = bytes_per_layer(spec) * static_cast<std::size_t>(slab_layers) + triangles.bytes() +
-                         prisms.bytes() + indices.bytes();
-
-  const float h = static_cast<float>(spec.voxel_size);
-  const float band = static_cast<float>(options.band);
-  if (options.build_grid) result.grid = make_level_set(spec, band);
-  std::optional<openvdb::FloatGrid::Accessor> accessor;
-  if (result.grid) accessor.emplace(result.grid->getAccessor());
-  if (options.keep_dense) {
-    result.dense.spec = spec;
-    result.dense.values.assign(spec.voxel_count(), Eigen::Vector4f(0, 0, 0, kUntouched));
-  }
-  const bool keep_signs = options.keep_dense || options.keep_texture;
-  std::vector<std::uint8_t> state;
-  if (keep_signs) state.assign(spec.voxel_count(), kOffBand);
-  if (options.keep_texture) {
-    result.texture = SdfTexture(spec, max_size);
-    stats.peak_gpu_bytes += result.texture.bytes();
-  }
-
-  glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer());
-  glViewport(0, 0, spec.dims.x(), spec.dims.y());
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_BLEND);
-  for (gpu::Program& program : programs) {
-    program.use();
-    program.set("grid_xy", static_cast<float>(spec.dims.x()), static_cast<float>(spec.dims.y()));
-    program.set("slab_layers", slab_layers);
-    program.set("depth_range", static_cast<float>(margin));
-    program.set("draw_layers", block);
-  }
-  glBindVertexArray(vao);
-
-  const std::size_t layer_voxels = static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y());
-  std::vector<float> readback(layer_voxels * 4 * static_cast<std::size_t>(slab_layers));
-  for (int z0 = 0; z0 < spec.dims.z(); z0 += slab_layers) {
-    const int layers = std::min(slab_layers, spec.dims.z() - z0);
-    const float clear_value[4] = {0.0f, 0.0f, 0.0f, kUntouched};
-    const float clear_depth = 1.0f;
-    glClearNamedFramebufferfv(target.framebuffer(), GL_COLOR, 0, clear_value);
-    glClearNamedFramebufferfv(target.framebuffer(), GL_DEPTH, 0, &clear_depth);
-    for (int first = 0; first < layers; first += block) {
-      for (std::size_t variant = 0; variant < kVariants; ++variant) {
-        const std::size_t list = kVariants * static_cast<std::size_t>((z0 + first) / block) + variant;
-        const std::size_t begin = lists.begin[list], end = lists.begin[list + 1];
-        if (begin == end) continue;
-        gpu::Program& program = programs[variant];
-        program.use();
-        program.set("slab_first_z", z0);
-        program.set("draw_first_layer", first);
-        queue.timed(timer_names[variant], [&] {
-          glDrawElements(GL_LINES_ADJACENCY, static_cast<GLsizei>(end - begin), GL_UNSIGNED_INT,
-                         reinterpret_cast<const void*>(begin * sizeof(std::uint32_t)));
-        });
-        ++stats.draws;
-      }
-    }
-    queue.timed("sdf/readback", [&] {
-      glGetTextureSubImage(target.color(), 0, 0, 0, 0, spec.dims.x(), spec.dims.y(), layers, GL_RGBA, GL_FLOAT,
-                           static_cast<GLsizei>(layer_voxels * 4 * static_cast<std::size_t>(layers) * sizeof(float)),
-                           readback.data());
-    });
-    if (options.keep_texture) {
-      queue.timed("sdf/copy to texture", [&] {
-        glCopyImageSubData(target.color(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, result.texture.id(), GL_TEXTURE_3D, 0, 0,
-                           0, z0, spec.dims.x(), spec.dims.y(), layers);
-      });
-    }
-    if (context.debug()) gpu::check_gl("SDF scan conversion (shaders sdf/scan_convert.*)");
-    for (int layer = 0; layer < layers; ++layer) {
-      const int k = z0 + layer;
-      for (int j = 0; j < spec.dims.y(); ++j) {
-        for (int i = 0; i < spec.dims.x(); ++i) {
-          const float* v = &readback[4 * (static_cast<std::size_t>(layer) * layer_voxels +
-                                          static_cast<std::size_t>(j) * static_cast<std::size_t>(spec.dims.x()) +
-                                          static_cast<std::size_t>(i))];
-          if (!(std::abs(v[3]) < band)) continue;
-          if (accessor) {
-            accessor->setValue(openvdb::Coord(spec.index_offset.x() + i, spec.index_offset.y() + j,
-                                              spec.index_offset.z() + k),
-                               v[3] * h);
-          }
-          ++stats.band_voxels;
-          if (keep_signs) state[spec.linear_index(i, j, k)] = kInBand;
-          if (options.keep_dense) result.dense.values[spec.linear_index(i, j, k)] = {v[0], v[1], v[2], v[3] * h};
-        }
-      }
-    }
-    ++stats.slabs;
-    if (options.progress) options.progress(static_cast<double>(z0 + layers) / spec.dims.z());
-  }
-  glBindVertexArray(0);
-  glDeleteVertexArrays(1, &vao);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-
+  stats.layers_per_slab = plan.slab_layers;
+  stats.degenerate_triangles = plan.geometry.degenerate;
+  stats.needle_triangles = plan.geometry.needles;
+  stats.peak_gpu_bytes = scanner.gpu_bytes();
+  const auto outputs = make_outputs(context, spec, options, queue, library, result);
+  scan_slabs(scanner, outputs, spec, options, queue.checks_errors(), stats);
   // Voxels outside the band take +-band: a closed band separates the inside from the outside, so a
   // flood fill classifies the whole grid (OpenVDB's signedFloodFill for the level set; a fill from
   // the grid border for the dense copy and the texture).
-  if (result.grid) openvdb::tools::signedFloodFill(result.grid->tree());
-  if (keep_signs) flood_fill_outside(spec, state);
-  if (options.keep_dense) fill_dense_off_band(result.dense, state, band * h);
-  if (options.keep_texture) finish_texture(queue, library, result.texture, state, band, h, stats.peak_gpu_bytes);
+  for (const auto& output : outputs) output->finish();
   if (options.timings) stats.timing_report = queue.timing_report();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -5,7 +5,7 @@
 // outside the band hold +-band (world units) with the flood fill's sign and a zero gradient.
 #include <cstddef>
 
-#include "gpu/gl.h"
+#include "gpu/graphics.h"
 #include "sdf/grid.h"
 
 namespace ts::sdf {
@@ -17,20 +17,16 @@ class SdfTexture {
   // Allocates an uninitialised dims.x * dims.y * dims.z RGBA32F texture. Throws GpuError when a side
   // exceeds the GPU's 3D texture limit or the GPU is out of memory. Needs a current context.
   SdfTexture(const GridSpec& spec, int max_3d_texture_size);
-  ~SdfTexture();
-  SdfTexture(SdfTexture&& other) noexcept;
-  SdfTexture& operator=(SdfTexture&& other) noexcept;
-  SdfTexture(const SdfTexture&) = delete;
-  SdfTexture& operator=(const SdfTexture&) = delete;
 
-  GLuint id() const { return id_; }
-  bool empty() const { return id_ == 0; }
+  GLuint id() const { return texture_.id(); }
+  bool empty() const { return texture_.empty(); }
   const GridSpec& spec() const { return spec_; }
-  std::size_t bytes() const { return id_ ? spec_.voxel_count() * 16 : 0; }
+  std::size_t bytes() const { return texture_.bytes(); }
+  const gpu::Texture& texture() const { return texture_; }
 
  private:
   GridSpec spec_;
-  GLuint id_ = 0;
+  gpu::Texture texture_;
 };
 
 }  // namespace ts::sdf

@@ -84,11 +84,7 @@ TS_LAYOUT(SimSpringSlots64) {
 }  // namespace ts::gpu::layout
 #endif
 
-// Buffer binding points, shared by host and kernels.
-#define TS_BINDING_SDF_TRIANGLES 0
-#define TS_BINDING_SDF_PRISMS 1
-
-// The simulator's binding slots are in shaders/sim/bindings.h.
+// Binding slots are not layouts: each stage names its own in shaders/<stage>/bindings.h.
 
 // Motion types (TS_SIM_BODY_VELOCITY.w)
 #define TS_MOTION_DYNAMIC 0

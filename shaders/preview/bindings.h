@@ -1,10 +1,23 @@
 // Buffer bindings and texture units of the preview passes, shared by GLSL and C++ (preview/renderer.cpp).
-// Bindings 26 and up stay clear of the simulator's (0-25), which shares the context in `tetrasand sim`.
+//
+// Slots per pass (program):
+//   particles (particles.vert + particles.frag; shadow map and G-buffer):
+//     buffers TS_PREVIEW_SPHERES, TS_PREVIEW_COLORS
+//   ray cast (raycast.vert + raycast.frag; shadow map and G-buffer):
+//     units TS_PREVIEW_UNIT_VOLUME, TS_PREVIEW_UNIT_PARTICLE_DEPTH
+//   shade (shade.vert + shade.frag; the lighting pass):
+//     units TS_PREVIEW_UNIT_VOLUME, TS_PREVIEW_UNIT_ALBEDO, TS_PREVIEW_UNIT_NORMAL, TS_PREVIEW_UNIT_DEPTH,
+//     TS_PREVIEW_UNIT_SHADOW
+//
+// The buffers sit at 27 and up because the simulator's kernels use bindings 0-26
+// (shaders/common/layouts.h) and share the context in `tetrasand sim`, which renders its frames with
+// this renderer. Every sampler has its own unit: two samplers of different types on one unit make
+// draws fail (GL_INVALID_OPERATION) whether or not the shader reads them.
 #ifndef TETRASAND_PREVIEW_BINDINGS_H
 #define TETRASAND_PREVIEW_BINDINGS_H
 
-#define TS_PREVIEW_SPHERES 26  // vec4[]: xyz centre relative to the scene centre [m], w radius [m]
-#define TS_PREVIEW_COLORS 27   // uint[]: sRGB colour per sphere, RGBA8 with red in the low byte
+#define TS_PREVIEW_SPHERES 27  // vec4[]: xyz centre relative to the scene centre [m], w radius [m]
+#define TS_PREVIEW_COLORS 28   // uint[]: sRGB colour per sphere, RGBA8 with red in the low byte
 
 #define TS_PREVIEW_UNIT_VOLUME 0          // sampler3D: signed distance [voxels]
 #define TS_PREVIEW_UNIT_PARTICLE_DEPTH 1  // sampler2D: window depth of the particle layer

@@ -10,7 +10,7 @@
 #include "preview/camera.glsl"
 #include "preview/volume.glsl"
 
-uniform sampler2D particle_depth;  // window depth of the particle layer (1: none)
+layout(binding = TS_PREVIEW_UNIT_PARTICLE_DEPTH) uniform sampler2D particle_depth;  // window depth of the particle layer (1: none)
 uniform int use_particle_depth;
 uniform int depth_only;            // shadow pass: depth, no normal
 uniform int max_steps;

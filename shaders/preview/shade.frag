@@ -8,10 +8,10 @@
 #include "preview/camera.glsl"
 #include "preview/volume.glsl"
 
-uniform sampler2D albedo_texture;
-uniform sampler2D normal_texture;
-uniform sampler2D depth_texture;
-uniform sampler2DShadow shadow_map;
+layout(binding = TS_PREVIEW_UNIT_ALBEDO) uniform sampler2D albedo_texture;
+layout(binding = TS_PREVIEW_UNIT_NORMAL) uniform sampler2D normal_texture;
+layout(binding = TS_PREVIEW_UNIT_DEPTH) uniform sampler2D depth_texture;
+layout(binding = TS_PREVIEW_UNIT_SHADOW) uniform sampler2DShadow shadow_map;
 uniform mat4 light_view_projection;  // relative world -> the light's clip space
 uniform int shadows;
 uniform float shadow_texel;          // [m] per shadow-map texel

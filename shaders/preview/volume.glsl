@@ -3,7 +3,9 @@
 #ifndef TETRASAND_PREVIEW_VOLUME_GLSL
 #define TETRASAND_PREVIEW_VOLUME_GLSL
 
-uniform sampler3D volume;
+#include "preview/bindings.h"
+
+layout(binding = TS_PREVIEW_UNIT_VOLUME) uniform sampler3D volume;
 uniform vec3 volume_origin;  // voxel (0,0,0)'s centre, relative to the scene centre [m]
 uniform float voxel_size;    // [m]
 uniform vec3 volume_dims;    // voxels along x, y, z

@@ -4,9 +4,10 @@
 // triangle, signed by the pseudonormal of the closest feature. The depth test (GL_LESS on |d|) keeps,
 // per voxel, the triangle nearest to it, over all triangles and all geometry-shader invocations.
 #include "common/layouts.h"
+#include "sdf/bindings.h"
 #include "sdf/closest_point.glsl"
 
-layout(std430, binding = TS_BINDING_SDF_TRIANGLES) readonly buffer Triangles { SdfTriangle triangles[]; };
+layout(std430, binding = TS_SDF_TRIANGLES) readonly buffer Triangles { SdfTriangle triangles[]; };
 
 uniform int slab_first_z;
 uniform float depth_range;  // |d| [voxels] that maps to depth 1; beyond it the fragment is dropped

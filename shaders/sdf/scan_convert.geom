@@ -9,6 +9,7 @@
 // INVOCATIONS * LAYERS_PER_INVOCATION layers starting at draw_first_layer, and the host issues as many
 // draws per slab as the slab has layers. Worst case per layer: a box prism = 6 tetrahedra x 4 vertices.
 #include "common/layouts.h"
+#include "sdf/bindings.h"
 
 // The host compiles two variants: INVOCATIONS 32 for triangles whose prism spans many layers, and
 // INVOCATIONS 4 for the common small ones, so a small triangle does not pay for 28 idle invocations.
@@ -19,7 +20,7 @@
 layout(lines_adjacency, invocations = INVOCATIONS) in;
 layout(triangle_strip, max_vertices = 96) out;
 
-layout(std430, binding = TS_BINDING_SDF_PRISMS) readonly buffer Prisms { SdfPrism prisms[]; };
+layout(std430, binding = TS_SDF_PRISMS) readonly buffer Prisms { SdfPrism prisms[]; };
 
 uniform int slab_first_z;      // grid z index of render-target layer 0
 uniform int slab_layers;       // layers in the render target
