@@ -38,7 +38,7 @@ struct Options {
   int rounds = 12, max_iterations = 2000;
   std::size_t sdf_budget_mib = 1024;
   std::string sign = "pseudonormal";
-  bool json = false, timings = false, allow_open = false, fill = false;
+  bool json = false, timings = false, allow_open = false, fill = false, preview = false;
 };
 
 struct BatchRow {
@@ -48,9 +48,6 @@ struct BatchRow {
   body::ParticleBody::Quality quality;
   double radius = 0.0;
 };
-
-int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& write_preview, gpu::Context& context,
-                BatchRow& row);
 
 // Lines of a list file: one mesh path each, relative to the list's folder unless absolute; blank
 // lines and lines starting with # are skipped.
@@ -134,184 +131,216 @@ std::filesystem::path summary_path(const Options& o) {
   return std::filesystem::path(o.output) / fmt::format("summary-{}-of-{}.csv", s.index, s.count);
 }
 
-}  // namespace
+// Options are registered in the order --help lists them.
+void add_input_options(CLI::App* cmd, Options& o) {
+  cmd->add_option("MESH", o.inputs, "Closed, consistently oriented triangle meshes; @FILE reads a list (one path a line)");
+  cmd->add_option("--list", o.list, "File listing meshes to convert, one path a line (relative to the file)");
+  cmd->add_option("--shard", o.shard, "I/N: convert only meshes k with k mod N = I of the expanded list (0 <= I < N)");
+  cmd->add_option("--summary", o.summary, "Summary CSV of a batch (default DIR/summary.csv, DIR/summary-I-of-N.csv with --shard)");
+  cmd->add_option("-o,--output", o.output, "Output directory")->capture_default_str();
+}
 
-Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
-  auto* cmd = app.add_subcommand("sample", "Convert a closed mesh into a particle rigid body (NAME.particles.ply + NAME.body.json)");
-  auto o = std::make_shared<Options>();
-  cmd->add_option("MESH", o->inputs, "Closed, consistently oriented triangle meshes; @FILE reads a list (one path a line)");
-  cmd->add_option("--list", o->list, "File listing meshes to convert, one path a line (relative to the file)");
-  cmd->add_option("--shard", o->shard, "I/N: convert only meshes k with k mod N = I of the expanded list (0 <= I < N)");
-  cmd->add_option("--summary", o->summary, "Summary CSV of a batch (default DIR/summary.csv, DIR/summary-I-of-N.csv with --shard)");
-  cmd->add_option("-o,--output", o->output, "Output directory")->capture_default_str();
-  auto* radius = cmd->add_option("--radius", o->radius, "Particle radius [m]")->check(CLI::PositiveNumber);
-  cmd->add_option("--count", o->count, "Particle count instead of a radius")->check(CLI::PositiveNumber)->excludes(radius);
-  cmd->add_option("--density", o->density, "Density of the solid [kg/m^3]")->check(CLI::PositiveNumber)->capture_default_str();
-  cmd->add_option("--seed", o->seed, "Seed of the generator that places the particles")->capture_default_str();
-  cmd->add_option("--coverage", o->coverage,
+// Size, density, placement and the accuracy of the arrangement.
+void add_sampling_options(CLI::App* cmd, Options& o) {
+  auto* radius = cmd->add_option("--radius", o.radius, "Particle radius [m]")->check(CLI::PositiveNumber);
+  cmd->add_option("--count", o.count, "Particle count instead of a radius")->check(CLI::PositiveNumber)->excludes(radius);
+  cmd->add_option("--density", o.density, "Density of the solid [kg/m^3]")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--seed", o.seed, "Seed of the generator that places the particles")->capture_default_str();
+  cmd->add_option("--coverage", o.coverage,
                   "Target covering radius / r: 1 = the particle spheres cover the surface; up to (r + r_grain) / r "
                   "still stops grains of radius r_grain")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--grain-radius", o->grain_radius, "Grain radius [m] for the leak figure c / (r + r_grain)")
+  cmd->add_option("--grain-radius", o.grain_radius, "Grain radius [m] for the leak figure c / (r + r_grain)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--voxel", o->voxel, "SDF voxel [m] (default r / 2)")->check(CLI::PositiveNumber);
-  cmd->add_option("--rounds", o->rounds, "Most hole-closing rounds")->check(CLI::NonNegativeNumber)->capture_default_str();
-  cmd->add_option("--probes", o->probes, "Surface points the covering radius is measured on")->capture_default_str();
-  cmd->add_option("--scale", o->scale, "Multiply coordinates by this factor first")->check(CLI::PositiveNumber);
-  cmd->add_option("--max-iterations", o->max_iterations, "Most relaxation steps of the first relaxation (later rounds: 200)")
+  cmd->add_option("--voxel", o.voxel, "SDF voxel [m] (default r / 2)")->check(CLI::PositiveNumber);
+  cmd->add_option("--rounds", o.rounds, "Most hole-closing rounds")->check(CLI::NonNegativeNumber)->capture_default_str();
+  cmd->add_option("--probes", o.probes, "Surface points the covering radius is measured on")->capture_default_str();
+  cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor first")->check(CLI::PositiveNumber);
+  cmd->add_option("--max-iterations", o.max_iterations, "Most relaxation steps of the first relaxation (later rounds: 200)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--sdf-budget-mib", o->sdf_budget_mib,
+  cmd->add_option("--sdf-budget-mib", o.sdf_budget_mib,
                   "GPU memory for the dense SDF texture [MiB]; past it the voxel grows beyond r / 2 (with a warning), "
                   "which coarsens very large counts: raise it on GPUs with more memory")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--sign", o->sign,
+}
+
+// Inside and outside, the interior, and what is printed or written besides the body.
+void add_solid_and_output_options(CLI::App* cmd, Options& o) {
+  cmd->add_option("--sign", o.sign,
                   "Inside/outside by pseudonormals (closed meshes only) or by the generalised winding number "
                   "(also open or non-manifold meshes: they are sampled with a warning, their mass properties "
                   "integrated over the winding-number solid)")
       ->check(CLI::IsMember({"pseudonormal", "winding"}))
       ->capture_default_str();
-  cmd->add_flag("--allow-open", o->allow_open, "Same as --sign winding (the older name)");
-  cmd->add_flag("--fill", o->fill,
+  cmd->add_flag("--allow-open", o.allow_open, "Same as --sign winding (the older name)");
+  cmd->add_flag("--fill", o.fill,
                 "Also fill the inside: particles on a face-centred cubic lattice of spacing 2r wherever phi <= -r "
                 "(after the surface ones in the PLY, with normal 0 0 0)");
-  cmd->add_flag("--json", o->json, "Print the body.json summary on stdout");
-  cmd->add_flag("--timings", o->timings, "Per-kernel GPU times");
-  auto write_preview = std::make_shared<bool>(false);
-  cmd->add_flag("--preview", *write_preview, "Also write NAME.preview.png: the mesh's SDF ray-cast with the particles over it");
-  return [o, write_preview, &global] {
-    if (o->inputs.empty() && o->list.empty()) throw Error(ExitCode::Usage, "sample: give at least one MESH or --list FILE");
-    const std::vector<std::string> meshes = expand_inputs(*o);
-    o->batch = meshes.size() > 1 || !o->list.empty() || !o->shard.empty() || !o->summary.empty() ||
-               (!o->inputs.empty() && o->inputs[0].rfind('@', 0) == 0);
-    gpu::ContextOptions context_options;
-    context_options.device = global.device;
-    context_options.debug = global.gl_debug;
-    gpu::Context context(context_options);  // one context for the whole batch
-    BatchRow row;
-    if (!o->batch) {
-      o->mesh = meshes.front();
-      return convert_one(o, write_preview, context, row);
-    }
-    std::vector<BatchRow> rows;
-    std::set<std::string> names;
-    int failed = 0, first_code = 0;
-    for (const std::string& path : meshes) {
-      auto one = std::make_shared<Options>(*o);
-      one->mesh = path;
-      BatchRow r;
-      r.mesh = path;
-      try {
-        if (!names.insert(std::filesystem::path(path).stem().string()).second) {
-          throw InputError(path, "another mesh of the batch has the same name; its outputs would overwrite");
-        }
-        convert_one(one, write_preview, context, r);
-      } catch (const GpuError&) {
-        throw;  // the context is gone: no later mesh can run
-      } catch (const Error& e) {
-        r.status = "failed", r.error = e.what(), r.exit_code = static_cast<int>(e.code());
-        log::error("{}", e.what());
-      }
-      if (r.exit_code != 0 && failed++ == 0) first_code = r.exit_code;
-      rows.push_back(r);
-    }
-    const std::filesystem::path csv = summary_path(*o);
-    write_summary(csv, rows);
-    if (!o->json) fmt::print("{} of {} meshes converted; summary: {}\n", rows.size() - failed, rows.size(), csv.string());
-    return first_code;
-  };
+  cmd->add_flag("--json", o.json, "Print the body.json summary on stdout");
+  cmd->add_flag("--timings", o.timings, "Per-kernel GPU times");
+  cmd->add_flag("--preview", o.preview, "Also write NAME.preview.png: the mesh's SDF ray-cast with the particles over it");
 }
 
-namespace {
-int convert_one(const std::shared_ptr<Options>& o, const std::shared_ptr<bool>& write_preview, gpu::Context& context,
-                BatchRow& row) {
-  {
-    TriangleMesh mesh = load_mesh(o->mesh);
-    if (o->scale != 1.0) scale_mesh(mesh, o->scale);
-    const MeshReport report = analyze_mesh(mesh);
-    const bool winding = o->sign == "winding" || o->allow_open;
-    sampler::SampleSettings settings;
-    settings.sign = winding ? sdf::SignMethod::Winding : sdf::SignMethod::Pseudonormal;
-    if (!report.watertight()) {
-      if (!winding) {
-        throw InputError(o->mesh, "is not a closed, consistently oriented solid (" + closed_solid_problems(report) +
-                                      "); `tetrasand info` shows the full report; --sign winding samples it anyway\n" +
-                                      format_report(report));
-      }
-      log::warn("{}: not a closed solid ({}): sampled with winding-number signs; the particles cover the mesh's own "
-                "surface only (holes stay open), mass properties come from the winding-number solid",
-                o->mesh, closed_solid_problems(report));
-      settings.mass_method = body::MassMethod::WindingCells;
-    }
-    settings.radius = o->radius;
-    settings.count = o->count;
-    settings.coverage = o->coverage;
-    settings.grain_radius = o->grain_radius;
-    settings.voxel_size = o->voxel;
-    settings.density = o->density;
-    settings.seed = o->seed;
-    settings.max_rounds = o->rounds;
-    settings.probes = o->probes;
-    settings.timings = o->timings;
-    settings.relax.max_iterations = o->max_iterations;
-    settings.fill = o->fill;
-    settings.max_sdf_bytes = o->sdf_budget_mib << 20;
-
-    const bool terminal = ::isatty(STDERR_FILENO) != 0;
-    const auto progress = [&](const sampler::SampleProgress& p) {
-      const std::string line = fmt::format("round {}  iteration {:>5}  particles {:>8}  residual {:.2e}", p.round,
-                                           p.iteration, p.particles, p.residual);
-      if (terminal) std::fprintf(stderr, "\r%s   ", line.c_str());
-    };
-    sampler::SampleResult result = sampler::sample_mesh(context, mesh, settings, progress);
-    if (terminal) std::fprintf(stderr, "\n");
-    for (const auto& warning : result.warnings) log::warn("{}", warning);
-
-    body::ParticleBody& body = result.body;
-    body.source_path = o->mesh;
-    body.source_sha256 = sha256_file(o->mesh);
-    const std::string name = std::filesystem::path(o->mesh).stem().string();
-    const std::filesystem::path json = body::write_body(o->output, name, body);
-    const auto& q = body.quality;
-    row.status = "ok", row.body_json = json.string(), row.particles = body.positions.size();
-    row.quality = q, row.radius = body.particle_radius;
-    if (o->json) {
-      std::ifstream in(json);
-      fmt::print("{}\n", nlohmann::json::parse(in).dump(o->batch ? -1 : 2));  // a batch prints JSON Lines
-    } else {
-      fmt::print("{} -> {}\n", o->mesh, json.string());
-      const std::size_t surface = body.positions.size() - body.interior_count;
-      fmt::print("  particles        {} of radius {:.6g} m on the surface (area estimate {}, {:+.1f} %)\n", surface,
-                 body.particle_radius, result.estimated_count,
-                 100.0 * (static_cast<double>(surface) / static_cast<double>(result.estimated_count) - 1.0));
-      if (o->fill) {
-        fmt::print("  interior         {} on an FCC lattice of spacing 2r (estimate from V - A r: {:.0f}); {} in all\n",
-                   body.interior_count, result.estimated_interior, body.positions.size());
-      }
-      fmt::print("  evenness         relative radius {:.3f}, CV of nearest-neighbour distances {:.3f}\n",
-                 q.relative_radius, q.cv);
-      fmt::print("  coverage         covering radius {:.6g} m = {:.3f} r{}\n", q.covering_radius, q.covering_over_r,
-                 q.covering_over_r_plus_grain ? fmt::format(" = {:.3f} (r + r_grain)", *q.covering_over_r_plus_grain) : "");
-      fmt::print("  on the surface   largest |phi| = {:.2e} r\n", q.max_abs_phi_over_r);
-      fmt::print("  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {}\n", q.iterations,
-                 q.injection_rounds, q.converged ? "converged" : "NOT converged", q.seconds, context.summary());
-      fmt::print("  mass properties  {:.6g} kg, volume {:.6g} m^3, centre of mass ({:.6g}, {:.6g}, {:.6g}) m, {}\n", body.mass,
-                 body.volume, body.center_of_mass.x(), body.center_of_mass.y(), body.center_of_mass.z(),
-                 body.mass_method == body::MassMethod::WindingCells
-                     ? fmt::format("from the winding-number solid (cells of {:.3g} m)", body.mass_cell)
-                     : std::string("from the closed mesh"));
-    }
-    if (o->timings) fmt::print("{}", result.timing_report);
-    if (*write_preview) {
-      const std::filesystem::path png = std::filesystem::path(o->output) / (name + ".preview.png");
-      preview::write_body_preview(context, mesh, body, png, {o->mesh});
-      log::info("preview: {}", png.string());
-    }
-    return 0;
+// The mesh, scaled, and the sign and mass methods it allows: an open or inconsistent mesh is refused
+// unless --sign winding, which samples it from its winding-number solid.
+TriangleMesh load_sample_mesh(const Options& o, sampler::SampleSettings& settings) {
+  TriangleMesh mesh = load_mesh(o.mesh);
+  if (o.scale != 1.0) scale_mesh(mesh, o.scale);
+  const MeshReport report = analyze_mesh(mesh);
+  const bool winding = o.sign == "winding" || o.allow_open;
+  settings.sign = winding ? sdf::SignMethod::Winding : sdf::SignMethod::Pseudonormal;
+  if (report.watertight()) return mesh;
+  if (!winding) {
+    throw InputError(o.mesh, "is not a closed, consistently oriented solid (" + closed_solid_problems(report) +
+                                 "); `tetrasand info` shows the full report; --sign winding samples it anyway\n" +
+                                 format_report(report));
   }
+  log::warn("{}: not a closed solid ({}): sampled with winding-number signs; the particles cover the mesh's own "
+            "surface only (holes stay open), mass properties come from the winding-number solid",
+            o.mesh, closed_solid_problems(report));
+  settings.mass_method = body::MassMethod::WindingCells;
+  return mesh;
 }
+
+void set_sampling(const Options& o, sampler::SampleSettings& settings) {
+  settings.radius = o.radius;
+  settings.count = o.count;
+  settings.coverage = o.coverage;
+  settings.grain_radius = o.grain_radius;
+  settings.voxel_size = o.voxel;
+  settings.density = o.density;
+  settings.seed = o.seed;
+  settings.max_rounds = o.rounds;
+  settings.probes = o.probes;
+  settings.timings = o.timings;
+  settings.relax.max_iterations = o.max_iterations;
+  settings.fill = o.fill;
+  settings.max_sdf_bytes = o.sdf_budget_mib << 20;
+}
+
+sampler::SampleResult sample_with_progress(gpu::Context& context, const TriangleMesh& mesh,
+                                           const sampler::SampleSettings& settings) {
+  const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  const auto progress = [&](const sampler::SampleProgress& p) {
+    const std::string line = fmt::format("round {}  iteration {:>5}  particles {:>8}  residual {:.2e}", p.round,
+                                         p.iteration, p.particles, p.residual);
+    if (terminal) std::fprintf(stderr, "\r%s   ", line.c_str());
+  };
+  sampler::SampleResult result = sampler::sample_mesh(context, mesh, settings, progress);
+  if (terminal) std::fprintf(stderr, "\n");
+  for (const auto& warning : result.warnings) log::warn("{}", warning);
+  return result;
+}
+
+void print_body_report(const Options& o, const sampler::SampleResult& result, const std::filesystem::path& json,
+                       const gpu::Context& context) {
+  const body::ParticleBody& body = result.body;
+  const auto& q = body.quality;
+  fmt::print("{} -> {}\n", o.mesh, json.string());
+  const std::size_t surface = body.positions.size() - body.interior_count;
+  fmt::print("  particles        {} of radius {:.6g} m on the surface (area estimate {}, {:+.1f} %)\n", surface,
+             body.particle_radius, result.estimated_count,
+             100.0 * (static_cast<double>(surface) / static_cast<double>(result.estimated_count) - 1.0));
+  if (o.fill) {
+    fmt::print("  interior         {} on an FCC lattice of spacing 2r (estimate from V - A r: {:.0f}); {} in all\n",
+               body.interior_count, result.estimated_interior, body.positions.size());
+  }
+  fmt::print("  evenness         relative radius {:.3f}, CV of nearest-neighbour distances {:.3f}\n",
+             q.relative_radius, q.cv);
+  fmt::print("  coverage         covering radius {:.6g} m = {:.3f} r{}\n", q.covering_radius, q.covering_over_r,
+             q.covering_over_r_plus_grain ? fmt::format(" = {:.3f} (r + r_grain)", *q.covering_over_r_plus_grain) : "");
+  fmt::print("  on the surface   largest |phi| = {:.2e} r\n", q.max_abs_phi_over_r);
+  fmt::print("  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {}\n", q.iterations,
+             q.injection_rounds, q.converged ? "converged" : "NOT converged", q.seconds, context.summary());
+  fmt::print("  mass properties  {:.6g} kg, volume {:.6g} m^3, centre of mass ({:.6g}, {:.6g}, {:.6g}) m, {}\n", body.mass,
+             body.volume, body.center_of_mass.x(), body.center_of_mass.y(), body.center_of_mass.z(),
+             body.mass_method == body::MassMethod::WindingCells
+                 ? fmt::format("from the winding-number solid (cells of {:.3g} m)", body.mass_cell)
+                 : std::string("from the closed mesh"));
+}
+
+// One mesh: sample, write the body (and its preview), report; `row` gets the batch summary's figures.
+int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
+  sampler::SampleSettings settings;
+  const TriangleMesh mesh = load_sample_mesh(o, settings);
+  set_sampling(o, settings);
+  sampler::SampleResult result = sample_with_progress(context, mesh, settings);
+  body::ParticleBody& body = result.body;
+  body.source_path = o.mesh;
+  body.source_sha256 = sha256_file(o.mesh);
+  const std::string name = std::filesystem::path(o.mesh).stem().string();
+  const std::filesystem::path json = body::write_body(o.output, name, body);
+  row.status = "ok", row.body_json = json.string(), row.particles = body.positions.size();
+  row.quality = body.quality, row.radius = body.particle_radius;
+  if (o.json) {
+    std::ifstream in(json);
+    fmt::print("{}\n", nlohmann::json::parse(in).dump(o.batch ? -1 : 2));  // a batch prints JSON Lines
+  } else {
+    print_body_report(o, result, json, context);
+  }
+  if (o.timings) fmt::print("{}", result.timing_report);
+  if (o.preview) {
+    const std::filesystem::path png = std::filesystem::path(o.output) / (name + ".preview.png");
+    preview::write_body_preview(context, mesh, body, png, {o.mesh});
+    log::info("preview: {}", png.string());
+  }
+  return 0;
+}
+
+// Every mesh of a batch, a failure a row of the summary; returns the first failure's exit code.
+int run_batch(const Options& o, const std::vector<std::string>& meshes, gpu::Context& context) {
+  std::vector<BatchRow> rows;
+  std::set<std::string> names;
+  int failed = 0, first_code = 0;
+  for (const std::string& path : meshes) {
+    Options one = o;
+    one.mesh = path;
+    BatchRow r;
+    r.mesh = path;
+    try {
+      if (!names.insert(std::filesystem::path(path).stem().string()).second) {
+        throw InputError(path, "another mesh of the batch has the same name; its outputs would overwrite");
+      }
+      convert_one(one, context, r);
+    } catch (const GpuError&) {
+      throw;  // the context is gone: no later mesh can run
+    } catch (const Error& e) {
+      r.status = "failed", r.error = e.what(), r.exit_code = static_cast<int>(e.code());
+      log::error("{}", e.what());
+    }
+    if (r.exit_code != 0 && failed++ == 0) first_code = r.exit_code;
+    rows.push_back(r);
+  }
+  const std::filesystem::path csv = summary_path(o);
+  write_summary(csv, rows);
+  if (!o.json) fmt::print("{} of {} meshes converted; summary: {}\n", rows.size() - failed, rows.size(), csv.string());
+  return first_code;
+}
+
+int run_sample(Options& o, const GlobalOptions& global) {
+  if (o.inputs.empty() && o.list.empty()) throw Error(ExitCode::Usage, "sample: give at least one MESH or --list FILE");
+  const std::vector<std::string> meshes = expand_inputs(o);
+  o.batch = meshes.size() > 1 || !o.list.empty() || !o.shard.empty() || !o.summary.empty() ||
+            (!o.inputs.empty() && o.inputs[0].rfind('@', 0) == 0);
+  gpu::Context context(context_options(global));  // one context for the whole batch
+  if (o.batch) return run_batch(o, meshes, context);
+  o.mesh = meshes.front();
+  BatchRow row;
+  return convert_one(o, context, row);
+}
+
 }  // namespace
+
+Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
+  auto* cmd = app.add_subcommand("sample", "Convert a closed mesh into a particle rigid body (NAME.particles.ply + NAME.body.json)");
+  auto o = std::make_shared<Options>();
+  add_input_options(cmd, *o);
+  add_sampling_options(cmd, *o);
+  add_solid_and_output_options(cmd, *o);
+  return [o, &global] { return run_sample(*o, global); };
+}
 
 }  // namespace ts::app

@@ -14,82 +14,104 @@
 #include "sim/scene_runner.h"
 
 namespace ts::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Options {
+  std::string scene;
+  std::string output = "sim-out";
+  double duration = 0;  // s; 0 = the scene's
+  bool cpu = false;
+  std::string precision = "float";
+  bool timings = false;
+};
+
+void add_options(CLI::App* cmd, Options& o) {
+  cmd->add_option("SCENE", o.scene, "Scene file (TOML; see assets/scenes/README.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", o.output, "Output directory (metrics.csv, particle dumps, frames)")->capture_default_str();
+  cmd->add_option("--duration", o.duration, "Simulated time [s], overriding the scene's")->check(CLI::PositiveNumber);
+  cmd->add_flag("--cpu", o.cpu, "Use the double-precision CPU reference instead of the GPU pipeline");
+  cmd->add_option("--precision", o.precision, "GPU arithmetic: float or double (GLSL fp64)")
+      ->check(CLI::IsMember({"float", "double"}))
+      ->capture_default_str();
+  cmd->add_flag("--timings", o.timings, "Print per-kernel GPU times at the end");
+}
+
+// A live line on a terminal, else a log line per output: time, step rate, contacts and the time left.
+void report_progress(const sim::Scene& scene, const sim::World& world, const sim::StepStats& stats, std::int64_t step,
+                     Clock::time_point start, bool terminal) {
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  const double rate = elapsed > 0 ? static_cast<double>(step) / elapsed : 0.0;
+  const double remaining = rate > 0 ? (scene.simulation.duration - world.time) / world.time * elapsed : 0.0;
+  const std::string line = fmt::format("t = {:.4f} / {:.4f} s  step {}  {:.0f} steps/s  contacts {}  ETA {:.0f} s",
+                                       world.time, scene.simulation.duration, step, rate, stats.contacts,
+                                       world.time > 0 ? remaining : 0.0);
+  if (terminal) {
+    std::fprintf(stderr, "\r%s   ", line.c_str());
+  } else {
+    log::info("{}", line);
+  }
+}
+
+void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResult& result, double seconds,
+                   const gpu::Context* context) {
+  fmt::print("{}: {} steps of {:.3g} s, {} grains, {:.1f} s wall ({:.3g} grain-steps/s, {})\n", o.scene, result.steps,
+             result.dt, result.grains, seconds,
+             seconds > 0 ? static_cast<double>(result.steps) * static_cast<double>(result.grains) / seconds : 0.0,
+             o.cpu ? "CPU reference" : context->summary());
+  fmt::print("clamps: {} velocity, {} angular velocity, {} overlap (each clamp means a less accurate result)\n",
+             result.last.velocity_clamps, result.last.angular_velocity_clamps, result.last.overlap_clamps);
+  if (scene.simulation.step.tangential == sim::TangentialModel::Spring) {
+    fmt::print("spring slots: {} overflows over the run (a contact past {} per particle has no static friction)\n",
+               result.spring_overflows, sim::ContactSprings::kSlots);
+  }
+  fmt::print("outputs: {}/metrics.csv ({} rows)\n", o.output, result.outputs);
+}
+
+int run_sim(const Options& o, const GlobalOptions& global) {
+  sim::Scene scene = sim::load_scene(o.scene);
+  if (o.duration > 0) scene.simulation.duration = o.duration;
+  std::unique_ptr<gpu::Context> context;
+  sim::StepperFactory make_stepper;
+  if (!o.cpu) {
+    context = std::make_unique<gpu::Context>(context_options(global));
+    const auto precision = o.precision == "double" ? sim::Precision::Double : sim::Precision::Float;
+    make_stepper = [&, precision](const sim::StepSettings& settings) -> std::unique_ptr<sim::Stepper> {
+      return std::make_unique<sim::GpuStepper>(*context, settings, precision, o.timings);
+    };
+  }
+  const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  const auto start = Clock::now();
+  sim::RunHooks hooks;
+  std::unique_ptr<preview::SimFrameWriter> frames;  // [output] frames = true: PNGs through the preview renderer
+  if (scene.output.frames) {
+    if (!context) context = std::make_unique<gpu::Context>(context_options(global));
+    frames = std::make_unique<preview::SimFrameWriter>(*context, scene);
+    hooks.write_frame = [&frames](const sim::World& world, std::int64_t frame, const std::filesystem::path& dir) {
+      frames->write(world, frame, dir);
+    };
+  }
+  hooks.on_output = [&](const sim::World& world, const sim::StepStats& stats, std::int64_t step) {
+    report_progress(scene, world, stats, step, start, terminal);
+  };
+  std::string timing_report;
+  if (o.timings) hooks.on_finish = [&](sim::Stepper& stepper) { timing_report = stepper.timing_report(); };
+  const sim::RunResult result = sim::run_scene(scene, o.output, hooks, make_stepper);
+  if (terminal) std::fprintf(stderr, "\n");
+  if (!result.time_step_warning.empty()) log::warn("{}", result.time_step_warning);
+  print_summary(o, scene, result, std::chrono::duration<double>(Clock::now() - start).count(), context.get());
+  if (!timing_report.empty()) fmt::print("{}", timing_report);
+  return 0;
+}
+
+}  // namespace
 
 Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
   auto* cmd = app.add_subcommand("sim", "Run a tetrahedral-grain DEM scene (TOML) on the GPU");
-  struct Options {
-    std::string scene;
-    std::string output = "sim-out";
-    double duration = 0;  // s; 0 = the scene's
-    bool cpu = false;
-    std::string precision = "float";
-    bool timings = false;
-  };
   auto o = std::make_shared<Options>();
-  cmd->add_option("SCENE", o->scene, "Scene file (TOML; see assets/scenes/README.md)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", o->output, "Output directory (metrics.csv, particle dumps, frames)")->capture_default_str();
-  cmd->add_option("--duration", o->duration, "Simulated time [s], overriding the scene's")->check(CLI::PositiveNumber);
-  cmd->add_flag("--cpu", o->cpu, "Use the double-precision CPU reference instead of the GPU pipeline");
-  cmd->add_option("--precision", o->precision, "GPU arithmetic: float or double (GLSL fp64)")
-      ->check(CLI::IsMember({"float", "double"}))
-      ->capture_default_str();
-  cmd->add_flag("--timings", o->timings, "Print per-kernel GPU times at the end");
-  return [o, &global] {
-    sim::Scene scene = sim::load_scene(o->scene);
-    if (o->duration > 0) scene.simulation.duration = o->duration;
-    std::unique_ptr<gpu::Context> context;
-    sim::StepperFactory make_stepper;
-    if (!o->cpu) {
-      context = std::make_unique<gpu::Context>(context_options(global));
-      make_stepper = [&](const sim::StepSettings& settings) -> std::unique_ptr<sim::Stepper> {
-        return std::make_unique<sim::GpuStepper>(
-            *context, settings, o->precision == "double" ? sim::Precision::Double : sim::Precision::Float, o->timings);
-      };
-    }
-    const bool terminal = ::isatty(STDERR_FILENO) != 0;
-    const auto start = std::chrono::steady_clock::now();
-    sim::RunHooks hooks;
-    std::unique_ptr<preview::SimFrameWriter> frames;  // [output] frames = true: PNGs through the preview renderer
-    if (scene.output.frames) {
-      if (!context) context = std::make_unique<gpu::Context>(context_options(global));
-      frames = std::make_unique<preview::SimFrameWriter>(*context, scene);
-      hooks.write_frame = [&frames](const sim::World& world, std::int64_t frame, const std::filesystem::path& dir) {
-        frames->write(world, frame, dir);
-      };
-    }
-    hooks.on_output = [&](const sim::World& world, const sim::StepStats& stats, std::int64_t step) {
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const double rate = elapsed > 0 ? static_cast<double>(step) / elapsed : 0.0;
-      const double remaining = rate > 0 ? (scene.simulation.duration - world.time) / world.time * elapsed : 0.0;
-      const std::string line = fmt::format("t = {:.4f} / {:.4f} s  step {}  {:.0f} steps/s  contacts {}  ETA {:.0f} s",
-                                           world.time, scene.simulation.duration, step, rate, stats.contacts,
-                                           world.time > 0 ? remaining : 0.0);
-      if (terminal) {
-        std::fprintf(stderr, "\r%s   ", line.c_str());
-      } else {
-        log::info("{}", line);
-      }
-    };
-    std::string timing_report;
-    if (o->timings) hooks.on_finish = [&](sim::Stepper& stepper) { timing_report = stepper.timing_report(); };
-    const sim::RunResult result = sim::run_scene(scene, o->output, hooks, make_stepper);
-    if (terminal) std::fprintf(stderr, "\n");
-    if (!result.time_step_warning.empty()) log::warn("{}", result.time_step_warning);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    fmt::print("{}: {} steps of {:.3g} s, {} grains, {:.1f} s wall ({:.3g} grain-steps/s, {})\n", o->scene,
-               result.steps, result.dt, result.grains, seconds,
-               seconds > 0 ? static_cast<double>(result.steps) * static_cast<double>(result.grains) / seconds : 0.0,
-               o->cpu ? "CPU reference" : context->summary());
-    fmt::print("clamps: {} velocity, {} angular velocity, {} overlap (each clamp means a less accurate result)\n",
-               result.last.velocity_clamps, result.last.angular_velocity_clamps, result.last.overlap_clamps);
-    if (scene.simulation.step.tangential == sim::TangentialModel::Spring) {
-      fmt::print("spring slots: {} overflows over the run (a contact past {} per particle has no static friction)\n",
-                 result.spring_overflows, sim::ContactSprings::kSlots);
-    }
-    fmt::print("outputs: {}/metrics.csv ({} rows)\n", o->output, result.outputs);
-    if (!timing_report.empty()) fmt::print("{}", timing_report);
-    return 0;
-  };
+  add_options(cmd, *o);
+  return [o, &global] { return run_sim(*o, global); };
 }
 
 }  // namespace ts::app

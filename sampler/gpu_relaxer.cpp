@@ -27,7 +27,7 @@ std::size_t GpuRelaxer::gpu_bytes() const {
 }
 
 void GpuRelaxer::bind_sdf(const gpu::Program& program) const {
-  glBindTextureUnit(TS_SAMPLER_UNIT_SDF, texture_.id());
+  texture_.texture().bind_unit(TS_SAMPLER_UNIT_SDF);
   program.set("voxel_size", static_cast<float>(spec_.voxel_size));
   program.set("sdf_dims", static_cast<float>(spec_.dims.x()), static_cast<float>(spec_.dims.y()),
               static_cast<float>(spec_.dims.z()));

@@ -88,42 +88,59 @@ double max_radius(const World& world) {
 
 }  // namespace
 
+// The spring of the contact being visited: found in a particle's old slots (zero for a new contact)
+// and, when stepping, kept in its new ones. Without springs find() gives null (viscous friction only).
+class CpuContacts::SpringLookup {
+ public:
+  explicit SpringLookup(SpringSlots* slots) : slots_(slots) {}
+  Eigen::Vector3d* find(std::int64_t partner) {
+    if (!slots_) return nullptr;
+    spring_.setZero();
+    for (std::size_t k = 0; k < ContactSprings::kSlots && slots_->old_partner; ++k) {
+      if (slots_->old_partner[k] == partner) spring_ = slots_->old_displacement[k];
+    }
+    return &spring_;
+  }
+  // After a touching contact: its spring, as the force left it, into the next free new slot.
+  void keep(std::int64_t partner) {
+    if (!slots_ || !slots_->new_partner) return;
+    if (slots_->used == ContactSprings::kSlots) {
+      ++slots_->overflows;
+      return;
+    }
+    slots_->new_partner[slots_->used] = partner;
+    slots_->new_displacement[slots_->used] = spring_;
+    ++slots_->used;
+  }
+
+ private:
+  SpringSlots* slots_;
+  Eigen::Vector3d spring_ = Eigen::Vector3d::Zero();
+};
+
+double CpuContacts::overlap_ratio_cap() const { return settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30; }
+
 template <typename Fn>
 void CpuContacts::visit_contacts(const World& world, std::uint32_t i, Fn&& fn, SpringSlots* springs) const {
+  SpringLookup lookup(springs);
+  visit_neighbours(world, i, fn, lookup);
+  visit_walls(world, i, fn, lookup);
+}
+
+// Other bodies' particles in the 27 cells around, row by row (dz, dy), each row's three cells in
+// increasing x and each bucket in increasing id. A row is three consecutive buckets (see hash_cell),
+// so it is one contiguous scan unless it wraps around the table's end.
+template <typename Fn>
+void CpuContacts::visit_neighbours(const World& world, std::uint32_t i, Fn& fn, SpringLookup& lookup) const {
   const Bodies& b = world.bodies;
   const Particles& p = world.particles;
-  const double overlap_ratio_cap = settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30;
+  const double cap = overlap_ratio_cap();
   const std::uint32_t bi = p.body[i];
   const double ri = p.radius[i];
   const double inverse_mass_i = b.inverse_mass[bi];
   const Eigen::Vector3d& xi = position_[i];
   const Eigen::Vector3d& wi = b.angular_velocity[bi];
-  const double dt = settings_.dt;
-  // The contact's spring (zero for a new contact), or null without springs.
-  Eigen::Vector3d spring = Eigen::Vector3d::Zero();
-  auto find_spring = [&](std::int64_t partner) -> Eigen::Vector3d* {
-    if (!springs) return nullptr;
-    spring.setZero();
-    for (std::size_t k = 0; k < ContactSprings::kSlots && springs->old_partner; ++k) {
-      if (springs->old_partner[k] == partner) spring = springs->old_displacement[k];
-    }
-    return &spring;
-  };
-  auto keep_spring = [&](std::int64_t partner) {
-    if (!springs || !springs->new_partner) return;
-    if (springs->used == ContactSprings::kSlots) {
-      ++springs->overflows;
-      return;
-    }
-    springs->new_partner[springs->used] = partner;
-    springs->new_displacement[springs->used] = spring;
-    ++springs->used;
-  };
-  // Other bodies' particles in the 27 cells around, row by row (dz, dy), each row's three cells in
-  // increasing x and each bucket in increasing id. A row is three consecutive buckets (see
-  // hash_cell), so it is one contiguous scan unless it wraps around the table's end.
   const Eigen::Vector3i& own_cell = grid_.cell[i];
-  const std::uint32_t last_bucket = grid_.table_size - 1;
   auto visit_bucket_range = [&](std::uint32_t first, std::uint32_t end, int y, int z) {
     for (std::uint32_t s = first; s < end; ++s) {
       const Candidate& other = candidates_[s];
@@ -140,12 +157,13 @@ void CpuContacts::visit_contacts(const World& world, std::uint32_t i, Fn&& fn, S
       const auto partner = static_cast<std::int64_t>(j);
       const ContactForce<double> f = sphere_sphere_contact(
           xi, velocity_[i], wi, ri, inverse_mass_i, position_[j], velocity_[j], b.angular_velocity[bj], rj,
-          b.inverse_mass[bj], overlap_ratio_cap * smaller, coefficients, dt, find_spring(partner));
+          b.inverse_mass[bj], cap * smaller, coefficients, settings_.dt, lookup.find(partner));
       if (!f.touching) continue;
-      keep_spring(partner);
+      lookup.keep(partner);
       fn(f, partner, smaller);
     }
   };
+  const std::uint32_t last_bucket = grid_.table_size - 1;
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
       const int y = own_cell.y() + dy, z = own_cell.z() + dz;
@@ -160,21 +178,29 @@ void CpuContacts::visit_contacts(const World& world, std::uint32_t i, Fn&& fn, S
       }
     }
   }
-  // Smooth walls, in declaration order: planes, then cylinders (partner -1 - wall index).
-  const double inverse_mass = b.inverse_mass[bi];
-  const double max_overlap = overlap_ratio_cap * ri;
+}
+
+// Smooth walls, in declaration order: planes, then cylinders (partner -1 - wall index).
+template <typename Fn>
+void CpuContacts::visit_walls(const World& world, std::uint32_t i, Fn& fn, SpringLookup& lookup) const {
+  const Particles& p = world.particles;
+  const std::uint32_t bi = p.body[i];
+  const double ri = p.radius[i];
+  const Eigen::Vector3d& wi = world.bodies.angular_velocity[bi];
+  const double inverse_mass = world.bodies.inverse_mass[bi];
+  const double max_overlap = overlap_ratio_cap() * ri;
   std::int64_t wall_index = 0;
+  auto touch = [&](const Eigen::Vector3d& normal, double gap, std::uint16_t material) {
+    const auto& coefficients = pairs_[p.material[i] * material_count_ + material];
+    const ContactForce<double> f = sphere_wall_contact(normal, gap, velocity_[i], wi, ri, inverse_mass, max_overlap,
+                                                       coefficients, settings_.dt, lookup.find(-1 - wall_index));
+    if (!f.touching) return;
+    lookup.keep(-1 - wall_index);
+    fn(f, -1 - wall_index, ri);
+  };
   for (const PlaneWall& wall : world.walls.planes) {
-    const auto& coefficients = pairs_[p.material[i] * material_count_ + wall.material];
     const double gap = wall.normal.dot(position_[i] - wall.point);
-    if (gap < ri) {
-      const ContactForce<double> f = sphere_wall_contact(wall.normal, gap, velocity_[i], wi, ri, inverse_mass,
-                                                         max_overlap, coefficients, dt, find_spring(-1 - wall_index));
-      if (f.touching) {
-        keep_spring(-1 - wall_index);
-        fn(f, -1 - wall_index, ri);
-      }
-    }
+    if (gap < ri) touch(wall.normal, gap, wall.material);
     ++wall_index;
   }
   for (const CylinderWall& wall : world.walls.cylinders) {
@@ -182,15 +208,7 @@ void CpuContacts::visit_contacts(const World& world, std::uint32_t i, Fn&& fn, S
     const Eigen::Vector2d radial = x.head<2>() - wall.axis;
     const double distance = radial.norm();
     if (x.z() >= wall.z_min && x.z() <= wall.z_max && distance > 0) {
-      const Eigen::Vector3d normal(-radial.x() / distance, -radial.y() / distance, 0.0);
-      const auto& coefficients = pairs_[p.material[i] * material_count_ + wall.material];
-      const ContactForce<double> f = sphere_wall_contact(normal, wall.radius - distance, velocity_[i], wi, ri,
-                                                         inverse_mass, max_overlap, coefficients, dt,
-                                                         find_spring(-1 - wall_index));
-      if (f.touching) {
-        keep_spring(-1 - wall_index);
-        fn(f, -1 - wall_index, ri);
-      }
+      touch(Eigen::Vector3d(-radial.x() / distance, -radial.y() / distance, 0.0), wall.radius - distance, wall.material);
     }
     ++wall_index;
   }

@@ -87,6 +87,12 @@ class CpuContacts {
   // old slots and, when its new slots are given, writes it back there, advanced.
   template <typename Fn>
   void visit_contacts(const World& world, std::uint32_t i, Fn&& fn, SpringSlots* springs = nullptr) const;
+  class SpringLookup;
+  template <typename Fn>
+  void visit_neighbours(const World& world, std::uint32_t i, Fn& fn, SpringLookup& lookup) const;
+  template <typename Fn>
+  void visit_walls(const World& world, std::uint32_t i, Fn& fn, SpringLookup& lookup) const;
+  double overlap_ratio_cap() const;  // settings' max_overlap_ratio, or no cap
   // Slots of particle i for reading the springs of `world` (none without the spring model).
   SpringSlots read_only_slots(const World& world, std::uint32_t i) const;
 
