@@ -44,6 +44,14 @@ std::string mass_text(const MassProperties& m) {
       m.principal_moments.x(), m.principal_moments.y(), m.principal_moments.z());
 }
 
+void add_options(CLI::App* cmd, Options& o) {
+  cmd->add_option("MESH", o.mesh, "Mesh file (OBJ, PLY, STL, OFF, glTF/GLB, ... anything assimp reads)")->required();
+  cmd->add_flag("--json", o.json, "Print the report as JSON");
+  cmd->add_option("--density", o.density, "Density for the mass properties [kg/m^3]")->capture_default_str();
+  cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor (e.g. 0.001 for millimetres)")->capture_default_str();
+  cmd->add_flag("--no-self-intersections", o.skip_self_intersections, "Skip the self-intersection test (large meshes)");
+}
+
 int run_info(const Options& o) {
   TriangleMesh mesh = load_mesh(o.mesh);
   if (o.scale != 1.0) scale_mesh(mesh, o.scale);
@@ -72,15 +80,10 @@ int run_info(const Options& o) {
 
 }  // namespace
 
-Runner add_info_command(CLI::App& app, const GlobalOptions&) {
-  auto* cmd = app.add_subcommand("info", "Report a mesh's validity (holes, non-manifold, self-intersections...) and mass properties");
-  auto o = std::make_shared<Options>();
-  cmd->add_option("MESH", o->mesh, "Mesh file (OBJ, PLY, STL, OFF, glTF/GLB, ... anything assimp reads)")->required();
-  cmd->add_flag("--json", o->json, "Print the report as JSON");
-  cmd->add_option("--density", o->density, "Density for the mass properties [kg/m^3]")->capture_default_str();
-  cmd->add_option("--scale", o->scale, "Multiply coordinates by this factor (e.g. 0.001 for millimetres)")->capture_default_str();
-  cmd->add_flag("--no-self-intersections", o->skip_self_intersections, "Skip the self-intersection test (large meshes)");
-  return [o] { return run_info(*o); };
+Runner add_info_command(CLI::App& app, const GlobalOptions& global) {
+  return add_command<Options>(app, global, "info",
+                              "Report a mesh's validity (holes, non-manifold, self-intersections...) and mass properties",
+                              [](const Options& o, const GlobalOptions&) { return run_info(o); }, add_options);
 }
 
 }  // namespace ts::app

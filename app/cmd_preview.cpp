@@ -315,14 +315,11 @@ int run_preview(const Options& o, const GlobalOptions& global) {
 }  // namespace
 
 Runner add_preview_command(CLI::App& app, const GlobalOptions& global) {
-  auto* cmd = app.add_subcommand("preview", "Off-screen preview: ray-cast SDF (of a mesh or a .vdb level set) with particles as sphere impostors, to PNG");
-  auto o = std::make_shared<Options>();
-  add_input_options(cmd, *o);
-  add_camera_options(cmd, *o);
-  add_colour_options(cmd, *o);
-  add_sdf_options(cmd, *o);
-  add_lighting_options(cmd, *o);
-  return [o, &global] { return run_preview(*o, global); };
+  return add_command<Options>(app, global, "preview",
+                              "Off-screen preview: ray-cast SDF (of a mesh or a .vdb level set) with particles as sphere "
+                              "impostors, to PNG",
+                              run_preview, add_input_options, add_camera_options, add_colour_options, add_sdf_options,
+                              add_lighting_options);
 }
 
 }  // namespace ts::app

@@ -32,13 +32,12 @@ struct Options {
   std::vector<std::string> inputs;  // meshes and @list files from the command line
   std::string list, shard, summary;
   bool batch = false;
-  double radius = 0, coverage = 1.0, grain_radius = 0, voxel = 0, density = 1000.0, scale = 1.0;
-  std::size_t count = 0, probes = 1'000'000;
-  std::uint64_t seed = 1;
-  int rounds = 12, max_iterations = 2000;
+  // The sampler's settings, bound to the options directly; sign and mass method follow the mesh.
+  sampler::SampleSettings sampling;
+  double scale = 1.0;
   std::size_t sdf_budget_mib = 1024;
   std::string sign = "pseudonormal";
-  bool json = false, timings = false, allow_open = false, fill = false, preview = false;
+  bool json = false, allow_open = false, preview = false;
 };
 
 struct BatchRow {
@@ -142,22 +141,23 @@ void add_input_options(CLI::App* cmd, Options& o) {
 
 // Size, density, placement and the accuracy of the arrangement.
 void add_sampling_options(CLI::App* cmd, Options& o) {
-  auto* radius = cmd->add_option("--radius", o.radius, "Particle radius [m]")->check(CLI::PositiveNumber);
-  cmd->add_option("--count", o.count, "Particle count instead of a radius")->check(CLI::PositiveNumber)->excludes(radius);
-  cmd->add_option("--density", o.density, "Density of the solid [kg/m^3]")->check(CLI::PositiveNumber)->capture_default_str();
-  cmd->add_option("--seed", o.seed, "Seed of the generator that places the particles")->capture_default_str();
-  cmd->add_option("--coverage", o.coverage,
+  sampler::SampleSettings& s = o.sampling;
+  auto* radius = cmd->add_option("--radius", s.radius, "Particle radius [m]")->check(CLI::PositiveNumber);
+  cmd->add_option("--count", s.count, "Particle count instead of a radius")->check(CLI::PositiveNumber)->excludes(radius);
+  cmd->add_option("--density", s.density, "Density of the solid [kg/m^3]")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--seed", s.seed, "Seed of the generator that places the particles")->capture_default_str();
+  cmd->add_option("--coverage", s.coverage,
                   "Target covering radius / r: 1 = the particle spheres cover the surface; up to (r + r_grain) / r "
                   "still stops grains of radius r_grain")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--grain-radius", o.grain_radius, "Grain radius [m] for the leak figure c / (r + r_grain)")
+  cmd->add_option("--grain-radius", s.grain_radius, "Grain radius [m] for the leak figure c / (r + r_grain)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--voxel", o.voxel, "SDF voxel [m] (default r / 2)")->check(CLI::PositiveNumber);
-  cmd->add_option("--rounds", o.rounds, "Most hole-closing rounds")->check(CLI::NonNegativeNumber)->capture_default_str();
-  cmd->add_option("--probes", o.probes, "Surface points the covering radius is measured on")->capture_default_str();
+  cmd->add_option("--voxel", s.voxel_size, "SDF voxel [m] (default r / 2)")->check(CLI::PositiveNumber);
+  cmd->add_option("--rounds", s.max_rounds, "Most hole-closing rounds")->check(CLI::NonNegativeNumber)->capture_default_str();
+  cmd->add_option("--probes", s.probes, "Surface points the covering radius is measured on")->capture_default_str();
   cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor first")->check(CLI::PositiveNumber);
-  cmd->add_option("--max-iterations", o.max_iterations, "Most relaxation steps of the first relaxation (later rounds: 200)")
+  cmd->add_option("--max-iterations", s.relax.max_iterations, "Most relaxation steps of the first relaxation (later rounds: 200)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--sdf-budget-mib", o.sdf_budget_mib,
@@ -176,11 +176,11 @@ void add_solid_and_output_options(CLI::App* cmd, Options& o) {
       ->check(CLI::IsMember({"pseudonormal", "winding"}))
       ->capture_default_str();
   cmd->add_flag("--allow-open", o.allow_open, "Same as --sign winding (the older name)");
-  cmd->add_flag("--fill", o.fill,
+  cmd->add_flag("--fill", o.sampling.fill,
                 "Also fill the inside: particles on a face-centred cubic lattice of spacing 2r wherever phi <= -r "
                 "(after the surface ones in the PLY, with normal 0 0 0)");
   cmd->add_flag("--json", o.json, "Print the body.json summary on stdout");
-  cmd->add_flag("--timings", o.timings, "Per-kernel GPU times");
+  cmd->add_flag("--timings", o.sampling.timings, "Per-kernel GPU times");
   cmd->add_flag("--preview", o.preview, "Also write NAME.preview.png: the mesh's SDF ray-cast with the particles over it");
 }
 
@@ -203,22 +203,6 @@ TriangleMesh load_sample_mesh(const Options& o, sampler::SampleSettings& setting
             o.mesh, closed_solid_problems(report));
   settings.mass_method = body::MassMethod::WindingCells;
   return mesh;
-}
-
-void set_sampling(const Options& o, sampler::SampleSettings& settings) {
-  settings.radius = o.radius;
-  settings.count = o.count;
-  settings.coverage = o.coverage;
-  settings.grain_radius = o.grain_radius;
-  settings.voxel_size = o.voxel;
-  settings.density = o.density;
-  settings.seed = o.seed;
-  settings.max_rounds = o.rounds;
-  settings.probes = o.probes;
-  settings.timings = o.timings;
-  settings.relax.max_iterations = o.max_iterations;
-  settings.fill = o.fill;
-  settings.max_sdf_bytes = o.sdf_budget_mib << 20;
 }
 
 sampler::SampleResult sample_with_progress(gpu::Context& context, const TriangleMesh& mesh,
@@ -244,7 +228,7 @@ void print_body_report(const Options& o, const sampler::SampleResult& result, co
   fmt::print("  particles        {} of radius {:.6g} m on the surface (area estimate {}, {:+.1f} %)\n", surface,
              body.particle_radius, result.estimated_count,
              100.0 * (static_cast<double>(surface) / static_cast<double>(result.estimated_count) - 1.0));
-  if (o.fill) {
+  if (o.sampling.fill) {
     fmt::print("  interior         {} on an FCC lattice of spacing 2r (estimate from V - A r: {:.0f}); {} in all\n",
                body.interior_count, result.estimated_interior, body.positions.size());
   }
@@ -264,9 +248,9 @@ void print_body_report(const Options& o, const sampler::SampleResult& result, co
 
 // One mesh: sample, write the body (and its preview), report; `row` gets the batch summary's figures.
 int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
-  sampler::SampleSettings settings;
+  sampler::SampleSettings settings = o.sampling;
+  settings.max_sdf_bytes = o.sdf_budget_mib << 20;
   const TriangleMesh mesh = load_sample_mesh(o, settings);
-  set_sampling(o, settings);
   sampler::SampleResult result = sample_with_progress(context, mesh, settings);
   body::ParticleBody& body = result.body;
   body.source_path = o.mesh;
@@ -281,7 +265,7 @@ int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
   } else {
     print_body_report(o, result, json, context);
   }
-  if (o.timings) fmt::print("{}", result.timing_report);
+  if (o.sampling.timings) fmt::print("{}", result.timing_report);
   if (o.preview) {
     const std::filesystem::path png = std::filesystem::path(o.output) / (name + ".preview.png");
     preview::write_body_preview(context, mesh, body, png, {o.mesh});
@@ -335,12 +319,9 @@ int run_sample(Options& o, const GlobalOptions& global) {
 }  // namespace
 
 Runner add_sample_command(CLI::App& app, const GlobalOptions& global) {
-  auto* cmd = app.add_subcommand("sample", "Convert a closed mesh into a particle rigid body (NAME.particles.ply + NAME.body.json)");
-  auto o = std::make_shared<Options>();
-  add_input_options(cmd, *o);
-  add_sampling_options(cmd, *o);
-  add_solid_and_output_options(cmd, *o);
-  return [o, &global] { return run_sample(*o, global); };
+  return add_command<Options>(app, global, "sample",
+                              "Convert a closed mesh into a particle rigid body (NAME.particles.ply + NAME.body.json)",
+                              run_sample, add_input_options, add_sampling_options, add_solid_and_output_options);
 }
 
 }  // namespace ts::app

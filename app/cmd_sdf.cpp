@@ -185,10 +185,9 @@ int run_sdf(const Options& o, const GlobalOptions& global) {
 }  // namespace
 
 Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
-  auto* cmd = app.add_subcommand("sdf", "Narrow-band signed distance field by GPU scan conversion (OpenVDB level set)");
-  auto o = std::make_shared<Options>();
-  add_options(cmd, *o);
-  return [o, &global] { return run_sdf(*o, global); };
+  return add_command<Options>(app, global, "sdf",
+                              "Narrow-band signed distance field by GPU scan conversion (OpenVDB level set)", run_sdf,
+                              add_options);
 }
 
 }  // namespace ts::app

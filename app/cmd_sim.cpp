@@ -108,10 +108,8 @@ int run_sim(const Options& o, const GlobalOptions& global) {
 }  // namespace
 
 Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
-  auto* cmd = app.add_subcommand("sim", "Run a tetrahedral-grain DEM scene (TOML) on the GPU");
-  auto o = std::make_shared<Options>();
-  add_options(cmd, *o);
-  return [o, &global] { return run_sim(*o, global); };
+  return add_command<Options>(app, global, "sim", "Run a tetrahedral-grain DEM scene (TOML) on the GPU", run_sim,
+                              add_options);
 }
 
 }  // namespace ts::app

@@ -3,6 +3,8 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <memory>
+#include <string>
 
 #include "gpu/context.h"
 
@@ -16,6 +18,17 @@ struct GlobalOptions {
 };
 
 using Runner = std::function<int()>;
+
+// A subcommand whose options live in one `Options` struct: each add(cmd, options) declares some of
+// them (in the order --help lists them), run(options, global) runs the command once they are parsed.
+template <typename Options, typename Run, typename... AddOptions>
+Runner add_command(CLI::App& app, const GlobalOptions& global, const std::string& name, const std::string& description,
+                   Run run, AddOptions... add) {
+  CLI::App* cmd = app.add_subcommand(name, description);
+  auto options = std::make_shared<Options>();
+  (add(cmd, *options), ...);
+  return [options, &global, run] { return run(*options, global); };
+}
 
 // The GL context options every GPU command takes from the global flags.
 inline gpu::ContextOptions context_options(const GlobalOptions& global) {
