@@ -4,6 +4,8 @@
 
 #include <chrono>
 #include <cstdio>
+#include <tuple>
+#include <utility>
 
 #include "app/commands.h"
 #include "core/log.h"
@@ -25,28 +27,39 @@ struct Options {
   bool cpu = false;
   std::string precision = "float";
   bool timings = false;
+  std::string resume;  // DIR: go on from its latest checkpoint, writing there
 };
 
 void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option("SCENE", o.scene, "Scene file (TOML; see assets/scenes/README.md)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", o.output, "Output directory (metrics.csv, particle dumps, frames)")->capture_default_str();
+  CLI::Option* output = cmd->add_option("-o,--output", o.output,
+                                        "Output directory (metrics.csv, particle dumps, frames, checkpoints)")
+                            ->capture_default_str();
   cmd->add_option("--duration", o.duration, "Simulated time [s], overriding the scene's")->check(CLI::PositiveNumber);
   cmd->add_flag("--cpu", o.cpu, "Use the double-precision CPU reference instead of the GPU pipeline");
   cmd->add_option("--precision", o.precision, "GPU arithmetic: float or double (GLSL fp64)")
       ->check(CLI::IsMember({"float", "double"}))
       ->capture_default_str();
   cmd->add_flag("--timings", o.timings, "Print per-kernel GPU times at the end");
+  cmd->add_option(
+         "--resume", o.resume,
+         "Go on from the latest checkpoint in DIR (written with [output] checkpoint_every or "
+         "checkpoint_seconds) and write the outputs there; the result is bit for bit the uninterrupted run's")
+      ->type_name("DIR")
+      ->excludes(output);
 }
 
 // A live line on a terminal, else a log line per output: time, step rate, contacts and the time left.
-void report_progress(const sim::Scene& scene, const sim::World& world, const sim::StepStats& stats, std::int64_t step,
-                     Clock::time_point start, bool terminal) {
+// `first_step` and `first_time` (s): where this process started (a resumed run starts late).
+void report_progress(double duration, const sim::World& world, const sim::StepStats& stats, std::int64_t step,
+                     Clock::time_point start, std::int64_t first_step, double first_time, bool terminal) {
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-  const double rate = elapsed > 0 ? static_cast<double>(step) / elapsed : 0.0;
-  const double remaining = rate > 0 ? (scene.simulation.duration - world.time) / world.time * elapsed : 0.0;
-  const std::string line = fmt::format("t = {:.4f} / {:.4f} s  step {}  {:.0f} steps/s  contacts {}  ETA {:.0f} s",
-                                       world.time, scene.simulation.duration, step, rate, stats.contacts,
-                                       world.time > 0 ? remaining : 0.0);
+  const double rate = elapsed > 0 ? static_cast<double>(step - first_step) / elapsed : 0.0;
+  const double done = world.time - first_time;  // s simulated by this process
+  const double remaining = done > 0 ? (duration - world.time) / done * elapsed : 0.0;
+  const std::string line =
+      fmt::format("t = {:.4f} / {:.4f} s  step {}  {:.0f} steps/s  contacts {}  ETA {:.0f} s", world.time,
+                  duration, step, rate, stats.contacts, remaining);
   if (terminal) {
     std::fprintf(stderr, "\r%s   ", line.c_str());
   } else {
@@ -54,11 +67,15 @@ void report_progress(const sim::Scene& scene, const sim::World& world, const sim
   }
 }
 
+const std::string& output_dir(const Options& o) { return o.resume.empty() ? o.output : o.resume; }
+
 void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResult& result, double seconds,
                    const gpu::Context* context) {
-  fmt::print("{}: {} steps of {:.3g} s, {} grains, {:.1f} s wall ({:.3g} grain-steps/s, {})\n", o.scene, result.steps,
-             result.dt, result.grains, seconds,
-             seconds > 0 ? static_cast<double>(result.steps) * static_cast<double>(result.grains) / seconds : 0.0,
+  // Steps this process ran (a resumed run started at resumed_from).
+  const auto stepped = static_cast<double>(result.steps - std::max<std::int64_t>(result.resumed_from, 0));
+  fmt::print("{}: {} steps of {:.3g} s, {} grains, {:.1f} s wall ({:.3g} grain-steps/s, {})\n", o.scene,
+             result.steps, result.dt, result.grains, seconds,
+             seconds > 0 ? stepped * static_cast<double>(result.grains) / seconds : 0.0,
              o.cpu ? "CPU reference" : context->summary());
   fmt::print("clamps: {} velocity, {} angular velocity, {} overlap (each clamp means a less accurate result)\n",
              result.last.velocity_clamps, result.last.angular_velocity_clamps, result.last.overlap_clamps);
@@ -66,12 +83,14 @@ void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResu
     fmt::print("spring slots: {} overflows over the run (a contact past {} per particle has no static friction)\n",
                result.spring_overflows, sim::ContactSprings::kSlots);
   }
-  fmt::print("outputs: {}/metrics.csv ({} rows)\n", o.output, result.outputs);
+  if (result.resumed_from >= 0) fmt::print("resumed from the checkpoint at step {}\n", result.resumed_from);
+  if (result.checkpoints > 0)
+    fmt::print("checkpoints: {} written in {}\n", result.checkpoints, output_dir(o));
+  fmt::print("outputs: {}/metrics.csv ({} rows)\n", output_dir(o), result.outputs);
 }
 
 int run_sim(const Options& o, const GlobalOptions& global) {
-  sim::Scene scene = sim::load_scene(o.scene);
-  if (o.duration > 0) scene.simulation.duration = o.duration;
+  const sim::Scene scene = sim::load_scene(o.scene);
   std::unique_ptr<gpu::Context> context;
   sim::StepperFactory make_stepper;
   if (!o.cpu) {
@@ -92,12 +111,20 @@ int run_sim(const Options& o, const GlobalOptions& global) {
       frames->write(world, frame, dir);
     };
   }
+  std::int64_t first_step = -1;
+  double first_time = 0;
+  const double duration =
+      o.duration > 0 ? o.duration : scene.simulation.duration;  // s (a resumed run: its own)
   hooks.on_output = [&](const sim::World& world, const sim::StepStats& stats, std::int64_t step) {
-    report_progress(scene, world, stats, step, start, terminal);
+    if (first_step < 0) std::tie(first_step, first_time) = std::pair(step, world.time);
+    report_progress(duration, world, stats, step, start, first_step, first_time, terminal);
   };
   std::string timing_report;
   if (o.timings) hooks.on_finish = [&](sim::Stepper& stepper) { timing_report = stepper.timing_report(); };
-  const sim::RunResult result = sim::run_scene(scene, o.output, hooks, make_stepper);
+  sim::RunControl control;
+  control.resume = !o.resume.empty();
+  control.duration = o.duration;
+  const sim::RunResult result = sim::run_scene(scene, output_dir(o), hooks, make_stepper, control);
   if (terminal) std::fprintf(stderr, "\n");
   if (!result.time_step_warning.empty()) log::warn("{}", result.time_step_warning);
   print_summary(o, scene, result, std::chrono::duration<double>(Clock::now() - start).count(), context.get());

@@ -105,6 +105,9 @@ struct ContactForce {
   Real elastic_energy = 0;                // J, 2/5 k_n delta^(5/2) stored in the Hertz spring
   bool touching = false;
   bool overlap_clamped = false;
+  // Against a wall: the raw overlap exceeds the particle's diameter, so the whole sphere is behind
+  // the wall's surface: it has passed through (StepSettings::check_penetration).
+  bool passed_through = false;
 };
 
 // Normal plus tangential force for a contact with normal n (towards body 1), overlap delta > 0,
@@ -229,6 +232,7 @@ ContactForce<Real> sphere_wall_contact(const Vec3<Real>& n, Real gap, const Vec3
   if (raw_overlap <= Real(0) || inverse_mass <= Real(0)) return out;
   out.touching = true;
   out.overlap_clamped = raw_overlap > max_overlap;
+  out.passed_through = raw_overlap > Real(2) * r;
   out.overlap = std::min(raw_overlap, max_overlap);
   const Vec3<Real> arm = -(r - Real(0.5) * raw_overlap) * n;
   const Vec3<Real> v_c = v + w.cross(arm);

@@ -60,6 +60,8 @@ struct ParticleContacts {
   std::uint32_t pairs = 0, walls = 0, overlap_clamps = 0;
   double max_overlap_ratio = 0;
   double elastic_energy = 0;  // J
+  // The first smooth wall (in visiting order) the particle has passed through; -1: none.
+  std::int64_t passed_wall = -1;
 
   void add(const ContactForce<double>& c, double smaller_radius, bool count) {
     if (!c.touching) return;
@@ -78,6 +80,16 @@ bool counted_here(const World& world, std::uint32_t i, std::int64_t partner) {
   if (partner < 0) return true;
   const auto j = static_cast<std::uint32_t>(partner);
   return world.bodies.inverse_mass[world.particles.body[j]] == 0 || i < j;
+}
+
+// How many particles passed through a smooth wall in this gather, and the lowest id among them with
+// its wall.
+void note_penetrations(const std::vector<ParticleContacts>& contacts, Penetration& out) {
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    if (contacts[i].passed_wall < 0 || out.count++ > 0) continue;
+    out.particle = static_cast<std::uint32_t>(i);
+    out.wall = contacts[i].passed_wall;
+  }
 }
 
 double max_radius(const World& world) {
@@ -321,6 +333,7 @@ void CpuContacts::gather(const World& world, GatheredForces& out_forces, StepSta
           out.add(f, smaller_radius, counted);
           out.pairs += (!wall && counted) ? 1 : 0;
           out.walls += wall ? 1 : 0;
+          if (f.passed_through && out.passed_wall < 0) out.passed_wall = -1 - partner;
         },
         springs ? &slots : nullptr);
     if (springs) overflows[i] = slots.overflows;
@@ -339,6 +352,7 @@ void CpuContacts::gather(const World& world, GatheredForces& out_forces, StepSta
     stats.elastic_energy += contacts[i].elastic_energy;
     stats.max_overlap_ratio = std::max(stats.max_overlap_ratio, contacts[i].max_overlap_ratio);
   }
+  if (settings_.check_penetration) note_penetrations(contacts, stats.penetration);
 }
 
 }  // namespace ts::sim

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "sim/state_bytes.h"
 
 namespace ts::sim {
 
@@ -48,6 +49,24 @@ StepStats CpuStepper::advance(World& world, std::int64_t steps) {
   last.angular_velocity_clamps = sums.angular_velocity_clamps;
   last.overlap_clamps = sums.overlap_clamps;
   return last;
+}
+
+// The energy check's reference is all the stepper keeps between steps (forces and the grid are
+// recomputed every step).
+std::string CpuStepper::save_state() const {
+  ByteWriter w;
+  w.put<std::uint64_t>(material_count_);
+  for (double v : {energy_reference_, energy_scale_, dynamic_mass_, max_diameter_}) w.put(v);
+  w.put<std::uint8_t>(reference_pending_ ? 1 : 0);
+  return w.bytes();
+}
+
+void CpuStepper::restore_state(const World& world, std::string_view state) {
+  ByteReader r(state, "the CPU reference's state");
+  if (r.get<std::uint64_t>() != world.materials.size()) r.fail("made for another world's materials");
+  for (double* v : {&energy_reference_, &energy_scale_, &dynamic_mass_, &max_diameter_}) r.get(*v);
+  reference_pending_ = r.get<std::uint8_t>() != 0;
+  if (!r.done()) r.fail("bytes left over");
 }
 
 std::vector<ContactRecord> CpuStepper::contacts(const World& world) {
@@ -129,7 +148,7 @@ void CpuStepper::integrate(World& world, StepStats& stats) const {
   }
 }
 
-void CpuStepper::check_stability(const World& world, double mechanical_energy) const {
+void CpuStepper::check_stability(const World& world, double mechanical_energy, const StepStats& stats) const {
   const Bodies& b = world.bodies;
   bool any_kinematic = false;
   for (std::size_t k = 0; k < b.size(); ++k) {
@@ -142,6 +161,7 @@ void CpuStepper::check_stability(const World& world, double mechanical_energy) c
                                                   world.time, k));
     }
   }
+  if (stats.penetration.count > 0) throw WallPenetration(world.time, stats.penetration);
   if (!settings_.check_energy || any_kinematic) return;  // kinematic bodies do work on the system
   const double growth = mechanical_energy - energy_reference_;
   if (growth > settings_.energy_growth_tolerance * energy_scale_) {
@@ -173,7 +193,7 @@ StepStats CpuStepper::step(World& world) {
   apply_tracks(world, world.time + settings_.dt);  // and end it there, with the velocities of that time
   world.time += settings_.dt;
   stats.energy = energy(world);
-  check_stability(world, mechanical);
+  check_stability(world, mechanical, stats);
   return stats;
 }
 

@@ -27,9 +27,13 @@ class CpuStepper : public Stepper {
   StepStats advance(World& world, std::int64_t steps) override;
   std::vector<ContactRecord> contacts(const World& world) override;
   const StepSettings& settings() const override { return settings_; }
+  std::string engine() const override { return "cpu reference"; }
+  std::string save_state() const override;
+  void restore_state(const World& world, std::string_view state) override;
 
-  // Advances `world` by settings.dt. Throws ts::Error (ExitCode::Unstable) on NaN/inf or on energy
-  // growth without work; `world` then holds the offending state.
+  // Advances `world` by settings.dt. Throws ts::Error (ExitCode::Unstable) on NaN/inf, on a wall
+  // penetration (WallPenetration) or on energy growth without work; `world` then holds the offending
+  // state.
   StepStats step(World& world);
 
   // Call after doing work on the system (adding grains, moving props by hand): the energy check
@@ -40,7 +44,7 @@ class CpuStepper : public Stepper {
 
  private:
   void integrate(World& world, StepStats& stats) const;
-  void check_stability(const World& world, double mechanical_energy) const;
+  void check_stability(const World& world, double mechanical_energy, const StepStats& stats) const;
 
   StepSettings settings_;
   CpuContacts contacts_;

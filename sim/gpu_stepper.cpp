@@ -7,10 +7,12 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "gpu/layouts.h"
 #include "shaders/common/bindings.h"
 #include "shaders/sim/bindings.h"
 #include "sim/cpu_contacts.h"
+#include "sim/state_bytes.h"
 
 namespace ts::sim {
 namespace {
@@ -203,8 +205,8 @@ void GpuStepper::upload(const World& world) {
   upload_particles(world);
   upload_springs(world);
   allocate_resort(body_count_, particle_count_);
-  allocate_statistics();
   upload_materials_and_walls(world);
+  allocate_statistics();
   set_uniforms();
 }
 
@@ -227,25 +229,44 @@ void GpuStepper::upload_particles(const World& world) {
   double max_radius = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     append(local, p.offset[i], p.radius[i]);
-    info.insert(info.end(), {p.body[i], p.material[i], 0u, 0u});
+    info.insert(info.end(), {p.body[i], p.material[i], static_cast<std::uint32_t>(i), 0u});
     max_radius = std::max(max_radius, p.radius[i]);
   }
   cell_size_ = particle_count_ > 0 ? 2.0 * max_radius : 1.0;
   const std::size_t real_size = precision_ == Precision::Double ? 8 : 4;
   particle_local_ = real_buffer(local);
   particle_info_ = gpu::Buffer::from<std::uint32_t>(info);
-  particle_position_ = gpu::Buffer(particle_count_ * 16);
-  particle_position_exact_ = gpu::Buffer(precision_ == Precision::Double ? particle_count_ * 32 : 16);
-  particle_velocity_ = gpu::Buffer(particle_count_ * 4 * real_size);
-  particle_wrench_ = gpu::Buffer(particle_count_ * 8 * real_size);
+  const std::size_t particles = particle_count_;  // size_t products: no 32-bit overflow
+  particle_position_ = gpu::Buffer(particles * 16);
+  particle_position_exact_ = gpu::Buffer(precision_ == Precision::Double ? particles * 32 : 16);
+  particle_velocity_ = gpu::Buffer(particles * 4 * real_size);
+  particle_wrench_ = gpu::Buffer(particles * 8 * real_size);
 }
 
 void GpuStepper::allocate_statistics() {
-  particle_stats_buffer_ = gpu::Buffer(particle_count_ * 16);
-  counters_ = gpu::Buffer(4 * sizeof(std::uint32_t));
+  particle_stats_buffer_ = gpu::Buffer(std::size_t{particle_count_} * 16);
+  counters_ = gpu::Buffer(counter_count() * sizeof(std::uint32_t));
   counters_.fill_zero();
-  metric_partials_ = gpu::Buffer(((body_count_ + 255) / 256 + 1) * 32);
-  stat_partials_ = gpu::Buffer(((particle_count_ + 255) / 256 + 1) * 16);
+  metric_partials_ = gpu::Buffer((std::size_t{(body_count_ + 255) / 256} + 1) * 32);
+  stat_partials_ = gpu::Buffer((std::size_t{(particle_count_ + 255) / 256} + 1) * 16);
+}
+
+std::size_t GpuStepper::counter_count() const {
+  return TS_SIM_COUNTER_WALL_SLOTS + std::size_t{plane_count_} + cylinder_count_;
+}
+
+// The wall slots of the counters: the lowest world particle id found behind any wall, and the first
+// wall (planes, then cylinders) that found it.
+Penetration GpuStepper::penetration(const std::vector<std::uint32_t>& counters) const {
+  Penetration p;
+  p.count = counters[TS_SIM_COUNTER_PENETRATIONS];
+  if (p.count == 0) return p;
+  std::size_t first = TS_SIM_COUNTER_WALL_SLOTS;
+  for (std::size_t s = TS_SIM_COUNTER_WALL_SLOTS; s < counters.size(); ++s)
+    if (counters[s] > counters[first]) first = s;
+  p.particle = ~counters[first];
+  p.wall = static_cast<std::int64_t>(first - TS_SIM_COUNTER_WALL_SLOTS);
+  return p;
 }
 
 void GpuStepper::upload_materials_and_walls(const World& world) {
@@ -271,6 +292,7 @@ void GpuStepper::set_uniforms() {
   contacts_.set("damping_model", settings_.normal_damping == NormalDamping::Tsuji ? 0 : 1);
   contacts_.set("max_overlap_ratio", static_cast<float>(settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30));
   contacts_.set("spring_model", settings_.tangential == TangentialModel::Spring ? 1 : 0);
+  contacts_.set("check_penetration", settings_.check_penetration ? 1 : 0);
   integrate_.set("body_count", body_count_);
   if (precision_ == Precision::Double) {
     contacts_.set_double("dt", settings_.dt);
@@ -361,16 +383,18 @@ StepStats GpuStepper::statistics() {
     stats.max_overlap_ratio = std::max(stats.max_overlap_ratio, static_cast<double>(contact[g + 2]));
     stats.overlap_clamps += static_cast<std::size_t>(contact[g + 3]);
   }
-  const auto counters = counters_.read<std::uint32_t>(4);
+  const auto counters = counters_.read<std::uint32_t>(counter_count());
   stats.velocity_clamps = counters[0];
   stats.angular_velocity_clamps = counters[1];
   stats.spring_overflows = counters[2];
+  stats.penetration = penetration(counters);
   counters_.fill_zero();
   if (bad > 0.0 || !std::isfinite(stats.energy.total())) {
     throw Error(ExitCode::Unstable, fmt::format("simulation unstable at t = {:.6g} s: {} bodies have a non-finite "
                                                 "state (reduce dt; see the time-step bound)",
                                                 time_, static_cast<std::size_t>(bad)));
   }
+  if (stats.penetration.count > 0) throw WallPenetration(time_, stats.penetration);
   const double growth = stats.energy.total() - energy_reference_;
   if (settings_.check_energy && !any_kinematic_ && growth > settings_.energy_growth_tolerance * energy_scale_) {
     throw Error(ExitCode::Unstable,
@@ -586,9 +610,46 @@ std::size_t GpuStepper::gpu_bytes() const {
 StepStats GpuStepper::advance(World& world, std::int64_t steps) {
   if (!loaded_) upload(world);
   step(static_cast<int>(steps));
-  StepStats stats = statistics();
-  download(world);
-  return stats;
+  download(world);  // first, so that a run stopped by statistics() leaves the offending state in `world`
+  return statistics();
+}
+
+std::string GpuStepper::save_state() const {
+  ByteWriter w;
+  w.put_string(context_.renderer());
+  w.put(body_count_);
+  w.put(particle_count_);
+  w.put(steps_since_resort_);
+  for (double v : {time_, energy_reference_, energy_scale_}) w.put(v);
+  for (const gpu::Buffer* b : persistent_buffers(*this)) {
+    const auto bytes = b->read<char>(b->bytes());
+    w.put_string(std::string_view(bytes.data(), bytes.size()));
+  }
+  return w.bytes();
+}
+
+void GpuStepper::restore_state(const World& world, std::string_view state) {
+  if (!loaded_) upload(world);
+  ByteReader r(state, "the GPU pipeline's state");
+  const std::string renderer = r.get_string();
+  if (renderer != context_.renderer()) {
+    log::warn(
+        "the checkpoint was written on {}, this run uses {}: it goes on, but not bit for bit as it would "
+        "have "
+        "there",
+        renderer, context_.renderer());
+  }
+  if (r.get<std::uint32_t>() != body_count_ || r.get<std::uint32_t>() != particle_count_) {
+    r.fail("made for a world of another size");
+  }
+  r.get(steps_since_resort_);
+  for (double* v : {&time_, &energy_reference_, &energy_scale_}) r.get(*v);
+  for (gpu::Buffer* b : persistent_buffers(*this)) {
+    const std::string bytes = r.get_string();
+    if (bytes.size() != b->bytes()) r.fail("a buffer of another size");
+    if (!bytes.empty()) b->upload(bytes.data(), bytes.size());
+  }
+  if (!r.done()) r.fail("bytes left over");
 }
 
 std::vector<ContactRecord> GpuStepper::contacts(const World& world) { return CpuContacts(settings_).contacts(world); }

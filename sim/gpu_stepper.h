@@ -4,6 +4,7 @@
 // gathered per particle (no float atomics) -> per-body sums and integration. Steps run with no CPU
 // round trip; statistics and state are read back only when asked. What only the CPU reference
 // computes (contact dumps, the spring energy of a loaded state) comes from sim/cpu_contacts.h.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -36,12 +37,18 @@ class GpuStepper : public Stepper {
   std::vector<ContactRecord> contacts(const World& world) override;
   std::string timing_report() override { return queue_.timing_report(); }
   const StepSettings& settings() const override { return settings_; }
+  std::string engine() const override { return precision_ == Precision::Double ? "gpu double" : "gpu float"; }
+  // The persistent buffers in GPU memory order, the re-sort counter, the time and the energy check's
+  // reference; the device's renderer goes along (another device continues, with a warning, not bitwise).
+  std::string save_state() const override;
+  void restore_state(const World& world, std::string_view state) override;
 
   void upload(const World& world);
   // Advances `steps` time steps of settings.dt.
   void step(int steps = 1);
-  // Statistics of the last step (energies, contacts, overlap, clamp counts since the last call).
-  // Throws ts::Error(ExitCode::Unstable) on a non-finite state.
+  // Statistics of the last step (energies, contacts, overlap; clamp, overflow and penetration counts
+  // since the last call). Throws ts::Error(ExitCode::Unstable) on a non-finite state, WallPenetration
+  // on a penetration, and on energy growth without work.
   StepStats statistics();
   // Bodies' positions, orientations and velocities back into `world` (its time advanced too), and
   // with the spring tangential model the contact springs.
@@ -67,6 +74,8 @@ class GpuStepper : public Stepper {
   void upload_materials_and_walls(const World& world);
   void set_uniforms();
   void download_springs(World& world) const;
+  std::size_t counter_count() const;  // uints of counters_
+  Penetration penetration(const std::vector<std::uint32_t>& counters) const;
   void allocate_resort(std::uint32_t body_count, std::uint32_t particle_count);
   // Re-sorts bodies (and their particles, springs renamed) by the cell of their centre.
   void resort();
@@ -74,6 +83,15 @@ class GpuStepper : public Stepper {
   void gather(gpu::Buffer& buffer, const gpu::Buffer& index, std::uint32_t rows, std::uint32_t width);
   // World index of each GPU body and particle (identity until the first re-sort).
   std::vector<std::uint32_t> original_ids(const gpu::Buffer& ids, std::uint32_t count) const;
+  // The buffers a step carries over to the next (everything else is recomputed each step), as
+  // pointers to const when `self` is.
+  template <typename Self>
+  static auto persistent_buffers(Self& self) {
+    return std::array{&self.body_position_, &self.body_orientation_,     &self.body_velocity_,
+                      &self.body_omega_,    &self.body_inverse_inertia_, &self.body_range_,
+                      &self.body_momentum_, &self.particle_info_,        &self.particle_local_,
+                      &self.springs_,       &self.original_body_,        &self.original_particle_};
+  }
 
   gpu::Context& context_;
   StepSettings settings_;

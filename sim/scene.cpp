@@ -43,8 +43,9 @@ int line_of(const toml::node& node) { return static_cast<int>(node.source().begi
 
 class TableReader {
  public:
-  TableReader(const toml::table& table, std::string path, const fs::path& file)
-      : table_(table), path_(std::move(path)), file_(file) {}
+  TableReader(const toml::table& table, std::string path, const fs::path& file,
+              std::map<std::string, int, std::less<>>* lines = nullptr)
+      : table_(table), path_(std::move(path)), file_(file), lines_(lines) {}
 
   [[noreturn]] void fail(std::string_view key, const std::string& problem) const {
     const toml::node* node = key.empty() ? nullptr : table_.get(key);
@@ -60,7 +61,10 @@ class TableReader {
 
   const toml::node* node(std::string_view key) {
     used_.insert(std::string(key));
-    return table_.get(key);
+    const toml::node* found = table_.get(key);
+    if (found && lines_)
+      (*lines_)[path_.empty() ? std::string(key) : path_ + "." + std::string(key)] = line_of(*found);
+    return found;
   }
 
   std::optional<double> optional_number(std::string_view key) {
@@ -178,6 +182,7 @@ class TableReader {
   const toml::table& table_;
   std::string path_;
   const fs::path& file_;
+  std::map<std::string, int, std::less<>>* lines_;  // where the keys read are, when kept
   std::set<std::string> used_;
 };
 
@@ -363,7 +368,7 @@ void read_simulation(TableReader& root, const fs::path& file, Scene& scene) {
   const toml::node* n = root.node("simulation");
   if (!n) return;
   if (!n->is_table()) root.fail("simulation", "must be a table");
-  TableReader r(*n->as_table(), "simulation", file);
+  TableReader r(*n->as_table(), "simulation", file, &scene.key_lines);
   SimulationSettings& s = scene.simulation;
   s.duration = r.positive("duration", s.duration);
   if (const toml::node* dt = r.node("dt")) {
@@ -386,6 +391,8 @@ void read_simulation(TableReader& root, const fs::path& file, Scene& scene) {
   s.step.angular_damping_rate = r.non_negative("angular_damping_rate", 0.0);
   s.step.angular_damping_speed = r.non_negative("angular_damping_speed", 0.0);
   s.step.check_energy = r.boolean("check_energy", true);
+  s.step.check_penetration = r.boolean("check_penetration", true);
+  s.check_clamps = r.boolean("check_clamps", true);
   r.reject_unknown_keys();
 }
 
@@ -393,7 +400,7 @@ void read_output(TableReader& root, const fs::path& file, Scene& scene) {
   const toml::node* n = root.node("output");
   if (!n) return;
   if (!n->is_table()) root.fail("output", "must be a table");
-  TableReader r(*n->as_table(), "output", file);
+  TableReader r(*n->as_table(), "output", file, &scene.key_lines);
   OutputSettings& o = scene.output;
   o.every = r.integer("every", o.every, 1);
   o.frames = r.boolean("frames", o.frames);
@@ -401,13 +408,15 @@ void read_output(TableReader& root, const fs::path& file, Scene& scene) {
   o.vtp = r.boolean("vtp", o.vtp);
   o.csv = r.boolean("csv", o.csv);
   o.contacts = r.boolean("contacts", o.contacts);
+  o.checkpoint_every = r.integer("checkpoint_every", 0, 0);
+  o.checkpoint_seconds = r.non_negative("checkpoint_seconds", 0.0);
   r.reject_unknown_keys();
 }
 
 Scene read_scene(const toml::table& root_table, const fs::path& file) {
   Scene scene;
   scene.file = file;
-  TableReader root(root_table, "", file);
+  TableReader root(root_table, "", file, &scene.key_lines);
   scene.gravity = root.vector<3>("gravity", scene.gravity);
   for_each_table(root, "material", [&](const toml::table& t) { read_material(t, file, scene); });
   if (scene.materials.empty()) root.fail("material", "no [[material]] table: a scene needs at least one");
@@ -434,5 +443,14 @@ Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
 }
 
 Scene load_scene(const std::filesystem::path& file) { return parse_scene(read_file(file), file); }
+
+std::string scene_location(const Scene& scene, std::string_view key, int line) {
+  if (line == 0) {
+    const auto it = scene.key_lines.find(key);
+    if (it != scene.key_lines.end()) line = it->second;
+  }
+  if (line == 0) return fmt::format("{}: {}", scene.file.string(), key);
+  return fmt::format("{}:{}: {}", scene.file.string(), line, key);
+}
 
 }  // namespace ts::sim

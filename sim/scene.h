@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <random>
 #include <string>
 #include <string_view>
@@ -90,6 +91,9 @@ struct SimulationSettings {
   double duration = 1.0;          // s
   double dt = 0;                  // s; 0 = "auto" (TimeStepBound::recommended)
   double max_impact_speed = 0;    // m/s for the contact-duration bound; 0 = from gravity and the scene height
+  // Stop (exit 4) when velocity clamps do not die out: in two output intervals in a row at least one
+  // clamp per step, the second interval with no fewer than the first (docs/reliability.md).
+  bool check_clamps = true;
   StepSettings step;              // dt filled in by make_world
 };
 
@@ -100,6 +104,10 @@ struct OutputSettings {
   bool vtp = false;           // VTK PolyData per output
   bool csv = true;            // metrics.csv: one row per output
   bool contacts = false;      // per-contact dump
+  // Checkpoints (checkpoint_STEP.tsck in the output folder, docs/checkpoint-format.md): every this
+  // many steps, and/or every this many seconds of wall-clock time; 0 = never.
+  std::int64_t checkpoint_every = 0;  // steps
+  double checkpoint_seconds = 0;      // s, wall clock
 };
 
 struct Scene {
@@ -113,12 +121,18 @@ struct Scene {
   std::vector<Boundary> boundaries;
   SimulationSettings simulation;
   OutputSettings output;
+  // Line of each top-level, [simulation] and [output] key the file sets ("gravity", "simulation.dt"),
+  // for messages about keys that are not read where they are checked.
+  std::map<std::string, int, std::less<>> key_lines;
 };
+
+// "file:line: key" for messages, the line being `line`, or the key's line from Scene::key_lines when
+// `line` is 0; without a line "file: key".
+std::string scene_location(const Scene& scene, std::string_view key, int line = 0);
 
 // Parses and validates a scene file. Throws ts::InputError naming file, line and key.
 Scene load_scene(const std::filesystem::path& file);
 // The same from text (`file` is only used in messages and to resolve relative paths).
 Scene parse_scene(std::string_view text, const std::filesystem::path& file);
-
 
 }  // namespace ts::sim

@@ -2,15 +2,20 @@
 
 #include <fmt/format.h>
 
+#include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <utility>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "sim/checkpoint.h"
 #include "sim/cpu_reference.h"
+#include "sim/scene_checks.h"
 #include "sim/scene_world.h"
 
 namespace ts::sim {
@@ -131,6 +136,12 @@ class OutputWriter {
   }
 
   std::int64_t count() const { return frame_; }
+  const std::string& csv() const { return csv_; }
+  // Goes on after `frames` outputs whose metrics.csv was `csv` (a resumed run).
+  void restore(std::string csv, std::int64_t frames) {
+    csv_ = std::move(csv);
+    frame_ = frames;
+  }
 
  private:
   OutputSettings settings_;
@@ -140,75 +151,284 @@ class OutputWriter {
   std::int64_t frame_ = 0;
 };
 
+using Clock = std::chrono::steady_clock;
+
+// A run from its first step or from a checkpoint to the end. Steps go in stretches that end where
+// an output is due or, while pouring, where emitters release grains, exactly as without checkpoints;
+// a checkpoint or the wall clock may split a stretch, which changes no bit (an engine's advance(a)
+// then advance(b) is advance(a + b), and emitters release only where a stretch starts).
+class SceneRun {
+ public:
+  SceneRun(const Scene& scene, const std::filesystem::path& dir, const RunHooks& hooks,
+           const StepperFactory& make_stepper, const RunControl& control)
+      : scene_(scene),
+        dir_(dir),
+        hooks_(hooks),
+        make_stepper_(make_stepper),
+        control_(control),
+        watch_(scene.simulation.check_clamps) {}
+
+  RunResult run();
+
+ private:
+  bool checkpointing() const {
+    return scene_.output.checkpoint_every > 0 || scene_.output.checkpoint_seconds > 0;
+  }
+  void prepare(const World& initial);
+  void start_fresh();
+  void resume();
+  void restore(const RunState& state, const std::filesystem::path& file);
+  std::size_t emit();
+  bool pouring() const;
+  void begin_stretch();
+  std::int64_t stop_at() const;
+  void advance_to(std::int64_t until);
+  void end_stretch();
+  void checkpoint_if_due();
+  RunState state() const;
+
+  const Scene& scene_;
+  std::filesystem::path dir_;
+  const RunHooks& hooks_;
+  const StepperFactory& make_stepper_;
+  RunControl control_;
+  World world_, last_good_;
+  WorldSources sources_;
+  RunResult result_;
+  std::unique_ptr<Stepper> stepper_;
+  std::vector<PourEmitter> pours_;
+  std::int64_t emit_every_ = 0;  // steps between pour checks: about twice per release
+  std::optional<OutputWriter> output_;
+  std::string hash_;     // of the scene, for checkpoints
+  double duration_ = 0;  // s
+  std::int64_t total_ = 0, step_ = 0, stretch_end_ = 0, stretch_output_ = 0, last_output_step_ = 0;
+  StepStats stats_;
+  // Counts since the last output (velocity, angular, overlap, spring overflows).
+  std::size_t velocity_clamps_ = 0, angular_clamps_ = 0, overlap_clamps_ = 0, overflows_ = 0;
+  ClampWatch watch_;
+  Clock::time_point last_checkpoint_ = Clock::now();
+  std::int64_t clock_stretch_ = 1;  // steps between looks at the wall clock (checkpoint_seconds)
+};
+
+// The time step, the force checks, the engine and the pour emitters, from the initial world.
+void SceneRun::prepare(const World& initial) {
+  result_.dt = resolve_time_step(scene_, initial, &result_.time_step_warning);
+  if (!result_.time_step_warning.empty())
+    log::warn("{}: {}", scene_.file.string(), result_.time_step_warning);
+  check_scene_forces(scene_, initial, sources_, result_.dt);
+  StepSettings settings = scene_.simulation.step;
+  settings.dt = result_.dt;
+  stepper_ = make_stepper_ ? make_stepper_(settings) : std::make_unique<CpuStepper>(settings);
+  emit_every_ = scene_.output.every;
+  for (const Emitter& e : scene_.emitters) {
+    if (e.type != EmitterType::Pour) continue;
+    pours_.emplace_back(scene_, e);
+    emit_every_ = std::min(emit_every_, std::max<std::int64_t>(1, std::llround(0.5 / (e.rate * result_.dt))));
+  }
+  if (checkpointing()) hash_ = scene_hash(scene_, initial);
+}
+
+std::size_t SceneRun::emit() {
+  std::size_t added = 0;
+  for (PourEmitter& p : pours_) added += p.emit(world_);
+  return added;
+}
+
+bool SceneRun::pouring() const {
+  return std::any_of(pours_.begin(), pours_.end(), [](const PourEmitter& p) { return !p.finished(); });
+}
+
+void SceneRun::start_fresh() {
+  world_ = make_world(scene_, &sources_);
+  prepare(world_);
+  duration_ = control_.duration > 0 ? control_.duration : scene_.simulation.duration;
+  emit();
+  stepper_->load(world_);
+  output_.emplace(scene_, dir_, hooks_);
+  remove_checkpoints(dir_);
+  stats_.energy = energy(world_);
+  output_->write(world_, stats_, 0, *stepper_);
+}
+
+void SceneRun::resume() {
+  const World initial = make_world(scene_, &sources_);
+  prepare(initial);
+  std::filesystem::path file;
+  const RunState state = read_latest_checkpoint(dir_, &file);
+  if (state.scene_hash != scene_hash(scene_, initial)) {
+    throw InputError(file,
+                     fmt::format("written for another scene: {} (or a prop's body) changed since, or is "
+                                 "another file; resume with the scene the run started with",
+                                 scene_.file.string()));
+  }
+  if (state.engine != stepper_->engine()) {
+    throw InputError(
+        file, fmt::format("written by the {} engine, and this run uses the {} (give the same --cpu and "
+                          "--precision as the run that wrote it)",
+                          state.engine, stepper_->engine()));
+  }
+  if (std::bit_cast<std::uint64_t>(state.dt) != std::bit_cast<std::uint64_t>(result_.dt)) {
+    throw InputError(file, fmt::format("written with dt = {:.17g} s, but the scene now gives {:.17g} s",
+                                       state.dt, result_.dt));
+  }
+  restore(state, file);
+  log::info("{}: resuming at step {} (t = {:.6g} s)", file.string(), step_, world_.time);
+}
+
+void SceneRun::restore(const RunState& s, const std::filesystem::path& file) {
+  world_ = s.world;
+  stepper_->load(world_);
+  try {
+    if (s.pours.size() != pours_.size()) throw InputError("its pour emitters are not the scene's");
+    for (std::size_t i = 0; i < pours_.size(); ++i) pours_[i].restore(s.pours[i]);
+    stepper_->restore_state(world_, s.engine_state);
+  } catch (const InputError& e) {
+    throw InputError(file, e.what());
+  }
+  duration_ = control_.duration > 0 ? control_.duration : s.duration;
+  output_.emplace(scene_, dir_, hooks_);
+  output_->restore(s.metrics_csv, s.frames);
+  step_ = s.step;
+  stretch_end_ = s.stretch_end;
+  stretch_output_ = s.stretch_output;
+  last_output_step_ = s.last_output_step;
+  velocity_clamps_ = s.velocity_clamps;
+  angular_clamps_ = s.angular_clamps;
+  overlap_clamps_ = s.overlap_clamps;
+  overflows_ = s.spring_overflows;
+  result_.spring_overflows = s.run_spring_overflows;
+  watch_.restore(s.clamp_watch);
+  stats_ = s.last;
+  result_.resumed_from = s.step;
+}
+
+// Releases due grains (after the first step), then sets where the stretch ends: at the next output,
+// or sooner while pouring.
+void SceneRun::begin_stretch() {
+  if (step_ > 0 && pouring() && emit() > 0) stepper_->load(world_);
+  const std::int64_t every = scene_.output.every;
+  stretch_output_ = std::min(total_, (step_ / every + 1) * every);
+  const std::int64_t chunk =
+      std::min(stretch_output_ - step_, pouring() ? emit_every_ : stretch_output_ - step_);
+  stretch_end_ = step_ + chunk;
+}
+
+// Where the next advance stops: the stretch's end, or sooner for a checkpoint or a look at the clock.
+std::int64_t SceneRun::stop_at() const {
+  std::int64_t until = stretch_end_;
+  const std::int64_t every = scene_.output.checkpoint_every;
+  if (every > 0) until = std::min(until, (step_ / every + 1) * every);
+  if (scene_.output.checkpoint_seconds > 0) until = std::min(until, step_ + clock_stretch_);
+  return until;
+}
+
+void SceneRun::advance_to(std::int64_t until) {
+  last_good_ = world_;
+  const auto start = Clock::now();
+  try {
+    stats_ = stepper_->advance(world_, until - step_);
+  } catch (const WallPenetration& e) {
+    write_particles_ply(last_good_, dir_ / "last_good.ply");
+    throw Error(ExitCode::Unstable, describe_penetration(e, world_, sources_));
+  } catch (const Error& e) {
+    if (e.code() == ExitCode::Unstable) write_particles_ply(last_good_, dir_ / "last_good.ply");
+    throw;
+  }
+  // About four looks at the clock per checkpoint interval, at most one a second.
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const double rate = static_cast<double>(until - step_) / std::max(seconds, 1e-6);  // steps/s
+  clock_stretch_ =
+      std::max<std::int64_t>(1, std::llround(rate * std::min(1.0, scene_.output.checkpoint_seconds / 4)));
+  step_ = until;
+  velocity_clamps_ += stats_.velocity_clamps;
+  angular_clamps_ += stats_.angular_velocity_clamps;
+  overlap_clamps_ += stats_.overlap_clamps;
+  overflows_ += stats_.spring_overflows;
+  result_.spring_overflows += stats_.spring_overflows;
+}
+
+// At an output step: the row and files of the output, then the clamp watch over its interval.
+void SceneRun::end_stretch() {
+  if (step_ != stretch_output_) return;
+  stats_.spring_overflows = std::exchange(overflows_, 0);
+  stats_.velocity_clamps = std::exchange(velocity_clamps_, 0);
+  stats_.angular_velocity_clamps = std::exchange(angular_clamps_, 0);
+  stats_.overlap_clamps = std::exchange(overlap_clamps_, 0);
+  output_->write(world_, stats_, step_, *stepper_);
+  try {
+    watch_.interval(stats_.velocity_clamps + stats_.angular_velocity_clamps, step_ - last_output_step_,
+                    world_.time);
+  } catch (const Error&) {
+    write_particles_ply(last_good_, dir_ / "last_good.ply");
+    throw;
+  }
+  last_output_step_ = step_;
+}
+
+void SceneRun::checkpoint_if_due() {
+  if (!checkpointing()) return;
+  const std::int64_t every = scene_.output.checkpoint_every;
+  const double seconds = scene_.output.checkpoint_seconds;
+  const bool by_steps = every > 0 && step_ % every == 0;
+  const bool by_clock =
+      seconds > 0 && std::chrono::duration<double>(Clock::now() - last_checkpoint_).count() >= seconds;
+  if (!by_steps && !by_clock && step_ < total_)
+    return;  // the last step always gets one: a run can be extended
+  write_checkpoint(dir_, state());
+  last_checkpoint_ = Clock::now();
+  ++result_.checkpoints;
+  if (hooks_.on_checkpoint) hooks_.on_checkpoint(checkpoint_path(dir_, step_), step_);
+}
+
+RunState SceneRun::state() const {
+  RunState s;
+  s.scene_hash = hash_;
+  s.engine = stepper_->engine();
+  s.duration = duration_;
+  s.dt = result_.dt;
+  s.step = step_;
+  s.stretch_end = stretch_end_;
+  s.stretch_output = stretch_output_;
+  s.frames = output_->count();
+  s.last_output_step = last_output_step_;
+  s.velocity_clamps = velocity_clamps_;
+  s.angular_clamps = angular_clamps_;
+  s.overlap_clamps = overlap_clamps_;
+  s.spring_overflows = overflows_;
+  s.run_spring_overflows = result_.spring_overflows;
+  s.clamp_watch = watch_.state();
+  s.last = stats_;
+  for (const PourEmitter& p : pours_) s.pours.push_back(p.progress());
+  s.metrics_csv = output_->csv();
+  s.world = world_;
+  s.engine_state = stepper_->save_state();
+  return s;
+}
+
+RunResult SceneRun::run() {
+  control_.resume ? resume() : start_fresh();
+  total_ = static_cast<std::int64_t>(std::ceil(duration_ / result_.dt - 1e-9));
+  if (stretch_end_ > total_)
+    stretch_end_ = stretch_output_ = std::max(step_, total_);  // a shorter --duration
+  while (step_ < total_) {
+    if (step_ == stretch_end_) begin_stretch();
+    advance_to(stop_at());
+    if (step_ == stretch_end_) end_stretch();
+    checkpoint_if_due();
+  }
+  result_.steps = step_;
+  result_.last = stats_;
+  result_.grains = dynamic_bodies(world_);
+  result_.outputs = output_->count();
+  if (hooks_.on_finish) hooks_.on_finish(*stepper_);
+  return result_;
+}
+
 }  // namespace
 
 RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir, const RunHooks& hooks,
-                    const StepperFactory& make_stepper) {
-  World world = make_world(scene);
-  RunResult result;
-  result.dt = resolve_time_step(scene, world, &result.time_step_warning);
-  if (!result.time_step_warning.empty()) log::warn("{}: {}", scene.file.string(), result.time_step_warning);
-  StepSettings settings = scene.simulation.step;
-  settings.dt = result.dt;
-  std::unique_ptr<Stepper> stepper =
-      make_stepper ? make_stepper(settings) : std::make_unique<CpuStepper>(settings);
-
-  std::vector<PourEmitter> pours;
-  std::int64_t emit_every = scene.output.every;  // steps between pour checks: about twice per release
-  for (const Emitter& e : scene.emitters) {
-    if (e.type != EmitterType::Pour) continue;
-    pours.emplace_back(scene, e);
-    emit_every = std::min(emit_every, std::max<std::int64_t>(1, std::llround(0.5 / (e.rate * result.dt))));
-  }
-  auto pouring = [&] {
-    return std::any_of(pours.begin(), pours.end(), [](const PourEmitter& p) { return !p.finished(); });
-  };
-  auto emit = [&] {
-    std::size_t added = 0;
-    for (PourEmitter& p : pours) added += p.emit(world);
-    return added;
-  };
-
-  emit();
-  stepper->load(world);
-  OutputWriter output(scene, output_dir, hooks);
-  const auto total = static_cast<std::int64_t>(std::ceil(scene.simulation.duration / result.dt - 1e-9));
-  StepStats stats;
-  stats.energy = energy(world);
-  output.write(world, stats, 0, *stepper);
-  std::int64_t step = 0;
-  std::size_t velocity_clamps = 0, angular_clamps = 0, overlap_clamps = 0, overflows = 0;  // since the last output
-  while (step < total) {
-    if (step > 0 && pouring() && emit() > 0) stepper->load(world);
-    const std::int64_t next_output = std::min(total, (step / scene.output.every + 1) * scene.output.every);
-    const std::int64_t chunk = std::min(next_output - step, pouring() ? emit_every : next_output - step);
-    const World last_good = world;
-    try {
-      stats = stepper->advance(world, chunk);
-    } catch (const Error& e) {
-      if (e.code() == ExitCode::Unstable) write_particles_ply(last_good, output_dir / "last_good.ply");
-      throw;
-    }
-    step += chunk;
-    velocity_clamps += stats.velocity_clamps;
-    angular_clamps += stats.angular_velocity_clamps;
-    overlap_clamps += stats.overlap_clamps;
-    overflows += stats.spring_overflows;
-    result.spring_overflows += stats.spring_overflows;
-    if (step == next_output) {
-      stats.spring_overflows = std::exchange(overflows, 0);
-      stats.velocity_clamps = std::exchange(velocity_clamps, 0);
-      stats.angular_velocity_clamps = std::exchange(angular_clamps, 0);
-      stats.overlap_clamps = std::exchange(overlap_clamps, 0);
-      output.write(world, stats, step, *stepper);
-    }
-  }
-  result.steps = step;
-  result.last = stats;
-  result.grains = dynamic_bodies(world);
-  result.outputs = output.count();
-  if (hooks.on_finish) hooks.on_finish(*stepper);
-  return result;
+                    const StepperFactory& make_stepper, const RunControl& control) {
+  return SceneRun(scene, output_dir, hooks, make_stepper, control).run();
 }
 
 }  // namespace ts::sim

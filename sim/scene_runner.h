@@ -8,7 +8,12 @@
 //   particles_NNNNNN.vtp       VTK XML PolyData (ASCII): points, radius and body per particle
 //   contacts_NNNNNN.csv        one row per contact (CPU reference: recomputed for the output state)
 //   frames                     through the write_frame hook (the preview renderer lives in the app)
-// On an unstable step the last good state is written as last_good.ply and the ts::Error rethrown.
+//   checkpoint_STEP.tsck       with [output] checkpoint_every / checkpoint_seconds: the complete state
+//                              (sim/checkpoint.h), the two latest kept; RunControl::resume goes on from
+//                              the latest, bit for bit as if the run had never stopped
+// Before the first step the scene's forces are checked (sim/scene_checks.h: exit 1). On an unstable
+// step (non-finite state, energy growth, a wall penetration, velocity clamps that do not die out) the
+// last good state is written as last_good.ply and a ts::Error (ExitCode::Unstable) thrown.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -27,6 +32,13 @@ struct RunHooks {
   std::function<void(const World& world, const StepStats& stats, std::int64_t step)> on_output;
   // Called once with the engine after the last step (e.g. for its --timings report).
   std::function<void(Stepper& stepper)> on_finish;
+  // Called after each checkpoint is written (tests stop a run there).
+  std::function<void(const std::filesystem::path& file, std::int64_t step)> on_checkpoint;
+};
+
+struct RunControl {
+  bool resume = false;  // go on from the latest checkpoint in the output folder
+  double duration = 0;  // s, overriding the scene's (fresh) or the checkpoint's (resume); 0: theirs
 };
 
 // Makes the engine of a run from the settings with dt resolved; the runner loads the world.
@@ -42,6 +54,8 @@ struct RunResult {
   // Contacts over the whole run that found no free spring slot (spring tangential model): each ran
   // without static friction for that step.
   std::size_t spring_overflows = 0;
+  std::int64_t resumed_from = -1;  // the step a resumed run went on from (-1: a fresh run)
+  std::int64_t checkpoints = 0;    // written by this run
 };
 
 // The time step a scene runs with: its own, or the recommended bound for "auto".
@@ -49,7 +63,7 @@ double resolve_time_step(const Scene& scene, const World& world, std::string* wa
 
 // `make_stepper` receives the settings with dt filled in (default: the CPU reference).
 RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir, const RunHooks& hooks = {},
-                    const StepperFactory& make_stepper = {});
+                    const StepperFactory& make_stepper = {}, const RunControl& control = {});
 
 // Output writers (atomic), usable on their own.
 void write_particles_ply(const World& world, const std::filesystem::path& file);

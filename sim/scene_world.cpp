@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
 
 #include "body/body_file.h"
 #include "core/error.h"
+#include "sim/scene_limits.h"
 #include "sim/scene_world.h"
 
 namespace ts::sim {
@@ -32,9 +34,11 @@ std::string where(const Scene& scene, int line, std::string_view key) {
 // A static body of touching (or `spacing`-spaced) spheres on a rectangular lattice whose tops lie
 // in the plane through `surface` with normal n; particles reaching into the hole are left out, and
 // a round rim lines the hole when asked.
-void add_rough_rectangle(World& world, const Eigen::Vector3d& surface, const Eigen::Vector3d& n,
+// Returns whether a body was added (a hole may leave out every sphere).
+bool add_rough_rectangle(World& world, const Eigen::Vector3d& surface, const Eigen::Vector3d& n,
                          const Eigen::Vector3d& t1, const Eigen::Vector3d& t2, const Eigen::Vector2d& size,
-                         double hole_radius, bool round_rim, double radius, double spacing, std::uint16_t material) {
+                         double hole_radius, bool round_rim, double radius, double spacing,
+                         std::uint16_t material) {
   const int n1 = static_cast<int>(std::floor(size.x() / spacing)) + 1;
   const int n2 = static_cast<int>(std::floor(size.y() / spacing)) + 1;
   std::vector<Eigen::Vector3d> offsets;
@@ -49,11 +53,12 @@ void add_rough_rectangle(World& world, const Eigen::Vector3d& surface, const Eig
     const auto rim = round_hole_rim(t1, t2, n, hole_radius, radius);
     offsets.insert(offsets.end(), rim.begin(), rim.end());
   }
-  if (offsets.empty()) return;
+  if (offsets.empty()) return false;
   BodyDesc desc;
   desc.position = surface;
   desc.motion = MotionType::Static;
   add_body(world, desc, offsets, std::vector<double>(offsets.size(), radius), material);
+  return true;
 }
 
 // In-plane axes for a plane normal; for a horizontal plane t1 = x and t2 = y.
@@ -85,44 +90,60 @@ void add_rough_cylinder(World& world, const Boundary& b) {
 struct Face {
   Eigen::Vector3d point, normal, t1, t2;
   Eigen::Vector2d size;
+  const char* name;
 };
 std::vector<Face> box_faces(const Boundary& b) {
   const Eigen::Vector3d c = 0.5 * (b.min + b.max), e = b.max - b.min;
   const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), y = Eigen::Vector3d::UnitY(), z = Eigen::Vector3d::UnitZ();
   const double zc = c.z();
-  return {{{c.x(), c.y(), b.min.z()}, z, x, y, {e.x(), e.y()}},
-          {{b.min.x(), c.y(), zc}, x, y, z, {e.y(), e.z()}},
-          {{b.max.x(), c.y(), zc}, -x, y, z, {e.y(), e.z()}},
-          {{c.x(), b.min.y(), zc}, y, x, z, {e.x(), e.z()}},
-          {{c.x(), b.max.y(), zc}, -y, x, z, {e.x(), e.z()}}};
+  return {{{c.x(), c.y(), b.min.z()}, z, x, y, {e.x(), e.y()}, "floor (z = min)"},
+          {{b.min.x(), c.y(), zc}, x, y, z, {e.y(), e.z()}, "x = min"},
+          {{b.max.x(), c.y(), zc}, -x, y, z, {e.y(), e.z()}, "x = max"},
+          {{c.x(), b.min.y(), zc}, y, x, z, {e.x(), e.z()}, "y = min"},
+          {{c.x(), b.max.y(), zc}, -y, x, z, {e.x(), e.z()}, "y = max"}};
 }
 
-void add_boundary(World& world, const Boundary& b) {
+// Where the walls and bodies of add_boundary come from, kept apart so that the smooth walls can be
+// listed as the world orders them (planes, then cylinders).
+struct BoundaryNames {
+  std::vector<std::string> planes, cylinders, bodies;
+};
+
+void add_boundary(World& world, const Boundary& b, BoundaryNames& names) {
+  const std::string from = fmt::format("of [[boundary]] at line {}", b.line);
   switch (b.type) {
     case BoundaryType::Plane:
       if (b.rough) {
         const auto [t1, t2] = plane_axes(b.normal);
-        add_rough_rectangle(world, b.point, b.normal, t1, t2, b.size, b.hole_radius, b.round_rim, b.particle_radius,
-                            b.spacing, b.material);
+        if (add_rough_rectangle(world, b.point, b.normal, t1, t2, b.size, b.hole_radius, b.round_rim,
+                                b.particle_radius, b.spacing, b.material)) {
+          names.bodies.push_back("the rough plane " + from);
+        }
       } else {
         world.walls.planes.push_back({b.point, b.normal, b.material});
+        names.planes.push_back("the plane " + from);
       }
       break;
     case BoundaryType::Box:
       for (const Face& f : box_faces(b)) {
-        if (b.rough) {
-          add_rough_rectangle(world, f.point, f.normal, f.t1, f.t2, f.size, 0.0, false, b.particle_radius, b.spacing,
-                              b.material);
-        } else {
+        const std::string face =
+            fmt::format("the {} face of the {}box {}", f.name, b.rough ? "rough " : "", from);
+        if (!b.rough) {
           world.walls.planes.push_back({f.point, f.normal, b.material});
+          names.planes.push_back(face);
+        } else if (add_rough_rectangle(world, f.point, f.normal, f.t1, f.t2, f.size, 0.0, false,
+                                       b.particle_radius, b.spacing, b.material)) {
+          names.bodies.push_back(face);
         }
       }
       break;
     case BoundaryType::Cylinder:
       if (b.rough) {
         add_rough_cylinder(world, b);
+        names.bodies.push_back("the rough cylinder " + from);
       } else {
         world.walls.cylinders.push_back({b.axis, b.radius, b.z_min, b.z_max, b.material});
+        names.cylinders.push_back("the cylinder " + from);
       }
       break;
   }
@@ -176,11 +197,26 @@ std::vector<Eigen::Vector3d> column_sites(const Emitter& e, double bound, std::m
 
 }  // namespace
 
+double lattice_spacing(double bound) { return 2 * bound * kSiteMargin; }
+
+double lattice_site_count(const Eigen::Vector3d& min, const Eigen::Vector3d& max, double bound) {
+  const Eigen::Vector3d lo = min.array() + bound * kSiteMargin, hi = max.array() - bound * kSiteMargin;
+  if (!(hi.array() >= lo.array()).all()) return 0;
+  const Eigen::Array3d n = ((hi - lo) / lattice_spacing(bound)).array().floor() + 1;
+  return n.prod();
+}
+
 std::vector<Eigen::Vector3d> grain_sites_in_box(const Eigen::Vector3d& min, const Eigen::Vector3d& max, double bound,
                                                 std::mt19937_64& rng) {
-  const double spacing = 2 * bound * kSiteMargin;  // m
+  const double spacing = lattice_spacing(bound);  // m
   const Eigen::Vector3d lo = min.array() + bound * kSiteMargin, hi = max.array() - bound * kSiteMargin;
   if (!(hi.array() >= lo.array()).all()) return {};
+  // Scenes are checked before (check_scene_sizes); this guards the int casts for other callers.
+  const double count = lattice_site_count(min, max, bound);
+  if (!(count <= kMaxLatticeSites)) {
+    throw InputError(
+        fmt::format("a box of {:.3g} lattice sites: at most {:.0f} fit", count, kMaxLatticeSites));
+  }
   const Eigen::Vector3i n = ((hi - lo) / spacing).array().floor().cast<int>() + 1;
   std::uniform_real_distribution<double> jitter(-kJitter * spacing, kJitter * spacing);
   std::vector<Eigen::Vector3d> sites;
@@ -211,12 +247,24 @@ std::vector<Eigen::Vector3d> round_hole_rim(const Eigen::Vector3d& t1, const Eig
   return rim;
 }
 
-World make_world(const Scene& scene) {
+World make_world(const Scene& scene, WorldSources* sources) {
+  check_scene_sizes(scene);
   World world;
   world.materials = scene.materials;
   world.gravity = scene.gravity;
-  for (const Boundary& b : scene.boundaries) add_boundary(world, b);
-  for (const Prop& p : scene.props) add_prop(world, p);
+  BoundaryNames names;
+  for (const Boundary& b : scene.boundaries) add_boundary(world, b, names);
+  for (const Prop& p : scene.props) {
+    add_prop(world, p);
+    names.bodies.push_back(
+        fmt::format("the prop of [[prop]] at line {} ({})", p.line, p.body_file.filename().string()));
+  }
+  check_world_sizes(scene, world);
+  if (sources) {
+    sources->smooth_walls = names.planes;
+    sources->smooth_walls.insert(sources->smooth_walls.end(), names.cylinders.begin(), names.cylinders.end());
+    sources->bodies = names.bodies;
+  }
   const GrainShape grain = make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
                                                   scene.materials[scene.grain.material].density);
   for (const Emitter& e : scene.emitters) {
@@ -249,6 +297,27 @@ PourEmitter::PourEmitter(const Scene& scene, const Emitter& emitter)
   }
 }
 
+PourProgress PourEmitter::progress() const {
+  std::ostringstream rng;
+  rng << rng_;
+  return {next_site_, emitted_, rng.str()};
+}
+
+void PourEmitter::restore(const PourProgress& progress) {
+  if (progress.next_site >= sites_.size() || progress.emitted > emitter_.count) {
+    throw InputError(
+        fmt::format("a pour emitter at site {} of {} with {} of {} grains released does not match the "
+                    "scene's",
+                    progress.next_site, sites_.size(), progress.emitted, emitter_.count));
+  }
+  next_site_ = static_cast<std::size_t>(progress.next_site);
+  emitted_ = static_cast<std::size_t>(progress.emitted);
+  std::istringstream rng(progress.rng);
+  std::mt19937_64 restored;
+  if (!(rng >> restored)) throw InputError("a pour emitter's random generator state is damaged");
+  rng_ = restored;
+}
+
 std::size_t PourEmitter::emit(World& world) {
   if (finished() || world.time < emitter_.start) return 0;
   const double released = std::floor((world.time - emitter_.start) * emitter_.rate) + 1;
@@ -271,7 +340,8 @@ std::size_t PourEmitter::emit(World& world) {
   return added;
 }
 
-TimeStepBound scene_time_step_bound(const Scene& scene, const World& world) {
+std::vector<SceneContactCase> scene_contact_cases(const Scene& scene, const World& world,
+                                                  const WorldSources* sources) {
   const GrainShape g = make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
                                               scene.materials[scene.grain.material].density);
   const Material& sand = scene.materials[scene.grain.material];
@@ -279,17 +349,19 @@ TimeStepBound scene_time_step_bound(const Scene& scene, const World& world) {
   auto pair = [&](std::uint16_t other) {
     return make_pair_coefficients(sand, scene.materials[other], scene.simulation.step.normal_damping);
   };
-  std::vector<ContactCase> cases;
-  std::vector<ParticleKind> kinds{{g.particle_radius, sand}};
+  std::vector<SceneContactCase> cases;
   const PairCoefficients grains = pair(scene.grain.material);
   const double r = g.particle_radius;
-  cases.push_back({g.mass / 2, r / 2, grains.effective_modulus, 1 / (2 * inverse_tangential),
-                   grains.tangential_damping});
+  cases.push_back(
+      {{g.mass / 2, r / 2, grains.effective_modulus, 1 / (2 * inverse_tangential), grains.tangential_damping},
+       r,
+       "another grain"});
   for (const Boundary& b : scene.boundaries) {
     const PairCoefficients c = pair(b.material);
     const double radius = b.rough ? r * b.particle_radius / (r + b.particle_radius) : r;
-    cases.push_back({g.mass, radius, c.effective_modulus, 1 / inverse_tangential, c.tangential_damping});
-    if (b.rough) kinds.push_back({b.particle_radius, scene.materials[b.material]});
+    cases.push_back({{g.mass, radius, c.effective_modulus, 1 / inverse_tangential, c.tangential_damping},
+                     b.rough ? std::min(r, b.particle_radius) : r,
+                     fmt::format("the {}boundary at line {}", b.rough ? "rough " : "", b.line)});
   }
   for (std::size_t k = 0; k < world.bodies.size(); ++k) {
     const std::uint32_t first = world.bodies.first_particle[k];
@@ -297,39 +369,69 @@ TimeStepBound scene_time_step_bound(const Scene& scene, const World& world) {
     const PairCoefficients c = pair(world.particles.material[first]);
     const double rp = world.particles.radius[first];
     const double inverse_mass = world.bodies.inverse_mass[k];
-    cases.push_back({1 / (1 / g.mass + inverse_mass), r * rp / (r + rp), c.effective_modulus,
-                     1 / inverse_tangential, c.tangential_damping});
+    const bool named = sources && k < sources->bodies.size();
+    cases.push_back({{1 / (1 / g.mass + inverse_mass), r * rp / (r + rp), c.effective_modulus,
+                      1 / inverse_tangential, c.tangential_damping},
+                     std::min(r, rp),
+                     named ? sources->bodies[k] : fmt::format("body {}", k)});
   }
-  double speed = scene.simulation.max_impact_speed;
-  if (speed <= 0) {
-    // Free fall over the scene's height, plus the fastest launched grain or moving prop.
-    double z_min = 0, z_max = 0, launched = 0;
-    bool first = true;
-    for (const Eigen::Vector3d& x : particle_positions(world)) {
-      z_min = first ? x.z() : std::min(z_min, x.z());
-      z_max = first ? x.z() : std::max(z_max, x.z());
-      first = false;
-    }
-    for (const Boundary& b : scene.boundaries) {
-      const double z = b.type == BoundaryType::Plane ? b.point.z() : b.type == BoundaryType::Box ? b.min.z() : b.z_min;
-      z_min = first ? z : std::min(z_min, z);
-      z_max = first ? z : std::max(z_max, z);
-      first = false;
-    }
-    for (const Emitter& e : scene.emitters) {
-      z_max = std::max(z_max, e.type == EmitterType::Column ? e.centre.z() : e.max.z());
-      launched = std::max(launched, e.velocity.norm());
-    }
-    for (const Prop& p : scene.props) {
-      launched = std::max(launched, p.velocity.norm());
-      for (std::size_t k = 1; k < p.keyframes.size(); ++k) {  // keyframed: its fastest segment
-        const double span = p.keyframes[k].time - p.keyframes[k - 1].time;
-        launched = std::max(launched, (p.keyframes[k].position - p.keyframes[k - 1].position).norm() / span);
-      }
-    }
-    speed = std::max(0.5, std::sqrt(2 * scene.gravity.norm() * (z_max - z_min)) + launched);
+  return cases;
+}
+
+DesignSpeed scene_design_speed(const Scene& scene, const World& world) {
+  if (scene.simulation.max_impact_speed > 0)
+    return {scene.simulation.max_impact_speed, "simulation.max_impact_speed", 0};
+  // Free fall over the scene's height, plus the fastest launched grain or moving prop.
+  double z_min = 0, z_max = 0;
+  bool first = true;
+  for (const Eigen::Vector3d& x : particle_positions(world)) {
+    z_min = first ? x.z() : std::min(z_min, x.z());
+    z_max = first ? x.z() : std::max(z_max, x.z());
+    first = false;
   }
-  return time_step_bound(cases, kinds, speed);
+  for (const Boundary& b : scene.boundaries) {
+    const double z = b.type == BoundaryType::Plane ? b.point.z()
+                     : b.type == BoundaryType::Box ? b.min.z()
+                                                   : b.z_min;
+    z_min = first ? z : std::min(z_min, z);
+    z_max = first ? z : std::max(z_max, z);
+    first = false;
+  }
+  DesignSpeed launch{0, "gravity", 0};  // the fastest launch, and where it is set
+  auto faster = [&](double speed, std::string key, int line) {
+    if (speed > launch.speed) launch = {speed, std::move(key), line};
+  };
+  for (const Emitter& e : scene.emitters) {
+    z_max = std::max(z_max, e.type == EmitterType::Column ? e.centre.z() : e.max.z());
+    faster(e.velocity.norm(), "emitter.velocity", e.line);
+  }
+  for (const Prop& p : scene.props) {
+    faster(p.velocity.norm(), "prop.velocity", p.line);
+    for (std::size_t k = 1; k < p.keyframes.size(); ++k) {  // keyframed: its fastest segment
+      const double span = p.keyframes[k].time - p.keyframes[k - 1].time;
+      faster((p.keyframes[k].position - p.keyframes[k - 1].position).norm() / span, "prop.keyframes", p.line);
+    }
+  }
+  const double launched = launch.speed;                                       // m/s
+  const double fall = std::sqrt(2 * scene.gravity.norm() * (z_max - z_min));  // m/s
+  const double speed = std::max(0.5, fall + launched);
+  return fall >= launched ? DesignSpeed{speed, "gravity", 0} : DesignSpeed{speed, launch.key, launch.line};
+}
+
+std::vector<ParticleKind> scene_particle_kinds(const Scene& scene) {
+  const Material& sand = scene.materials[scene.grain.material];
+  std::vector<ParticleKind> kinds{{scene.grain.radius, sand}};
+  for (const Boundary& b : scene.boundaries) {
+    if (b.rough) kinds.push_back({b.particle_radius, scene.materials[b.material]});
+  }
+  return kinds;
+}
+
+TimeStepBound scene_time_step_bound(const Scene& scene, const World& world, double impact_speed) {
+  std::vector<ContactCase> cases;
+  for (const SceneContactCase& c : scene_contact_cases(scene, world)) cases.push_back(c.contact);
+  const double speed = impact_speed > 0 ? impact_speed : scene_design_speed(scene, world).speed;
+  return time_step_bound(cases, scene_particle_kinds(scene), speed);
 }
 
 }  // namespace ts::sim

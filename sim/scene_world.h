@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "sim/grain.h"
@@ -15,12 +16,43 @@
 
 namespace ts::sim {
 
+// What the smooth walls and the non-grain bodies of a world stand for in the scene, for messages.
+struct WorldSources {
+  std::vector<std::string> smooth_walls;  // planes, then cylinders: "the plane of [[boundary]] at line 12"
+  std::vector<std::string> bodies;        // the first bodies (rough walls, props), in world order
+};
+
 // The initial world of a scene: materials, smooth walls, rough walls as static particle bodies,
 // props, and the grains of the fill and column emitters. Pour emitters run through PourEmitter.
-World make_world(const Scene& scene);
+// Every size the scene implies is checked first (sim/scene_limits.h). `sources`, when given, names
+// the walls and bodies.
+World make_world(const Scene& scene, WorldSources* sources = nullptr);
 
-// The time-step bound for the scene's contact kinds (grain-grain, grain-wall, grain-prop).
-TimeStepBound scene_time_step_bound(const Scene& scene, const World& world);
+// A kind of contact a grain of the scene will see, and what it is with.
+struct SceneContactCase {
+  ContactCase contact;
+  double smaller_radius = 0;  // m, of the two spheres
+  std::string partner;        // "another grain", "the boundary at line 12", a WorldSources body name
+};
+// Grain-grain, grain-boundary (each [[boundary]]) and grain-body (each rough wall and prop body).
+std::vector<SceneContactCase> scene_contact_cases(const Scene& scene, const World& world,
+                                                  const WorldSources* sources = nullptr);
+
+// The impact speed the automatic time step is sized for, and the key that sets it.
+struct DesignSpeed {
+  double speed = 0;  // m/s
+  std::string key;   // "simulation.max_impact_speed", "gravity" (free fall), "emitter.velocity", ...
+  int line = 0;      // of the [[emitter]] or [[prop]] table; 0: the key's own line
+};
+// simulation.max_impact_speed, else free fall over the scene's height plus the fastest launch
+// (at least 0.5 m/s).
+DesignSpeed scene_design_speed(const Scene& scene, const World& world);
+
+// The particle kinds of the Rayleigh bound: the grain's spheres and each rough boundary's.
+std::vector<ParticleKind> scene_particle_kinds(const Scene& scene);
+
+// The time-step bound for the scene's contact kinds at `impact_speed` (m/s; 0: the design speed).
+TimeStepBound scene_time_step_bound(const Scene& scene, const World& world, double impact_speed = 0);
 
 // Offsets from the hole's centre of fixed spheres of `radius` lining a round hole in a rough plane
 // (in-plane axes t1, t2, normal n into the free side; sphere tops in the plane, as the lattice's):
@@ -30,6 +62,13 @@ TimeStepBound scene_time_step_bound(const Scene& scene, const World& world);
 std::vector<Eigen::Vector3d> round_hole_rim(const Eigen::Vector3d& t1, const Eigen::Vector3d& t2,
                                             const Eigen::Vector3d& n, double hole_radius, double radius);
 
+// Where a pour emitter stands: its next site, grains released, and its generator's state (text of
+// std::mt19937_64's operator<<).
+struct PourProgress {
+  std::uint64_t next_site = 0, emitted = 0;
+  std::string rng;
+};
+
 // Releases a pour emitter's grains as time passes, at free lattice sites of its region.
 class PourEmitter {
  public:
@@ -37,6 +76,9 @@ class PourEmitter {
   // Adds the grains due by world.time whose site is free; returns how many were added.
   std::size_t emit(World& world);
   bool finished() const { return emitted_ == emitter_.count; }
+  // For checkpoints: where it stands, and going on from there (the sites are the constructor's).
+  PourProgress progress() const;
+  void restore(const PourProgress& progress);
 
  private:
   GrainShape grain_;
@@ -46,6 +88,11 @@ class PourEmitter {
   std::size_t next_site_ = 0, emitted_ = 0;
   std::mt19937_64 rng_;
 };
+
+// The lattice of grain_sites_in_box: its spacing (m) and how many sites a box holds (in double,
+// so a huge box does not overflow; 0 when the box is smaller than one grain).
+double lattice_spacing(double bound);
+double lattice_site_count(const Eigen::Vector3d& min, const Eigen::Vector3d& max, double bound);
 
 // Lattice sites (m) for grains of bounding radius `bound` in a box: spacing >= 2.22 d so that
 // no two grains overlap whatever their orientation (notes/peers.md), jittered by `rng`.

@@ -8,8 +8,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "core/error.h"
 #include "sim/contact_model.h"
 #include "sim/world.h"
 
@@ -48,10 +50,21 @@ struct StepSettings {
   // spring energy then + M |g| d_max) while no work is done on the system.
   bool check_energy = true;
   double energy_growth_tolerance = 0.5;
+  // Wall penetration: a dynamic particle whose sphere lies wholly behind a smooth wall's surface (its
+  // overlap beyond its diameter) has passed through: the run stops (WallPenetration). Checked every
+  // step on both engines.
+  bool check_penetration = true;
   // GPU pipeline only: every this many steps the bodies are re-sorted by the cell of their centre
   // (Morton order), so neighbours sit near each other in memory; 0 = never. Results stay
   // deterministic; forces change only by the order of float sums.
   std::int64_t resort_every = 100;
+};
+
+// Dynamic particles found wholly behind a smooth wall's surface (StepSettings::check_penetration).
+struct Penetration {
+  std::size_t count = 0;       // particle-steps (CPU: of the step; GPU: summed since the last statistics)
+  std::uint32_t particle = 0;  // the lowest world id of such a particle
+  std::int64_t wall = 0;       // the first smooth wall it passed through (planes, then cylinders)
 };
 
 struct StepStats {
@@ -64,6 +77,20 @@ struct StepStats {
   std::size_t angular_velocity_clamps = 0;
   std::size_t overlap_clamps = 0;         // contacts whose overlap was capped
   std::size_t spring_overflows = 0;       // contacts beyond a particle's spring slots (no spring: viscous only)
+  Penetration penetration;                // when check_penetration is on
+};
+
+// A run stopped by a wall penetration (ExitCode::Unstable). The message names the wall by index;
+// sim::run_scene replaces it with the scene's names.
+class WallPenetration : public Error {
+ public:
+  WallPenetration(double time, const Penetration& penetration);
+  double time() const { return time_; }  // s, when it was found
+  const Penetration& penetration() const { return penetration_; }
+
+ private:
+  double time_;
+  Penetration penetration_;
 };
 
 // One contact of the current state, for dumps and tests.
@@ -91,6 +118,15 @@ class Stepper {
   // Per-kernel times for --timings; empty where the engine keeps none.
   virtual std::string timing_report() { return {}; }
   virtual const StepSettings& settings() const = 0;
+
+  // For checkpoints (sim/checkpoint.h): which engine this is ("cpu reference", "gpu float", ...; a
+  // checkpoint resumes only on the engine that wrote it), and its own state beyond the world it last
+  // brought up to date (the GPU's memory order, its re-sort counter, the energy check's reference), so
+  // that after load(world) and restore_state(world, save_state()) it steps on bit for bit. Throws
+  // ts::InputError when `state` does not belong to `world` or to this engine.
+  virtual std::string engine() const = 0;
+  virtual std::string save_state() const = 0;
+  virtual void restore_state(const World& world, std::string_view state) = 0;
 };
 
 }  // namespace ts::sim

@@ -33,7 +33,7 @@
 // ---- State: one buffer per quantity (structure of arrays). real4 = vec4, or dvec4 with TS_FP64.
 #define TS_SIM_PARTICLE_POSITION 0   // vec4: xyz world position [m]; w: radius [m] (= TS_GRID_POSITIONS)
 #define TS_SIM_PARTICLE_VELOCITY 6   // real4: xyz velocity of the sphere centre [m/s]
-#define TS_SIM_PARTICLE_INFO 7       // uvec4: x body index, y material index
+#define TS_SIM_PARTICLE_INFO 7       // uvec4: x body index, y material index, z world particle id
 #define TS_SIM_PARTICLE_LOCAL 8      // real4: xyz offset from the body's centre of mass in its frame [m]; w: radius [m]
 #define TS_SIM_BODY_POSITION 9       // real4: xyz centre of mass [m]; w: inverse mass [1/kg] (0 unless dynamic)
 #define TS_SIM_BODY_ORIENTATION 10   // real4: unit quaternion (x, y, z, w); body axes = principal axes
@@ -49,12 +49,19 @@
 #define TS_SIM_PLANES 18             // SimPlane[]
 #define TS_SIM_CYLINDERS 19          // SimCylinder[]
 #define TS_SIM_PARTICLE_STATS 20     // vec4: x pair contacts (counted by the lower id), y wall contacts, z largest overlap / smaller radius, w overlap clamps
-#define TS_SIM_COUNTERS 21           // uint[]: 0 velocity clamps, 1 angular velocity clamps, 2 spring slot overflows
+// uint[]: 0 velocity clamps, 1 angular velocity clamps, 2 spring slot overflows, then the wall
+// penetrations (TS_SIM_COUNTER_*): a count, and per smooth wall (planes, then cylinders) ~id of the
+// lowest world particle id found wholly behind it, under atomicMax (0: none).
+#define TS_SIM_COUNTERS 21
 #define TS_SIM_BODY_MOMENTUM 22      // real4: xyz angular momentum [kg m^2/s] (world frame)
 #define TS_SIM_PARTICLE_POSITION_EXACT 23  // dvec4 (TS_FP64 only): the particle position before rounding to float [m]
 #define TS_SIM_METRIC_PARTIALS 24    // dvec4 per 256 bodies: kinetic translational, rotational, potential [J], non-finite bodies
 #define TS_SIM_STAT_PARTIALS 25      // vec4 per 256 particles: TS_SIM_PARTICLE_STATS summed (z: max)
 #define TS_SIM_KEYFRAMES 26          // 2 real4 per key of a kinematic track (sim::Keyframe): xyz centre of mass [m], w time [s]; quaternion (x, y, z, w)
+
+// Entries of TS_SIM_COUNTERS after the three clamp and overflow counts.
+#define TS_SIM_COUNTER_PENETRATIONS 3  // particle-steps of a dynamic particle wholly behind a smooth wall
+#define TS_SIM_COUNTER_WALL_SLOTS 4    // the first per-wall slot
 
 // ---- Re-sort by Morton key (GpuStepper::resort): the keys go through gpu::BucketSort (TS_SORT_*).
 #define TS_SIM_RESORT_ORDER TS_SORT_SORTED  // uint per new body: its old index (the sort's output)

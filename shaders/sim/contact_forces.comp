@@ -45,6 +45,7 @@ uniform float max_overlap_ratio;  // overlap clamp (thesis 3.3.1): delta <= rati
 uniform uint material_count;
 uniform int spring_model;  // 1: tangential springs (static friction), 0: viscous eq. 3.28
 uniform real dt;           // [s], advances the springs
+uniform int check_penetration;  // 1: count dynamic particles that passed through a wall (StepSettings)
 
 // This particle's contact history: the old slots, read once, and how many new ones are written.
 int old_partner[TS_SIM_SPRING_SLOTS];
@@ -75,6 +76,13 @@ real3 contact_force(uint i, bool with_springs, int partner, real3 n, real delta,
     ++slots_used;
   }
   return f;
+}
+
+// Particle i lies wholly behind the surface of smooth wall `slot` (planes, then cylinders): counted,
+// and the wall keeps the lowest world particle id found behind it (as ~id, so 0 means none).
+void note_penetration(uint i, uint slot) {
+  atomicAdd(counters[TS_SIM_COUNTER_PENETRATIONS], 1u);
+  atomicMax(counters[TS_SIM_COUNTER_WALL_SLOTS + slot], ~particle_info[i].z);
 }
 
 void main() {
@@ -147,6 +155,7 @@ void main() {
         real lateral = length(rel - dot(rel, n) * n);
         if (plane.extent.w > 0.0 ? lateral > real(plane.extent.w) : lateral < real(-plane.extent.w)) continue;
       }
+      if (check_penetration != 0 && raw > 2.0 * ri) note_penetration(i, k);
       real delta = min(raw, overlap_cap * ri);
       real3 arm = -(ri - 0.5 * raw) * n;
       real3 f = contact_force(i, with_springs, -1 - int(k), n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i,
@@ -166,6 +175,7 @@ void main() {
       real raw = ri - (real(cyl.axis_radius.w) - distance);
       if (raw <= 0.0) continue;
       real3 n = real3(-radial / distance, 0.0);
+      if (check_penetration != 0 && raw > 2.0 * ri) note_penetration(i, plane_count + k);
       real delta = min(raw, overlap_cap * ri);
       real3 arm = -(ri - 0.5 * raw) * n;
       real3 f = contact_force(i, with_springs, -1 - int(plane_count + k), n, delta, vi + cross(wi, arm), ri,

@@ -1,0 +1,137 @@
+// Sizes checked before allocation (sim/scene_limits.h): every count a scene's keys imply is refused
+// with file:line:key and the largest that fits before anything is allocated, in sim and in export.
+#include "sim/scene_limits.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "sim/export_lammps.h"
+#include "sim/scene_runner.h"
+#include "sim/scene_world.h"
+#include "tests/test_support.h"
+
+namespace ts::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* kHead = R"(gravity = [0.0, 0.0, -9.81]
+[[material]]
+name = "sand"
+E = 1.0e7
+nu = 0.3
+restitution = 0.65
+mu = 0.5
+density = 2600.0
+[grain]
+radius = 1.0e-3
+material = "sand"
+)";
+
+// Writes kHead + `tables` as DIR/scene.toml; returns make_world's InputError message ("" if none).
+std::string world_error(const fs::path& dir, const std::string& tables) {
+  write_file_atomically(dir / "scene.toml", std::string(kHead) + tables);
+  try {
+    make_world(load_scene(dir / "scene.toml"));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The message starts with "DIR/scene.toml:LINE: KEY:" and says what fits.
+void expect_names(const std::string& message, const fs::path& dir, int line, const std::string& key,
+                  const std::string& fits) {
+  EXPECT_EQ(message.rfind(fmt::format("{}:{}: {}:", (dir / "scene.toml").string(), line, key), 0), 0u)
+      << message;
+  EXPECT_NE(message.find(fits), std::string::npos) << message;
+}
+
+constexpr int kFirstTable = 12;  // the line of the first table after kHead
+
+TEST(SceneLimits, EmitterBoxAGigametreWideIsRefusedInSimAndExport) {
+  const fs::path dir = test::temp_dir();
+  const std::string fill =
+      "[[emitter]]\ntype = \"fill\"\nmin = [0.0, 0.0, 0.0]\nmax = [1e9, 0.01, 0.01]\ncount = 8\n";
+  expect_names(world_error(dir, fill), dir, kFirstTable, "emitter.max", "at most 134217728 fit");
+  // The same through the runner and the LAMMPS export (both used to end in vector::reserve).
+  const Scene scene = load_scene(dir / "scene.toml");
+  EXPECT_THROW(run_scene(scene, dir / "out"), InputError);
+  try {
+    export_lammps(scene, dir / "deck");
+    FAIL() << "exported";
+  } catch (const InputError& e) {
+    expect_names(e.what(), dir, kFirstTable, "emitter.max", "at most 134217728 fit");
+  }
+  const std::string pour =
+      "[[emitter]]\ntype = \"pour\"\nmin = [0.0, 0.0, 0.0]\nmax = [1e9, 1e9, 1e9]\ncount = 8\n"
+      "rate = 10.0\n";
+  expect_names(world_error(dir, pour), dir, kFirstTable, "emitter.max", "a box of at most");
+  // A large box within the limit is no error (2 m x 2 m x 2 cm: 6.7e5 sites).
+  const std::string fits =
+      "[[emitter]]\ntype = \"fill\"\nmin = [0.0, 0.0, 0.0]\nmax = [2.0, 2.0, 0.02]\ncount = 8\n";
+  EXPECT_EQ(world_error(dir, fits), "");
+}
+
+TEST(SceneLimits, GrainCountsAndColumnsBeyondTheLimitsAreRefused) {
+  const fs::path dir = test::temp_dir();
+  const std::string many =
+      "[[emitter]]\ntype = \"fill\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.1, 0.1, 0.1]\n"
+      "count = 300000000\n";
+  expect_names(world_error(dir, many), dir, kFirstTable, "emitter.count", "at most 268435456 grains fit");
+  const std::string wide =
+      "[[emitter]]\ntype = \"column\"\ncentre = [0.0, 0.0, 0.0]\nradius = 1e5\ncount = 10\n";
+  expect_names(world_error(dir, wide), dir, kFirstTable, "emitter.radius", "at most 134217728 fit");
+  const std::string tall =
+      "[[emitter]]\ntype = \"column\"\ncentre = [0.0, 0.0, 0.0]\nradius = 0.02\n"
+      "count = 200000000\n";
+  expect_names(world_error(dir, tall), dir, kFirstTable, "emitter.count", "at most 134217728 fit");
+  // Two emitters each within the limit, together beyond it.
+  const std::string two =
+      "[[emitter]]\ntype = \"pour\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.1, 0.1, 0.1]\n"
+      "count = 200000000\nrate = 10.0\n[[emitter]]\ntype = \"pour\"\nmin = [0.0, 0.0, 0.0]\n"
+      "max = [0.1, 0.1, 0.1]\ncount = 200000000\nrate = 10.0\n";
+  const std::string total = world_error(dir, two);
+  EXPECT_EQ(total.rfind((dir / "scene.toml").string() + ": the scene needs 1.6e+09 particles", 0), 0u)
+      << total;
+  EXPECT_NE(total.find("at most 1073741824 fit"), std::string::npos) << total;
+}
+
+TEST(SceneLimits, RoughBoundariesBeyondTheLimitAreRefused) {
+  const fs::path dir = test::temp_dir();
+  const std::string rough = "rough = true\nparticle_radius = 1e-3\nmaterial = \"sand\"\n";
+  expect_names(world_error(dir, "[[boundary]]\ntype = \"plane\"\nsize = [1e7, 1e7]\n" + rough), dir,
+               kFirstTable, "boundary.size", "at most 1073741824 fit");
+  expect_names(
+      world_error(dir,
+                  "[[boundary]]\ntype = \"box\"\nmin = [0.0, 0.0, 0.0]\nmax = [1e5, 1e5, 1.0]\n" + rough),
+      dir, kFirstTable, "boundary.max", "at most 1073741824 fit");
+  expect_names(
+      world_error(dir, "[[boundary]]\ntype = \"cylinder\"\nradius = 0.1\nz_min = 0.0\nz_max = 1e9\n" + rough),
+      dir, kFirstTable, "boundary.z_max", "at most 1073741824 fit");
+  expect_names(world_error(dir,
+                           "[[boundary]]\ntype = \"plane\"\nsize = [0.1, 0.1]\nhole_radius = 1e12\n"
+                           "hole_rim = \"round\"\n" +
+                               rough),
+               dir, kFirstTable, "boundary.hole_radius", "at most 1073741824 fit");
+}
+
+TEST(SceneLimits, ParticlesFartherThanTheGridCellsReachAreRefused) {
+  const fs::path dir = test::temp_dir();
+  const std::string prop =
+      fmt::format("[[prop]]\nbody = \"{}\"\nposition = [1e9, 0.0, 0.0]\nmaterial = \"sand\"\n",
+                  test::asset("bodies/cube.body.json").string());
+  const std::string message = world_error(dir, prop);
+  expect_names(message, dir, kFirstTable, "prop.position", "at most 1e+09 cells fit");
+  const std::string far =
+      "[[emitter]]\ntype = \"fill\"\nmin = [-1e12, 0.0, 0.0]\nmax = [-999999999999.9, 0.01, 0.01]\n"
+      "count = 1\n";
+  expect_names(world_error(dir, far), dir, kFirstTable, "emitter.min", "at most 1e+09 cells fit");
+}
+
+}  // namespace
+}  // namespace ts::sim
