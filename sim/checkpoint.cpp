@@ -10,6 +10,7 @@
 #include <array>
 #include <cerrno>
 #include <regex>
+#include <type_traits>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -38,30 +39,29 @@ std::string hex(std::string_view bytes) {
   return out;
 }
 
+// The body arrays in file order, through `fn` (writing and reading alike).
+template <typename AnyBodies, typename Fn>
+void for_each_body_array(AnyBodies& b, Fn&& fn) {
+  fn(b.position);
+  fn(b.orientation);
+  fn(b.linear_velocity);
+  fn(b.angular_velocity);
+  fn(b.inverse_mass);
+  fn(b.inverse_inertia);
+  fn(b.bounding_radius);
+  fn(b.motion);
+  fn(b.first_particle);
+  fn(b.particle_count);
+}
+
 void put_bodies(ByteWriter& w, const Bodies& b) {
-  w.put_vector(b.position);
-  w.put_vector(b.orientation);
-  w.put_vector(b.linear_velocity);
-  w.put_vector(b.angular_velocity);
-  w.put_vector(b.inverse_mass);
-  w.put_vector(b.inverse_inertia);
-  w.put_vector(b.bounding_radius);
-  w.put_vector(b.motion);
-  w.put_vector(b.first_particle);
-  w.put_vector(b.particle_count);
+  for_each_body_array(b, [&](const auto& values) { w.put_vector(values); });
 }
 
 void get_bodies(ByteReader& r, Bodies& b) {
-  b.position = r.get_vector<Eigen::Vector3d>();
-  b.orientation = r.get_vector<Eigen::Quaterniond>();
-  b.linear_velocity = r.get_vector<Eigen::Vector3d>();
-  b.angular_velocity = r.get_vector<Eigen::Vector3d>();
-  b.inverse_mass = r.get_vector<double>();
-  b.inverse_inertia = r.get_vector<Eigen::Matrix3d>();
-  b.bounding_radius = r.get_vector<double>();
-  b.motion = r.get_vector<MotionType>();
-  b.first_particle = r.get_vector<std::uint32_t>();
-  b.particle_count = r.get_vector<std::uint32_t>();
+  for_each_body_array(b, [&](auto& values) {
+    values = r.get_vector<typename std::remove_reference_t<decltype(values)>::value_type>();
+  });
 }
 
 // Arrays of structs: a count, then each element through `put_one`; read back likewise, the count
@@ -78,34 +78,32 @@ std::vector<T> get_each(ByteReader& r, std::size_t min_bytes, Get get_one) {
   return values;
 }
 
+// The fields of a smooth wall in file order, through `fn` (writing and reading alike).
+template <typename Plane, typename Fn>
+void for_each_plane_field(Plane& p, Fn&& fn) {
+  fn(p.point);
+  fn(p.normal);
+  fn(p.material);
+}
+template <typename Cylinder, typename Fn>
+void for_each_cylinder_field(Cylinder& c, Fn&& fn) {
+  fn(c.axis);
+  fn(c.radius);
+  fn(c.z_min);
+  fn(c.z_max);
+  fn(c.material);
+}
+
 void put_walls(ByteWriter& w, const Walls& walls) {
-  put_each(w, walls.planes, [&](const PlaneWall& p) {
-    w.put(p.point);
-    w.put(p.normal);
-    w.put(p.material);
-  });
-  put_each(w, walls.cylinders, [&](const CylinderWall& c) {
-    w.put(c.axis);
-    w.put(c.radius);
-    w.put(c.z_min);
-    w.put(c.z_max);
-    w.put(c.material);
-  });
+  const auto put = [&](const auto& value) { w.put(value); };
+  put_each(w, walls.planes, [&](const PlaneWall& p) { for_each_plane_field(p, put); });
+  put_each(w, walls.cylinders, [&](const CylinderWall& c) { for_each_cylinder_field(c, put); });
 }
 
 void get_walls(ByteReader& r, Walls& walls) {
-  walls.planes = get_each<PlaneWall>(r, 50, [&](PlaneWall& p) {
-    r.get(p.point);
-    r.get(p.normal);
-    r.get(p.material);
-  });
-  walls.cylinders = get_each<CylinderWall>(r, 42, [&](CylinderWall& c) {
-    r.get(c.axis);
-    r.get(c.radius);
-    r.get(c.z_min);
-    r.get(c.z_max);
-    r.get(c.material);
-  });
+  const auto get = [&](auto& value) { r.get(value); };
+  walls.planes = get_each<PlaneWall>(r, 50, [&](PlaneWall& p) { for_each_plane_field(p, get); });
+  walls.cylinders = get_each<CylinderWall>(r, 42, [&](CylinderWall& c) { for_each_cylinder_field(c, get); });
 }
 
 void put_tracks(ByteWriter& w, const std::vector<KinematicTrack>& tracks) {

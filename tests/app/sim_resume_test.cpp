@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/atomic_file.h"
+#include "tests/scene_texts.h"
 #include "tests/test_support.h"
 
 extern char** environ;
@@ -32,58 +33,21 @@ using Clock = std::chrono::steady_clock;
 // Grains poured into a box with a keyframed plate sweeping through and contact springs: every part
 // of the state a checkpoint keeps changes as the run goes. Checkpoints every 50 steps.
 std::string scene_text() {
-  return fmt::format(R"(gravity = [0.0, 0.0, -9.81]
-[[material]]
-name = "sand"
-E = 1.0e6
-nu = 0.3
-restitution = 0.5
-mu = 0.5
-gamma_s = 2.0
-density = 2600.0
-[grain]
-radius = 5.0e-3
-material = "sand"
-[[emitter]]
-type = "fill"
-min = [-0.045, -0.045, 0.006]
-max = [0.045, 0.045, 0.06]
-count = 12
-seed = 5
-[[emitter]]
-type = "pour"
-min = [-0.03, -0.03, 0.08]
-max = [0.03, 0.03, 0.11]
-count = 30
-rate = 60.0
-seed = 9
-[[prop]]
-body = "{}"
-motion = "kinematic"
-material = "sand"
-[[prop.keyframes]]
-time = 0.0
-position = [-0.11, 0.0, 0.036]
-orientation = [0.5, 0.5, 0.5, 0.5]
-[[prop.keyframes]]
-time = 0.6
-position = [-0.02, 0.0, 0.036]
-orientation = [0.5, 0.5, 0.5, 0.5]
-[[boundary]]
+  test::PouredScene p;
+  p.pour_count = 30;
+  p.pour_rate = 60.0;
+  p.plate_time = 0.6;
+  p.plate_x = -0.02;
+  p.boundaries = R"([[boundary]]
 type = "box"
 min = [-0.05, -0.05, 0.0]
 max = [0.05, 0.05, 0.3]
 material = "sand"
-[simulation]
-duration = 0.6
-integrator = "symplectic"
-tangential = "spring"
-[output]
-every = 200
-ply = true
-checkpoint_every = 50
-)",
-                     test::asset("bodies/plate.body.json").string());
+)";
+  p.duration = 0.6;
+  p.every = 200;
+  p.checkpoint_every = 50;
+  return test::poured_scene(p);
 }
 
 // Starts `tetrasand ARGS...` with its output discarded; returns its pid.

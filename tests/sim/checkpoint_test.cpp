@@ -15,6 +15,7 @@
 #include "gpu/context.h"
 #include "sim/gpu_stepper.h"
 #include "sim/scene_runner.h"
+#include "tests/scene_texts.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {
@@ -27,45 +28,9 @@ namespace fs = std::filesystem;
 // Checkpoints every 37 steps fall inside the stretches between pour releases (36 steps) and outputs
 // (100 steps).
 std::string scene_text(const std::string& engine_keys) {
-  return fmt::format(R"(gravity = [0.0, 0.0, -9.81]
-[[material]]
-name = "sand"
-E = 1.0e6
-nu = 0.3
-restitution = 0.5
-mu = 0.5
-gamma_s = 2.0
-density = 2600.0
-[grain]
-radius = 5.0e-3
-material = "sand"
-[[emitter]]
-type = "fill"
-min = [-0.045, -0.045, 0.006]
-max = [0.045, 0.045, 0.06]
-count = 12
-seed = 5
-[[emitter]]
-type = "pour"
-min = [-0.03, -0.03, 0.08]
-max = [0.03, 0.03, 0.11]
-count = 12
-rate = 100.0
-velocity = [0.0, 0.0, -0.5]
-seed = 9
-[[prop]]
-body = "{}"
-motion = "kinematic"
-material = "sand"
-[[prop.keyframes]]
-time = 0.0
-position = [-0.11, 0.0, 0.036]
-orientation = [0.5, 0.5, 0.5, 0.5]
-[[prop.keyframes]]
-time = 0.2
-position = [-0.03, 0.0, 0.036]
-orientation = [0.5, 0.5, 0.5, 0.5]
-[[boundary]]
+  test::PouredScene p;
+  p.pour_extra = "velocity = [0.0, 0.0, -0.5]\n";
+  p.boundaries = R"([[boundary]]
 type = "plane"
 rough = true
 point = [0.0, 0.0, 0.0]
@@ -83,17 +48,9 @@ radius = 0.07
 z_min = 0.0
 z_max = 0.2
 material = "sand"
-[simulation]
-duration = 0.12
-integrator = "symplectic"
-tangential = "spring"
-{}
-[output]
-every = 100
-ply = true
-checkpoint_every = 37
-)",
-                     test::asset("bodies/plate.body.json").string(), engine_keys);
+)";
+  p.simulation = engine_keys;
+  return test::poured_scene(p);
 }
 
 Scene write_scene(const fs::path& dir, const std::string& engine_keys = "") {

@@ -12,6 +12,7 @@
 #include "sim/export_lammps.h"
 #include "sim/scene_runner.h"
 #include "sim/scene_world.h"
+#include "tests/scene_texts.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {
@@ -19,22 +20,22 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* kHead = R"(gravity = [0.0, 0.0, -9.81]
-[[material]]
-name = "sand"
-E = 1.0e7
-nu = 0.3
-restitution = 0.65
-mu = 0.5
-density = 2600.0
-[grain]
-radius = 1.0e-3
-material = "sand"
-)";
+const std::string kHead = std::string("gravity = [0.0, 0.0, -9.81]\n") + test::kMinimalScene;
+
+// A fill or pour emitter from the origin to `max` (min given last, as it seldom changes).
+std::string box_emitter(const std::string& type, const std::string& max, long long count,
+                        const std::string& extra = "", const std::string& min = "[0.0, 0.0, 0.0]") {
+  return test::box_emitter(type, min, max, count, extra);
+}
+
+std::string column_emitter(const std::string& radius, long long count) {
+  return fmt::format("[[emitter]]\ntype = \"column\"\ncentre = [0.0, 0.0, 0.0]\nradius = {}\ncount = {}\n", radius,
+                     count);
+}
 
 // Writes kHead + `tables` as DIR/scene.toml; returns make_world's InputError message ("" if none).
 std::string world_error(const fs::path& dir, const std::string& tables) {
-  write_file_atomically(dir / "scene.toml", std::string(kHead) + tables);
+  write_file_atomically(dir / "scene.toml", kHead + tables);
   try {
     make_world(load_scene(dir / "scene.toml"));
   } catch (const InputError& e) {
@@ -51,12 +52,11 @@ void expect_names(const std::string& message, const fs::path& dir, int line, con
   EXPECT_NE(message.find(fits), std::string::npos) << message;
 }
 
-constexpr int kFirstTable = 12;  // the line of the first table after kHead
+constexpr int kFirstTable = 14;  // the line of the first table after kHead
 
 TEST(SceneLimits, EmitterBoxAGigametreWideIsRefusedInSimAndExport) {
   const fs::path dir = test::temp_dir();
-  const std::string fill =
-      "[[emitter]]\ntype = \"fill\"\nmin = [0.0, 0.0, 0.0]\nmax = [1e9, 0.01, 0.01]\ncount = 8\n";
+  const std::string fill = box_emitter("fill", "[1e9, 0.01, 0.01]", 8);
   expect_names(world_error(dir, fill), dir, kFirstTable, "emitter.max", "at most 134217728 fit");
   // The same through the runner and the LAMMPS export (both used to end in vector::reserve).
   const Scene scene = load_scene(dir / "scene.toml");
@@ -67,34 +67,24 @@ TEST(SceneLimits, EmitterBoxAGigametreWideIsRefusedInSimAndExport) {
   } catch (const InputError& e) {
     expect_names(e.what(), dir, kFirstTable, "emitter.max", "at most 134217728 fit");
   }
-  const std::string pour =
-      "[[emitter]]\ntype = \"pour\"\nmin = [0.0, 0.0, 0.0]\nmax = [1e9, 1e9, 1e9]\ncount = 8\n"
-      "rate = 10.0\n";
+  const std::string pour = box_emitter("pour", "[1e9, 1e9, 1e9]", 8, "rate = 10.0\n");
   expect_names(world_error(dir, pour), dir, kFirstTable, "emitter.max", "a box of at most");
   // A large box within the limit is no error (2 m x 2 m x 2 cm: 6.7e5 sites).
-  const std::string fits =
-      "[[emitter]]\ntype = \"fill\"\nmin = [0.0, 0.0, 0.0]\nmax = [2.0, 2.0, 0.02]\ncount = 8\n";
+  const std::string fits = box_emitter("fill", "[2.0, 2.0, 0.02]", 8);
   EXPECT_EQ(world_error(dir, fits), "");
 }
 
 TEST(SceneLimits, GrainCountsAndColumnsBeyondTheLimitsAreRefused) {
   const fs::path dir = test::temp_dir();
-  const std::string many =
-      "[[emitter]]\ntype = \"fill\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.1, 0.1, 0.1]\n"
-      "count = 300000000\n";
+  const std::string many = box_emitter("fill", "[0.1, 0.1, 0.1]", 300000000);
   expect_names(world_error(dir, many), dir, kFirstTable, "emitter.count", "at most 268435456 grains fit");
-  const std::string wide =
-      "[[emitter]]\ntype = \"column\"\ncentre = [0.0, 0.0, 0.0]\nradius = 1e5\ncount = 10\n";
+  const std::string wide = column_emitter("1e5", 10);
   expect_names(world_error(dir, wide), dir, kFirstTable, "emitter.radius", "at most 134217728 fit");
-  const std::string tall =
-      "[[emitter]]\ntype = \"column\"\ncentre = [0.0, 0.0, 0.0]\nradius = 0.02\n"
-      "count = 200000000\n";
+  const std::string tall = column_emitter("0.02", 200000000);
   expect_names(world_error(dir, tall), dir, kFirstTable, "emitter.count", "at most 134217728 fit");
   // Two emitters each within the limit, together beyond it.
-  const std::string two =
-      "[[emitter]]\ntype = \"pour\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.1, 0.1, 0.1]\n"
-      "count = 200000000\nrate = 10.0\n[[emitter]]\ntype = \"pour\"\nmin = [0.0, 0.0, 0.0]\n"
-      "max = [0.1, 0.1, 0.1]\ncount = 200000000\nrate = 10.0\n";
+  const std::string one = box_emitter("pour", "[0.1, 0.1, 0.1]", 200000000, "rate = 10.0\n");
+  const std::string two = one + one;
   const std::string total = world_error(dir, two);
   EXPECT_EQ(total.rfind((dir / "scene.toml").string() + ": the scene needs 1.6e+09 particles", 0), 0u)
       << total;
@@ -127,9 +117,7 @@ TEST(SceneLimits, ParticlesFartherThanTheGridCellsReachAreRefused) {
                   test::asset("bodies/cube.body.json").string());
   const std::string message = world_error(dir, prop);
   expect_names(message, dir, kFirstTable, "prop.position", "at most 1e+09 cells fit");
-  const std::string far =
-      "[[emitter]]\ntype = \"fill\"\nmin = [-1e12, 0.0, 0.0]\nmax = [-999999999999.9, 0.01, 0.01]\n"
-      "count = 1\n";
+  const std::string far = box_emitter("fill", "[-999999999999.9, 0.01, 0.01]", 1, "", "[-1e12, 0.0, 0.0]");
   expect_names(world_error(dir, far), dir, kFirstTable, "emitter.min", "at most 1e+09 cells fit");
 }
 

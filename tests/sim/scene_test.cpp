@@ -11,24 +11,13 @@
 #include <numbers>
 
 #include "core/error.h"
+#include "tests/scene_texts.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {
 namespace {
 
-const char* kMinimal = R"(# line 1
-[[material]]
-name = "sand"
-E = 1.0e7
-nu = 0.3
-restitution = 0.65
-mu = 0.5
-density = 2600.0
-
-[grain]
-radius = 1.0e-3
-material = "sand"
-)";
+const char* const kMinimal = test::kMinimalScene;
 
 // The InputError message of parsing `text`, or "" when it parses.
 std::string parse_error(const std::string& text) {
