@@ -32,6 +32,12 @@ inline std::string box_emitter(const std::string& type, const std::string& min, 
                      extra);
 }
 
+// A smooth [[boundary]] plane of sand through `point` with normal `normal` (TOML arrays).
+inline std::string smooth_plane(const std::string& point, const std::string& normal) {
+  return fmt::format("[[boundary]]\ntype = \"plane\"\npoint = {}\nnormal = {}\nmaterial = \"sand\"\n", point,
+                     normal);
+}
+
 // What differs between the poured scenes of the tests.
 struct PouredScene {
   int pour_count = 12;

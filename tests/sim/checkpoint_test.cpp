@@ -38,12 +38,8 @@ point = [0.0, 0.0, 0.0]
 size = [0.1, 0.1]
 particle_radius = 5.0e-3
 material = "sand"
-[[boundary]]
-type = "plane"
-point = [0.05, 0.0, 0.0]
-normal = [-1.0, 0.0, 0.0]
-material = "sand"
-[[boundary]]
+)" + test::smooth_plane("[0.05, 0.0, 0.0]", "[-1.0, 0.0, 0.0]") +
+                 R"([[boundary]]
 type = "cylinder"
 radius = 0.07
 z_min = 0.0
