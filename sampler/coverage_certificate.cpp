@@ -63,15 +63,40 @@ struct CoverageCertifier::Frame {
   double lower(double gpu_distance) const { return std::max(gpu_distance * (1.0 - relative) - margin, 0.0); }
 };
 
-std::vector<UncoveredPiece> deepest_holes(const CoverageCertificate& certificate, std::size_t count,
+// The deepest of the points (i, j) / 8 of a piece's parameter triangle, with its exact depth.
+void move_to_deepest_point(UncoveredPiece& piece, const PointGrid& grid) {
+  constexpr int kSteps = 8;
+  const auto& [a, b, c] = piece.corners;
+  for (int i = 0; i <= kSteps; ++i)
+    for (int j = 0; i + j <= kSteps; ++j) {
+      const Eigen::Vector3d x = a + (b - a) * (double(i) / kSteps) + (c - a) * (double(j) / kSteps);
+      const double depth = grid.nearest(x).distance;
+      if (depth > piece.depth) {
+        piece.position = x;
+        piece.depth = depth;
+      }
+    }
+}
+
+std::vector<UncoveredPiece> deepest_holes(const CoverageCertificate& certificate,
+                                          std::span<const Eigen::Vector3f> centres, std::size_t count,
                                           double separation) {
   std::vector<UncoveredPiece> picked;
-  if (count == 0 || certificate.pieces.empty()) return picked;
+  if (count == 0 || certificate.pieces.empty() || centres.empty()) return picked;
   SeparatedPicks picks(separation * certificate.pieces.front().depth);
   for (const UncoveredPiece& piece : certificate.pieces) {  // deepest first
     if (picked.size() == count) break;
     if (picks.try_add(piece.position, separation * piece.depth)) picked.push_back(piece);
   }
+  std::vector<Eigen::Vector3d> points(centres.size());
+  for (std::size_t i = 0; i < centres.size(); ++i) points[i] = centres[i].cast<double>();
+  const PointGrid grid(points, certificate.radius);
+  for (UncoveredPiece& piece : picked) {
+    piece.depth = grid.nearest(piece.position).distance;
+    move_to_deepest_point(piece, grid);
+  }
+  std::stable_sort(picked.begin(), picked.end(),
+                   [](const UncoveredPiece& a, const UncoveredPiece& b) { return a.depth > b.depth; });
   return picked;
 }
 
@@ -210,6 +235,7 @@ UncoveredPiece CoverageCertifier::make_piece(const Eigen::Vector4i& id, const Ei
   const Eigen::Vector3d v2 = piece_point(triangle, level, down ? i + 1 : i, j + 1);
   UncoveredPiece p;
   p.triangle = triangle;
+  p.corners = {v0, v1, v2};
   p.position = (v0 + v1 + v2) / 3.0;
   const Eigen::Vector3d cross = (v1 - v0).cross(v2 - v0);
   p.area = 0.5 * cross.norm();

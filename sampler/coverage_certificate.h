@@ -8,6 +8,7 @@
 // a lower bound from the points it evaluated. The argument, the floor and the float margin are in
 // docs/coverage-certificate.md.
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -38,6 +39,7 @@ struct CertificateSettings {
 
 // One final sub-triangle that is not proven covered.
 struct UncoveredPiece {
+  std::array<Eigen::Vector3d, 3> corners;              // m
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // m, its centroid (a point of the surface)
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();    // unit face normal of its triangle
   std::uint32_t triangle = 0;
@@ -63,9 +65,12 @@ struct CoverageCertificate {
   std::vector<UncoveredPiece> pieces;  // every uncovered final sub-triangle, deepest first
 };
 
-// Up to `count` uncovered points well apart, deepest first: each at least separation * its depth
-// from every deeper one taken (one hole, one point), for the sampler to put particles at.
-std::vector<UncoveredPiece> deepest_holes(const CoverageCertificate& certificate, std::size_t count,
+// Up to `count` holes, deepest first, one point each: uncovered pieces taken in order of depth when
+// at least separation * depth from every piece taken before, then each moved to the deepest of a
+// grid of 45 points over it (its depth there exact, from `centres`, the certified ones): where the
+// sampler puts particles, and what it reports.
+std::vector<UncoveredPiece> deepest_holes(const CoverageCertificate& certificate,
+                                          std::span<const Eigen::Vector3f> centres, std::size_t count,
                                           double separation = 1.0);
 
 class CoverageCertifier {

@@ -183,7 +183,7 @@ TEST(CoverageCertificate, IcosahedralSetsOnASphereAreBoundedWithinTheFloorOfThei
       expect_bounds_exact(cert, exact, r);
       if (n == 12 && r < exact) {
         // The holes are the 20 face centres of the icosahedron, one point each.
-        const std::vector<UncoveredPiece> holes = deepest_holes(cert, 100);
+        const std::vector<UncoveredPiece> holes = deepest_holes(cert, stored, 100);
         EXPECT_EQ(holes.size(), 20u);
         for (const auto& h : holes) EXPECT_NEAR(h.depth, exact, exact / 16.0);
       }
@@ -214,7 +214,7 @@ TEST(CoverageCertificate, LatticeWithOneParticleRemovedHasAHoleAsDeepAsTheSpacin
   // q towards a neighbour and sqrt(r^2 - (s/2)^2) ... at most s - r + a floor piece beyond.
   for (const UncoveredPiece& p : cert.pieces)
     EXPECT_LT((p.position - q).norm(), s - r + 0.5 * s) << p.position.transpose();
-  const std::vector<UncoveredPiece> holes = deepest_holes(cert, 10);
+  const std::vector<UncoveredPiece> holes = deepest_holes(cert, to_float(lattice), 10);
   ASSERT_EQ(holes.size(), 1u);
   EXPECT_LT((holes[0].position - q).norm(), r / 16.0);
   // The uncovered region holds the disc of radius s - r about q; the certificate's area is an upper bound.
