@@ -89,17 +89,19 @@ void check_particles(const Fields& f, const ParticleBody& b, bool interior_norma
 // The certificate's figures agree with each other: the lower bound is below the upper one, and a
 // body is certified exactly when no sub-triangle is left uncovered and the bound is at most r.
 // `prefix`: the key path of the quality object relative to `f` ("quality." at the top level).
-void check_certificate(const Fields& f, const std::string& prefix, const ParticleBody::Quality::Certificate& c) {
+void check_certificate(const Fields& f, const std::string& prefix,
+                       const ParticleBody::Quality::Certificate& c) {
   if (c.lower_over_r > c.bound_over_r) {
     f.fail(prefix + "covering_lower_over_r",
            fmt::format("{} is above covering_bound_over_r {}", c.lower_over_r, c.bound_over_r));
   }
   if (c.certified != (c.uncovered_subtriangles == 0)) {
-    f.fail(prefix + "coverage_certified", fmt::format("{} with {} uncovered sub-triangles", c.certified,
-                                                      c.uncovered_subtriangles));
+    f.fail(prefix + "coverage_certified",
+           fmt::format("{} with {} uncovered sub-triangles", c.certified, c.uncovered_subtriangles));
   }
   if (c.certified ? c.bound_over_r > 1.0 : c.bound_over_r < 1.0) {
-    f.fail(prefix + "coverage_certified", fmt::format("{} with covering_bound_over_r {}", c.certified, c.bound_over_r));
+    f.fail(prefix + "coverage_certified",
+           fmt::format("{} with covering_bound_over_r {}", c.certified, c.bound_over_r));
   }
 }
 
@@ -237,16 +239,17 @@ void read_source(const fs::path& file, const Json& node, ParticleBody& b) {
   if (!is_sha256(b.source_sha256)) source.fail("sha256", "must be 64 lowercase hex digits");
 }
 
-const std::vector<std::string> kCertificateKeys = {"coverage_certified",     "covering_bound_over_r",
-                                                   "covering_lower_over_r",  "uncovered_subtriangles",
-                                                   "uncovered_area",         "certificate_floor"};
+const std::vector<std::string> kCertificateKeys = {"coverage_certified",    "covering_bound_over_r",
+                                                   "covering_lower_over_r", "uncovered_subtriangles",
+                                                   "uncovered_area",        "certificate_floor"};
 
 // Version 3: the certificate's keys, all null but coverage_certified (false) when none was computed.
 std::optional<ParticleBody::Quality::Certificate> read_certificate(const Fields& f) {
   const bool certified = f.boolean("coverage_certified");
   if (f.at("covering_bound_over_r").is_null()) {
     for (std::size_t k = 2; k < kCertificateKeys.size(); ++k) {
-      if (!f.at(kCertificateKeys[k]).is_null()) f.fail(kCertificateKeys[k], "must be null without covering_bound_over_r");
+      if (!f.at(kCertificateKeys[k]).is_null())
+        f.fail(kCertificateKeys[k], "must be null without covering_bound_over_r");
     }
     if (certified) f.fail("coverage_certified", "true without covering_bound_over_r");
     return std::nullopt;
@@ -262,9 +265,9 @@ std::optional<ParticleBody::Quality::Certificate> read_certificate(const Fields&
 }
 
 ParticleBody::Quality read_quality(const fs::path& file, const Json& node, std::int64_t version) {
-  std::vector<std::string> keys = {"relative_radius",    "cv",         "covering_radius", "covering_over_r",
-                                   "covering_over_r_plus_grain", "max_abs_phi_over_r", "iterations",
-                                   "seconds",            "converged",  "injection_rounds"};
+  std::vector<std::string> keys = {
+      "relative_radius",    "cv",         "covering_radius", "covering_over_r", "covering_over_r_plus_grain",
+      "max_abs_phi_over_r", "iterations", "seconds",         "converged",       "injection_rounds"};
   if (version >= 3) keys.insert(keys.end(), kCertificateKeys.begin(), kCertificateKeys.end());
   const Fields f(file, node, "quality.", keys);
   ParticleBody::Quality q;

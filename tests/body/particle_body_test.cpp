@@ -50,7 +50,16 @@ ParticleBody box_body() {
   body.sdf_voxel_size = 0.0125;
   body.source_path = "meshes/box.obj";
   body.source_sha256 = std::string(64, 'a');
-  body.quality = {0.81, 0.035, 0.047, 0.94, 0.47 / 1.5, 0.02, 1234, 1.75, true, 2,
+  body.quality = {0.81,
+                  0.035,
+                  0.047,
+                  0.94,
+                  0.47 / 1.5,
+                  0.02,
+                  1234,
+                  1.75,
+                  true,
+                  2,
                   ParticleBody::Quality::Certificate{false, 1.07, 1.02, 12, 3e-4, 0.05 / 64.0}};
   return body;
 }
@@ -243,11 +252,12 @@ TEST(ParticleBody, JsonHasExactlyTheDocumentedKeys) {
                                             "interior_particle_count", "particles", "density", "mass", "volume", "center_of_mass", "inertia",
                                             "principal_moments", "principal_axes", "mass_properties_method",
                                             "mass_properties_cell", "sdf_voxel_size", "quality"}));
-  EXPECT_EQ(quality_keys, (std::vector<std::string>{"relative_radius", "cv", "covering_radius", "covering_over_r",
-                                                    "covering_over_r_plus_grain", "max_abs_phi_over_r", "iterations",
-                                                    "seconds", "converged", "injection_rounds", "coverage_certified",
-                                                    "covering_bound_over_r", "covering_lower_over_r",
-                                                    "uncovered_subtriangles", "uncovered_area", "certificate_floor"}));
+  EXPECT_EQ(quality_keys,
+            (std::vector<std::string>{"relative_radius", "cv", "covering_radius", "covering_over_r",
+                                      "covering_over_r_plus_grain", "max_abs_phi_over_r", "iterations",
+                                      "seconds", "converged", "injection_rounds", "coverage_certified",
+                                      "covering_bound_over_r", "covering_lower_over_r",
+                                      "uncovered_subtriangles", "uncovered_area", "certificate_floor"}));
   EXPECT_EQ(j["particles"], "box.particles.ply");
   EXPECT_EQ(j["particle_count"], 300);
   EXPECT_EQ(j["format_version"], kBodyFormatVersion);
@@ -274,7 +284,9 @@ TEST(ParticleBody, ValidationErrorsNameTheFileAndTheKey) {
   EXPECT_EQ(error_after([](auto& j) { j["quality"]["converged"] = 1; }), prefix + "quality.converged: must be true or false");
   EXPECT_NE(error_after([](auto& j) { j["quality"]["colour"] = "red"; }).find(prefix + "quality.colour: unknown key"),
             std::string::npos);
-  EXPECT_NE(error_after([](auto& j) { j["format_version"] = 4; }).find(prefix + "format_version: 4 is not supported"),
+  EXPECT_NE(error_after([](auto& j) {
+              j["format_version"] = 4;
+            }).find(prefix + "format_version: 4 is not supported"),
             std::string::npos);
   // The certificate's figures must agree with each other.
   EXPECT_EQ(error_after([](auto& j) { j["quality"]["coverage_certified"] = true; }),
@@ -291,7 +303,9 @@ TEST(ParticleBody, ValidationErrorsNameTheFileAndTheKey) {
   EXPECT_EQ(error_after([](auto& j) { j["quality"].erase("certificate_floor"); }),
             prefix + "quality.certificate_floor: missing");
   // Version 2 has no certificate keys.
-  EXPECT_NE(error_after([](auto& j) { j["format_version"] = 2; }).find(prefix + "quality.coverage_certified: unknown key"),
+  EXPECT_NE(error_after([](auto& j) {
+              j["format_version"] = 2;
+            }).find(prefix + "quality.coverage_certified: unknown key"),
             std::string::npos);
   EXPECT_NE(error_after([](auto& j) { j["mass_properties_method"] = "guess"; }).find(prefix + "mass_properties_method: must be"),
             std::string::npos);
@@ -441,13 +455,16 @@ TEST(Body, PhysicalKeysStillCheckEveryOtherKeyThatIsGiven) {
       {R"(, "density": 1000, "volume": 0.001)", "mass: 2 kg differs from density * volume = 1 kg"},
       {R"(, "units": {"length": "mm", "mass": "kg", "time": "s"})", "units.length: must be \"m\""},
       {R"(, "quality": {"cv": 0.1})", "quality.relative_radius: missing"},
-      {R"(, "source": {"path": "cube.obj", "sha256": "abc"})", "source.sha256: must be 64 lowercase hex digits"},
-      {R"(, "principal_axes": [[2, 0, 0], [0, 1, 0], [0, 0, 1]])", "principal_axes: must be three orthonormal"},
+      {R"(, "source": {"path": "cube.obj", "sha256": "abc"})",
+       "source.sha256: must be 64 lowercase hex digits"},
+      {R"(, "principal_axes": [[2, 0, 0], [0, 1, 0], [0, 0, 1]])",
+       "principal_axes: must be three orthonormal"},
       {R"(, "principal_axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "principal_moments": [0.5, 0.5, 0.7])",
        "principal_axes: axis 2 is not an eigenvector"},
       {R"(, "mass_properties_cell": 0.01)", "mass_properties_cell: must be null for closed_mesh"},
       {R"(, "mass_properties_method": "winding_cells")", "mass_properties_cell: missing"},
-      {R"(, "interior_particle_count": 2)", "interior_particle_count: 2 interior particles, but particle 6 has a non-zero normal"},
+      {R"(, "interior_particle_count": 2)",
+       "interior_particle_count: 2 interior particles, but particle 6 has a non-zero normal"},
       {R"(, "format_version": 4)", "format_version: 4 is not supported"},
       {R"(, "sdf_voxel_size": "small")", "sdf_voxel_size: must be a number"},
   };
