@@ -31,6 +31,8 @@ def run_sample(exe, mesh, count, out, extra):
     seconds = time.perf_counter() - t
     if res.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({res.returncode}): {res.stdout}{res.stderr}")
+    with open(os.path.join(out, f"sample-{count}.log"), "w") as log:  # the run's report, warnings included
+        log.write(res.stdout + res.stderr)
     work = re.search(r"certificate ([0-9.]+) s in ([0-9]+) passes, probes ([0-9.]+) s", res.stdout)
     if not work:
         raise RuntimeError(f"no work line in the report of {' '.join(cmd)}:\n{res.stdout}")
@@ -79,7 +81,7 @@ def main():
                "sample_certificate_s": cert_s, "sample_passes": passes, "sample_probes_s": probes_s,
                "ratio": b["certificate_s"] / b["probes_s"], **{k: b[k] for k in FIELDS if k in b}}
         rows.append(row)
-        print(json.dumps(row), flush=True)
+        print(json.dumps(row), f"(report: {tmp}/sample-{count}.log)", flush=True)
         if writer:
             writer.writerow({k: row.get(k, "") for k in FIELDS})
             csv_file.flush()
