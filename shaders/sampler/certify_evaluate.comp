@@ -122,15 +122,19 @@ void main() {
   // Every point of T is farther than the radius from every centre: splitting cannot find cover.
   bool wholly_uncovered = witness - rho > test_radius;
   bool at_floor = edge <= floor_length || level >= kMaxLevel || no_split != 0u;
-  // The search ended at max_shells before it could rule out a nearer centre (a hole deeper than
-  // the search; U may be infinite): split only while T is larger than the search, so its children
-  // may find one; a final one is bounded again by the host from its exact nearest centre.
+  // The search ended at max_shells before it could rule out a nearer centre (U may be infinite).
+  // Either T is large (its corners lie beyond the search, though a centre is near its centroid) or
+  // it sits in a hole deeper than the search. A large T is split like an undecided one: its children
+  // are smaller, their searches complete. One in a deep hole is split only while it is larger than
+  // the search, so its children may find a centre; a final one is bounded again by the host from its
+  // exact nearest centre.
   bool complete = bound <= searched;
+  bool near_centre = s.nearest2 <= searched * searched;  // g's nearest centre was seen
+  float resolution = witness_so_far > test_radius ? hole_resolution : floor_length;
   bool split;
   if (!complete) {
-    split = !at_floor && !wholly_uncovered && rho > searched;
+    split = !at_floor && !wholly_uncovered && (rho > searched || (near_centre && edge > resolution));
   } else {
-    float resolution = witness_so_far > test_radius ? hole_resolution : floor_length;
     bool undecided = !covered && !wholly_uncovered && edge > resolution;
     split = !at_floor && (bound > witness_so_far + refine_tol || undecided);
   }

@@ -222,6 +222,36 @@ TEST(CoverageCertificate, LatticeWithOneParticleRemovedHasAHoleAsDeepAsTheSpacin
   EXPECT_LE(cert.uncovered_area, M_PI * s * s);
 }
 
+// A triangle larger than the neighbour search: its corners lie beyond the shells searched from its
+// centroid although centres are near it. An equilateral triangle whose circumcentre O is a hole of
+// a hexagonal lattice (distance s / sqrt 3 from the nearest lattice points) has, for every centre p,
+// a corner at least sqrt(rho^2 + |p - O|^2) from p (its corner vectors from O sum to zero): with rho
+// just below the search radius the smallest largest-corner distance lies beyond it. The triangle
+// must still be split and certified: c = s / sqrt 3 (O is in it; no point of the plane is deeper).
+TEST(CoverageCertificate, TriangleLargerThanTheSearchIsSplitAndCertified) {
+  const double s = 0.05, r = 0.75 * s, hole = s / std::sqrt(3.0);
+  const Eigen::Vector3d o(0.5 * s, 0.5 * s / std::sqrt(3.0), 0.0);  // centroid of (0,0), (s,0), (s/2, h)
+  for (const int shells : {2, 8}) {
+    const double rho = (shells - 0.02) * r;  // below the search radius shells * r ...
+    ASSERT_GT(std::sqrt(rho * rho + hole * hole), shells * r);  // ... its best corner distance above it
+    TriangleMesh triangle;
+    for (const double degrees : {90.0, 210.0, 330.0}) {
+      const double a = degrees * M_PI / 180.0;
+      triangle.vertices.push_back(o + rho * Eigen::Vector3d(std::cos(a), std::sin(a), 0.0));
+    }
+    triangle.triangles.push_back({0, 1, 2});
+    const double reach = rho + 2.0 * s;
+    const std::vector<Eigen::Vector3d> lattice = hex_lattice(s, o.x() - reach, o.x() + reach, o.y() - reach,
+                                                             o.y() + reach, 0.0);
+    CoverageCertifier certifier(shared_context(), triangle);
+    CertificateSettings settings;
+    settings.max_shells = shells;
+    const CoverageCertificate cert = certifier.certify(to_float(lattice), r, settings);
+    expect_bounds_exact(cert, hole, r);
+    EXPECT_TRUE(cert.covered) << shells << " shells";
+  }
+}
+
 // A plate with particles over its top face only: each face is judged on its own. A point of the
 // bottom face lies sqrt(t^2 + d^2) from a top particle (d: in-plane distance), so the covering
 // radius is sqrt(t^2 + s^2 / 3), on the bottom face. Thin (t = 0.3 s): the top balls reach through and
