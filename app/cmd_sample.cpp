@@ -110,14 +110,19 @@ std::string csv_field(const std::string& text) {
 
 void write_summary(const std::filesystem::path& path, const std::vector<BatchRow>& rows) {
   std::string csv =
-      "mesh,status,exit_code,particles,particle_radius_m,relative_radius,cv,covering_over_r,max_abs_phi_over_r,"
-      "iterations,injection_rounds,converged,seconds,body_json,error\n";
+      "mesh,status,exit_code,particles,particle_radius_m,relative_radius,cv,covering_over_r,"
+      "coverage_certified,covering_bound_over_r,uncovered_subtriangles,max_abs_phi_over_r,iterations,"
+      "injection_rounds,converged,seconds,body_json,error\n";
   for (const BatchRow& r : rows) {
     const auto& q = r.quality;
-    csv += fmt::format("{},{},{},{},{:.9g},{:.6f},{:.6f},{:.6f},{:.3e},{},{},{},{:.3f},{},{}\n", csv_field(r.mesh),
-                       r.status, r.exit_code, r.particles, r.radius, q.relative_radius, q.cv, q.covering_over_r,
-                       q.max_abs_phi_over_r, q.iterations, q.injection_rounds, q.converged ? 1 : 0, q.seconds,
-                       csv_field(r.body_json), csv_field(r.error));
+    // A failed mesh has no certificate: its certificate columns are empty.
+    const auto& c = q.certificate;
+    csv += fmt::format(
+        "{},{},{},{},{:.9g},{:.6f},{:.6f},{:.6f},{},{},{},{:.3e},{},{},{},{:.3f},{},{}\n", csv_field(r.mesh),
+        r.status, r.exit_code, r.particles, r.radius, q.relative_radius, q.cv, q.covering_over_r,
+        c ? (c->certified ? "1" : "0") : "", c ? fmt::format("{:.6f}", c->bound_over_r) : "",
+        c ? std::to_string(c->uncovered_subtriangles) : "", q.max_abs_phi_over_r, q.iterations,
+        q.injection_rounds, q.converged ? 1 : 0, q.seconds, csv_field(r.body_json), csv_field(r.error));
   }
   std::filesystem::create_directories(path.parent_path().empty() ? "." : path.parent_path());
   write_file_atomically(path, csv);
@@ -155,7 +160,15 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--voxel", s.voxel_size, "SDF voxel [m] (default r / 2)")->check(CLI::PositiveNumber);
   cmd->add_option("--rounds", s.max_rounds, "Most hole-closing rounds")->check(CLI::NonNegativeNumber)->capture_default_str();
-  cmd->add_option("--probes", s.probes, "Surface points the covering radius is measured on")->capture_default_str();
+  cmd->add_option("--probes", s.probes,
+                  "Random surface points of the statistical covering radius (beside the certificate)")
+      ->capture_default_str();
+  cmd->add_option(
+         "--certificate-floor", s.certificate.floor_divisor,
+         "The coverage certificate splits triangles no finer than r / this (its bound is within max(r, c) / "
+         "this of the covering radius c)")
+      ->check(CLI::Range(1.0, 4096.0))
+      ->capture_default_str();
   cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor first")->check(CLI::PositiveNumber);
   cmd->add_option("--max-iterations", s.relax.max_iterations, "Most relaxation steps of the first relaxation (later rounds: 200)")
       ->check(CLI::PositiveNumber)
@@ -219,6 +232,29 @@ sampler::SampleResult sample_with_progress(gpu::Context& context, const Triangle
   return result;
 }
 
+// The certificate: proven or not, its bound and lower figure, and where the deepest holes are.
+void print_certificate_line(const sampler::SampleResult& result) {
+  const sampler::CoverageCertificate& c = result.certificate;
+  const double r = result.body.particle_radius;
+  if (c.covered) {
+    fmt::print(
+        "  certificate      certified: every surface point lies within r of a particle centre; "
+        "covering radius <= {:.3f} r (>= {:.3f} r), {} sub-triangles down to r / {:.0f}\n",
+        c.covering_bound / r, c.covering_lower / r, c.evaluated, r / c.floor);
+    return;
+  }
+  fmt::print(
+      "  certificate      NOT certified: covering radius <= {:.3f} r (>= {:.3f} r); {} sub-triangles "
+      "({:.3g} m^2) not proven within r of a particle, in {}{} holes\n",
+      c.covering_bound / r, c.covering_lower / r, c.uncovered, c.uncovered_area,
+      result.holes.size() == sampler::kReportedHoles ? "at least " : "", result.holes.size());
+  for (std::size_t k = 0; k < std::min<std::size_t>(result.holes.size(), 5); ++k) {
+    const auto& h = result.holes[k];
+    fmt::print("                   hole {:.3f} r deep at ({:.6g}, {:.6g}, {:.6g}) m\n", h.depth / r,
+               h.position.x(), h.position.y(), h.position.z());
+  }
+}
+
 void print_body_report(const Options& o, const sampler::SampleResult& result, const std::filesystem::path& json,
                        const gpu::Context& context) {
   const body::ParticleBody& body = result.body;
@@ -234,11 +270,19 @@ void print_body_report(const Options& o, const sampler::SampleResult& result, co
   }
   fmt::print("  evenness         relative radius {:.3f}, CV of nearest-neighbour distances {:.3f}\n",
              q.relative_radius, q.cv);
-  fmt::print("  coverage         covering radius {:.6g} m = {:.3f} r{}\n", q.covering_radius, q.covering_over_r,
-             q.covering_over_r_plus_grain ? fmt::format(" = {:.3f} (r + r_grain)", *q.covering_over_r_plus_grain) : "");
+  print_certificate_line(result);
+  fmt::print(
+      "  probes           covering radius {:.6g} m = {:.3f} r over {} random surface points (a lower "
+      "figure){}\n",
+      q.covering_radius, q.covering_over_r, o.sampling.probes,
+      q.covering_over_r_plus_grain ? fmt::format(" = {:.3f} (r + r_grain)", *q.covering_over_r_plus_grain)
+                                   : "");
   fmt::print("  on the surface   largest |phi| = {:.2e} r\n", q.max_abs_phi_over_r);
-  fmt::print("  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {}\n", q.iterations,
-             q.injection_rounds, q.converged ? "converged" : "NOT converged", q.seconds, context.summary());
+  fmt::print(
+      "  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {} (certificate {:.2f} s "
+      "in {} passes, probes {:.2f} s)\n",
+      q.iterations, q.injection_rounds, q.converged ? "converged" : "NOT converged", q.seconds,
+      context.summary(), result.certificate_seconds, result.certificate_passes, result.probe_seconds);
   fmt::print("  mass properties  {:.6g} kg, volume {:.6g} m^3, centre of mass ({:.6g}, {:.6g}, {:.6g}) m, {}\n", body.mass,
              body.volume, body.center_of_mass.x(), body.center_of_mass.y(), body.center_of_mass.z(),
              body.mass_method == body::MassMethod::WindingCells

@@ -86,6 +86,25 @@ void check_particles(const Fields& f, const ParticleBody& b, bool interior_norma
   }
 }
 
+// The certificate's figures agree with each other: the lower bound is below the upper one, and a
+// body is certified exactly when no sub-triangle is left uncovered and the bound is at most r.
+// `prefix`: the key path of the quality object relative to `f` ("quality." at the top level).
+void check_certificate(const Fields& f, const std::string& prefix,
+                       const ParticleBody::Quality::Certificate& c) {
+  if (c.lower_over_r > c.bound_over_r) {
+    f.fail(prefix + "covering_lower_over_r",
+           fmt::format("{} is above covering_bound_over_r {}", c.lower_over_r, c.bound_over_r));
+  }
+  if (c.certified != (c.uncovered_subtriangles == 0)) {
+    f.fail(prefix + "coverage_certified",
+           fmt::format("{} with {} uncovered sub-triangles", c.certified, c.uncovered_subtriangles));
+  }
+  if (c.certified ? c.bound_over_r > 1.0 : c.bound_over_r < 1.0) {
+    f.fail(prefix + "coverage_certified",
+           fmt::format("{} with covering_bound_over_r {}", c.certified, c.bound_over_r));
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Writing
 
@@ -104,6 +123,14 @@ Json quality_json(const ParticleBody::Quality& q) {
   quality["seconds"] = q.seconds;
   quality["converged"] = q.converged;
   quality["injection_rounds"] = q.injection_rounds;
+  // Version 3: the certificate; null figures (and not certified) when none was computed.
+  const auto& c = q.certificate;
+  quality["coverage_certified"] = c && c->certified;
+  quality["covering_bound_over_r"] = c ? Json(c->bound_over_r) : Json();
+  quality["covering_lower_over_r"] = c ? Json(c->lower_over_r) : Json();
+  quality["uncovered_subtriangles"] = c ? Json(c->uncovered_subtriangles) : Json();
+  quality["uncovered_area"] = c ? Json(c->uncovered_area) : Json();
+  quality["certificate_floor"] = c ? Json(c->floor) : Json();
   return quality;
 }
 
@@ -146,6 +173,14 @@ void validate_for_writing(const fs::path& json_path, const ParticleBody& b) {
   positive("sdf_voxel_size", b.sdf_voxel_size);
   if (b.mass_method == MassMethod::WindingCells) positive("mass_properties_cell", b.mass_cell);
   if (!is_sha256(b.source_sha256)) f.fail("source.sha256", "must be 64 lowercase hex digits");
+  if (const auto& c = b.quality.certificate) {
+    positive("quality.certificate_floor", c->floor);
+    if (!(c->bound_over_r >= 0.0) || !std::isfinite(c->bound_over_r) || !(c->lower_over_r >= 0.0) ||
+        !(c->uncovered_area >= 0.0) || !std::isfinite(c->uncovered_area)) {
+      f.fail("quality.covering_bound_over_r", "certificate figures must be finite and >= 0");
+    }
+    check_certificate(f, "quality.", *c);
+  }
   check_particles(f, b);
   check_mass_properties(f, b);
 }
@@ -204,10 +239,37 @@ void read_source(const fs::path& file, const Json& node, ParticleBody& b) {
   if (!is_sha256(b.source_sha256)) source.fail("sha256", "must be 64 lowercase hex digits");
 }
 
-ParticleBody::Quality read_quality(const fs::path& file, const Json& node) {
-  const Fields f(file, node, "quality.",
-                 {"relative_radius", "cv", "covering_radius", "covering_over_r", "covering_over_r_plus_grain",
-                  "max_abs_phi_over_r", "iterations", "seconds", "converged", "injection_rounds"});
+const std::vector<std::string> kCertificateKeys = {"coverage_certified",    "covering_bound_over_r",
+                                                   "covering_lower_over_r", "uncovered_subtriangles",
+                                                   "uncovered_area",        "certificate_floor"};
+
+// Version 3: the certificate's keys, all null but coverage_certified (false) when none was computed.
+std::optional<ParticleBody::Quality::Certificate> read_certificate(const Fields& f) {
+  const bool certified = f.boolean("coverage_certified");
+  if (f.at("covering_bound_over_r").is_null()) {
+    for (std::size_t k = 2; k < kCertificateKeys.size(); ++k) {
+      if (!f.at(kCertificateKeys[k]).is_null())
+        f.fail(kCertificateKeys[k], "must be null without covering_bound_over_r");
+    }
+    if (certified) f.fail("coverage_certified", "true without covering_bound_over_r");
+    return std::nullopt;
+  }
+  ParticleBody::Quality::Certificate c;
+  c.certified = certified;
+  c.bound_over_r = f.non_negative("covering_bound_over_r");
+  c.lower_over_r = f.non_negative("covering_lower_over_r");
+  c.uncovered_subtriangles = static_cast<std::size_t>(f.count("uncovered_subtriangles"));
+  c.uncovered_area = f.non_negative("uncovered_area");
+  c.floor = f.positive("certificate_floor");
+  return c;
+}
+
+ParticleBody::Quality read_quality(const fs::path& file, const Json& node, std::int64_t version) {
+  std::vector<std::string> keys = {
+      "relative_radius",    "cv",         "covering_radius", "covering_over_r", "covering_over_r_plus_grain",
+      "max_abs_phi_over_r", "iterations", "seconds",         "converged",       "injection_rounds"};
+  if (version >= 3) keys.insert(keys.end(), kCertificateKeys.begin(), kCertificateKeys.end());
+  const Fields f(file, node, "quality.", keys);
   ParticleBody::Quality q;
   q.relative_radius = f.non_negative("relative_radius");
   q.cv = f.non_negative("cv");
@@ -221,6 +283,8 @@ ParticleBody::Quality read_quality(const fs::path& file, const Json& node) {
   q.seconds = f.non_negative("seconds");
   q.converged = f.boolean("converged");
   q.injection_rounds = f.small_count("injection_rounds");
+  if (version >= 3) q.certificate = read_certificate(f);
+  if (q.certificate) check_certificate(f, "", *q.certificate);
   return q;
 }
 
@@ -334,7 +398,7 @@ ParticleBody read_body(const fs::path& json_path, BodyKeys keys) {
   const GivenMassKeys given = read_mass_properties(f, b);
   if (f.has("sdf_voxel_size")) b.sdf_voxel_size = f.positive("sdf_voxel_size");
   if (version >= 2) read_mass_method(f, b);
-  if (f.has("quality")) b.quality = read_quality(json_path, f.at("quality"));
+  if (f.has("quality")) b.quality = read_quality(json_path, f.at("quality"), version);
   check_mass_properties(f, b, given);
   const bool interior_normals =
       keys == BodyKeys::All || (version >= 2 && j.contains("interior_particle_count"));

@@ -14,9 +14,10 @@
 namespace ts::body {
 
 // body.json `format_version` written. Version 2 added interior_particle_count,
-// mass_properties_method and mass_properties_cell; version 1 files are still read (surface
-// particles only, mass properties from the closed mesh).
-inline constexpr int kBodyFormatVersion = 2;
+// mass_properties_method and mass_properties_cell; version 3 the coverage certificate's figures in
+// quality. Versions 1 and 2 are still read (version 1: surface particles only, mass properties from
+// the closed mesh; both: no certificate).
+inline constexpr int kBodyFormatVersion = 3;
 
 // Where a body's mass properties come from (body.json `mass_properties_method`).
 enum class MassMethod {
@@ -56,6 +57,19 @@ struct ParticleBody {
     double seconds = 0.0;             // s, wall time of the sampler
     bool converged = false;
     int injection_rounds = 0;  // hole-closing rounds
+
+    // The coverage certificate of the surface particles at radius r (sampler/coverage_certificate.h,
+    // docs/coverage-certificate.md): a proof, where covering_radius is a random sample's figure.
+    struct Certificate {
+      bool certified = false;                  // proven: every surface point lies within r of a centre
+      double bound_over_r = 0.0;               // covering radius / r is at most this (certified)
+      double lower_over_r = 0.0;               // and at least this (a point the certificate evaluated)
+      std::size_t uncovered_subtriangles = 0;  // final sub-triangles not proven covered (0 iff certified)
+      double uncovered_area = 0.0;             // m^2, their area (an upper bound of the uncovered area)
+      double floor = 0.0;                      // m, longest edge below which no sub-triangle is split
+    };
+    // Format version 3; absent in older files and in bodies whose maker computed none.
+    std::optional<Certificate> certificate;
   } quality;
 };
 

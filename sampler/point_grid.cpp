@@ -135,4 +135,41 @@ NearestPoint PointGrid::nearest(const Eigen::Vector3d& q, std::size_t exclude) c
   return best;
 }
 
+SeparatedPicks::SeparatedPicks(double largest_radius) : cell_(std::max(largest_radius, 1e-300)) {}
+
+SeparatedPicks::Cell SeparatedPicks::cell_of(const Eigen::Vector3d& p) const {
+  return (p / cell_).array().floor().cast<std::int64_t>();
+}
+
+std::uint64_t SeparatedPicks::key(const Cell& c) {
+  return static_cast<std::uint64_t>(c.x()) * 73856093u ^ static_cast<std::uint64_t>(c.y()) * 19349663u ^
+         static_cast<std::uint64_t>(c.z()) * 83492791u;
+}
+
+bool SeparatedPicks::separated(const Eigen::Vector3d& p) const {
+  const Cell c = cell_of(p);
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        const auto it = bins_.find(key(c + Cell(dx, dy, dz)));
+        if (it == bins_.end()) continue;
+        for (const std::size_t j : it->second) {
+          const auto& [q, radius] = picks_[j];
+          if ((q - p).squaredNorm() < radius * radius) return false;
+        }
+      }
+  return true;
+}
+
+void SeparatedPicks::add(const Eigen::Vector3d& p, double radius) {
+  bins_[key(cell_of(p))].push_back(picks_.size());
+  picks_.emplace_back(p, radius);
+}
+
+bool SeparatedPicks::try_add(const Eigen::Vector3d& p, double radius) {
+  if (!separated(p)) return false;
+  add(p, radius);
+  return true;
+}
+
 }  // namespace ts::sampler

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 namespace ts::sampler {
@@ -44,6 +45,31 @@ class PointGrid {
   std::vector<Eigen::Vector3d> points_;       // m, in bucket order
   std::vector<std::uint32_t> original_;       // index in the input of each sorted point
   Eigen::Vector3i cell_min_, cell_max_;       // cells of the points' bounding box
+};
+
+// Greedy selection of well-separated points, deepest first (holes of a coverage measurement): a
+// candidate is taken when no earlier pick lies within that pick's exclusion radius of it. Picks are
+// binned in cells as large as the largest radius (the first pick's, the deepest), so a candidate
+// checks only the picks in its 27 cells. Offer candidates in order of decreasing radius.
+class SeparatedPicks {
+ public:
+  explicit SeparatedPicks(double largest_radius);  // [m]
+  // Whether `p` (m) lies outside every earlier pick's exclusion radius.
+  bool separated(const Eigen::Vector3d& p) const;
+  // Takes `p` (m) with exclusion radius `radius` [m].
+  void add(const Eigen::Vector3d& p, double radius);
+  // Both: takes `p` unless it is too close to an earlier pick.
+  bool try_add(const Eigen::Vector3d& p, double radius);
+  std::size_t size() const { return picks_.size(); }
+
+ private:
+  using Cell = Eigen::Array<std::int64_t, 3, 1>;
+  Cell cell_of(const Eigen::Vector3d& p) const;
+  static std::uint64_t key(const Cell& c);
+
+  double cell_;
+  std::vector<std::pair<Eigen::Vector3d, double>> picks_;  // position [m], exclusion radius [m]
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> bins_;
 };
 
 }  // namespace ts::sampler

@@ -122,9 +122,8 @@ sdf::GridSpec choose_grid(const TriangleMesh& mesh, double radius, const SampleS
 constexpr double kMobileRadiusOverSpacing = 2.5;
 constexpr int kLocalIterations = 200;
 constexpr int kNeighbourRounds = 3;
-constexpr std::size_t kScoutProbeFraction = 4;
 std::vector<std::uint8_t> mobile_near_injections(const std::vector<Eigen::Vector3d>& particles,
-                                                 const std::vector<UncoveredPoint>& holes, double radius) {
+                                                 const std::vector<UncoveredPiece>& holes, double radius) {
   std::vector<Eigen::Vector3d> injected;
   for (const auto& h : holes) injected.push_back(h.position);
   const PointGrid grid(injected, std::max(radius, 1e-300));
@@ -262,24 +261,44 @@ sdf::ScanConvertResult scan_field(gpu::Context& context, const TriangleMesh& mes
   return sdf::scan_convert(context, mesh, normals, spec, scan);
 }
 
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The particles as a body stores them (float, mesh coordinates): what the certificate and the probes judge.
+std::vector<Eigen::Vector3f> as_stored(const std::vector<Eigen::Vector3d>& particles) {
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(particles.size());
+  for (const auto& p : particles) out.push_back(p.cast<float>());
+  return out;
+}
+
 // The particle arrangement as the hole-closing rounds leave it.
 struct Arrangement {
   std::vector<Eigen::Vector3d> particles;  // m, on the surface
   std::vector<Eigen::Vector3d> normals;    // unit outward normals
-  CoverageResult coverage;                 // of the last full probe pass
+  CoverageCertificate certificate;         // of the last round, at the target covering radius
+  int certificates = 0;                    // computed, all rounds
+  double certificate_seconds = 0.0;        // s, their wall time
   int iterations = 0, rounds = 0;
   bool converged = true;                   // the global (first) relaxation's verdict
 };
 
-// Relax, project, measure coverage, inject at the deepest holes, relax locally, repeat (sample_mesh.h
-// step 4), until the covering radius meets the target over the full probe set or the round limit.
+// Relax, project, certify coverage, inject at the deepest holes it proves, relax locally, repeat
+// (sample_mesh.h step 4), until the certificate holds at the target radius or the round limit.
 class HoleClosing {
  public:
-  HoleClosing(GpuRelaxer& relaxer, const TriangleMesh& mesh, const sdf::ExactDistance& exact,
+  HoleClosing(GpuRelaxer& relaxer, CoverageCertifier& certifier, const sdf::ExactDistance& exact,
               const sdf::GridSpec& spec, const SamplingPlan& plan, const SampleSettings& settings,
               const std::function<void(const SampleProgress&)>& progress)
-      : relaxer_(relaxer), mesh_(mesh), exact_(exact), spec_(spec), plan_(plan), settings_(settings),
-        progress_(progress), target_(settings.coverage * plan.z.radius) {
+      : relaxer_(relaxer),
+        certifier_(certifier),
+        exact_(exact),
+        spec_(spec),
+        plan_(plan),
+        settings_(settings),
+        progress_(progress),
+        target_(settings.coverage * plan.z.radius) {
     relax_ = settings.relax;
     relax_.spacing = plan.z.spacing;
     relax_.band_limit = 0.95 * kBandVoxels * spec.voxel_size;
@@ -292,13 +311,13 @@ class HoleClosing {
     for (;;) {
       if (relax_round) relax();
       project_and_thin();
-      measure();
-      if (out_.coverage.covering_radius <= target_ || out_.rounds >= settings_.max_rounds) break;
+      certify();
+      if (out_.certificate.covered || out_.rounds >= settings_.max_rounds) break;
       // The first rounds relax the new particles with their neighbours (better spacing). Later ones
-      // only place them: a particle at the deepest point of a hole, on the surface and at least r
-      // from every other one, can only shrink holes, never open one elsewhere, so the rounds converge.
+      // only place them: a particle at an uncovered point, on the surface and about r or more from
+      // every other one, can only shrink holes, never open one elsewhere, so the rounds converge.
       relax_round = out_.rounds < kNeighbourRounds;
-      inject();
+      if (!inject()) break;
     }
     return std::move(out_);
   }
@@ -326,38 +345,33 @@ class HoleClosing {
     if (dropped > 0) log::debug("sampler round {}: dropped {} crowded particles", out_.rounds, dropped);
   }
 
-  // Holes are hunted with a quarter of the probes (a 1M-probe pass costs more than a local
-  // relaxation on llvmpipe); the reported figure always comes from a full pass, and when that one
-  // still finds holes its worst points feed the next injection.
-  void measure() {
-    CoverageSettings probe;
-    probe.seed = settings_.seed + 1000u * static_cast<unsigned>(out_.rounds + 1);
-    probe.worst_k = std::max<std::size_t>(1, out_.particles.size() / 10);
-    probe.min_depth = target_;  // only real holes
-    probe.probes = std::max<std::size_t>(settings_.probes / kScoutProbeFraction, 1);
-    const std::span<const Eigen::Vector3d> particles(out_.particles);
-    out_.coverage = measure_coverage(mesh_, particles, probe);
-    if (out_.coverage.covering_radius <= target_ || out_.rounds >= settings_.max_rounds) {
-      probe.probes = settings_.probes;
-      probe.seed += 500u;
-      out_.coverage = measure_coverage(mesh_, particles, probe);
-    }
-    log::debug("sampler round {}: covering radius {:.4f} r over {} probes, {} holes deeper than the target",
-               out_.rounds, out_.coverage.covering_radius / plan_.z.radius, probe.probes, out_.coverage.worst.size());
+  void certify() {
+    const auto start = std::chrono::steady_clock::now();
+    out_.certificate = certifier_.certify(as_stored(out_.particles), target_, settings_.certificate);
+    out_.certificate_seconds += seconds_since(start);
+    ++out_.certificates;
+    const CoverageCertificate& c = out_.certificate;
+    log::debug(
+        "sampler round {}: covering radius <= {:.4f} r (>= {:.4f} r), {} of {} sub-triangles uncovered",
+        out_.rounds, c.covering_bound / plan_.z.radius, c.covering_lower / plan_.z.radius, c.uncovered,
+        c.evaluated);
   }
 
-  // New particles at the worst uncovered surface points (already on the surface); only they and the
-  // particles near them relax again, so the rest of the arrangement (and its holes, already
-  // measured) stays as it is.
-  void inject() {
-    mobile_ = mobile_near_injections(out_.particles, out_.coverage.worst, kMobileRadiusOverSpacing * plan_.z.spacing);
-    for (const auto& hole : out_.coverage.worst) out_.particles.push_back(hole.position);
+  // New particles at the deepest uncovered points, one per hole (already on the surface); only they
+  // and the particles near them relax again, so the rest of the arrangement stays as it is.
+  bool inject() {
+    const std::vector<UncoveredPiece> holes = deepest_holes(
+        out_.certificate, as_stored(out_.particles), std::max<std::size_t>(1, out_.particles.size() / 10));
+    if (holes.empty()) return false;
+    mobile_ = mobile_near_injections(out_.particles, holes, kMobileRadiusOverSpacing * plan_.z.spacing);
+    for (const auto& hole : holes) out_.particles.push_back(hole.position);
     relax_.max_iterations = std::min(relax_.max_iterations, kLocalIterations);
     ++out_.rounds;
+    return true;
   }
 
   GpuRelaxer& relaxer_;
-  const TriangleMesh& mesh_;
+  CoverageCertifier& certifier_;
   const sdf::ExactDistance& exact_;
   const sdf::GridSpec& spec_;
   const SamplingPlan& plan_;
@@ -369,14 +383,69 @@ class HoleClosing {
   Arrangement out_;
 };
 
-void warn_about_quality(const Arrangement& a, const SamplingPlan& plan, const SampleSettings& settings,
-                        SampleResult& result) {
+// What is reported of the coverage: the certificate at radius r (the rounds' own when they aimed at
+// r, i.e. --coverage 1) and the covering radius over random probes, a second, statistical figure of
+// the same particles. No probe can lie deeper than the certified bound: one that does means the
+// certificate is wrong, a bug, and no body is written.
+struct CoverageFigures {
+  CoverageCertificate certificate;
+  CoverageResult probes;
+  int certificates = 0;              // computed, the rounds' included
+  double certificate_seconds = 0.0;  // s, their wall time
+  double probe_seconds = 0.0;        // s
+};
+
+CoverageFigures measure_coverage_figures(CoverageCertifier& certifier, const TriangleMesh& mesh,
+                                         Arrangement& a, const SamplingPlan& plan,
+                                         const SampleSettings& settings) {
+  CoverageFigures f;
+  const std::vector<Eigen::Vector3f> stored = as_stored(a.particles);
+  auto start = std::chrono::steady_clock::now();
+  f.certificates = a.certificates;
+  if (settings.coverage == 1.0) {
+    f.certificate = std::move(a.certificate);
+  } else {
+    f.certificate = certifier.certify(stored, plan.z.radius, settings.certificate);
+    ++f.certificates;
+  }
+  f.certificate_seconds = a.certificate_seconds + seconds_since(start);
+  start = std::chrono::steady_clock::now();
+  CoverageSettings probe;
+  probe.probes = std::max<std::size_t>(settings.probes, 1);
+  probe.seed = settings.seed + 1000u * static_cast<unsigned>(a.rounds + 1) + 500u;
+  f.probes = measure_coverage(mesh, std::span<const Eigen::Vector3f>(stored), probe);
+  f.probe_seconds = seconds_since(start);
+  if (f.probes.covering_radius > f.certificate.covering_bound) {
+    const Eigen::Vector3d& p = f.probes.deepest.position;
+    throw Error(
+        ExitCode::Internal,
+        fmt::format(
+            "coverage certificate contradicted: a probe at ({:.9g}, {:.9g}, {:.9g}) m lies {:.9g} m from "
+            "every particle, beyond the certified bound {:.9g} m",
+            p.x(), p.y(), p.z(), f.probes.covering_radius, f.certificate.covering_bound));
+  }
+  return f;
+}
+
+void warn_about_quality(const CoverageFigures& f, int rounds, const SamplingPlan& plan,
+                        const SampleSettings& settings, SampleResult& result) {
   const double r = plan.z.radius;
-  if (a.coverage.covering_radius > settings.coverage * r) {
-    result.warnings.push_back(fmt::format("coverage target not reached after {} rounds: covering radius {:.4g} m = "
-                                          "{:.3f} r (target {:.3f} r)",
-                                          a.rounds, a.coverage.covering_radius, a.coverage.covering_radius / r,
-                                          settings.coverage));
+  const CoverageCertificate& c = f.certificate;
+  if (c.covering_bound > settings.coverage * r) {
+    result.warnings.push_back(fmt::format(
+        "coverage target not certified after {} rounds: covering radius <= {:.4g} m = {:.3f} r (>= {:.3f} r; "
+        "target {:.3f} r); {} sub-triangles ({:.3g} m^2) not proven within r of a particle{}",
+        rounds, c.covering_bound, c.covering_bound / r, c.covering_lower / r, settings.coverage, c.uncovered,
+        c.uncovered_area,
+        result.holes.empty() ? std::string()
+                             : fmt::format(", deepest hole {:.3f} r at ({:.6g}, {:.6g}, {:.6g}) m",
+                                           result.holes[0].depth / r, result.holes[0].position.x(),
+                                           result.holes[0].position.y(), result.holes[0].position.z())));
+  }
+  if (c.budget_reached) {
+    result.warnings.push_back(
+        "the coverage certificate reached its sub-triangle budget: it stopped refining early "
+        "(still conservative, but coarser)");
   }
   const ThinFeatures& thin = result.thin;
   if (thin.triangles > 0) {
@@ -413,21 +482,27 @@ void fill_body(const Arrangement& a, const sdf::ExactDistance& exact, const Tria
 }
 
 // Quality figures of the surface particles alone (docs/body-format.md).
-body::ParticleBody::Quality measure_quality(const Arrangement& a, const TriangleMesh& mesh, const SamplingPlan& plan,
-                                      const SampleSettings& settings) {
+body::ParticleBody::Quality measure_quality(const Arrangement& a, const CoverageFigures& f,
+                                            const TriangleMesh& mesh, const SamplingPlan& plan,
+                                            const SampleSettings& settings) {
   const std::span<const Eigen::Vector3d> particles(a.particles);
   const SpacingStatistics spacing = spacing_statistics(plan.area, particles);
   const double r = plan.z.radius;
+  const double c = f.probes.covering_radius;
   body::ParticleBody::Quality q;
   q.relative_radius = spacing.relative_radius;
   q.cv = spacing.cv_nn;
-  q.covering_radius = a.coverage.covering_radius;
-  q.covering_over_r = a.coverage.covering_radius / r;
-  if (settings.grain_radius > 0.0) q.covering_over_r_plus_grain = a.coverage.covering_radius / (r + settings.grain_radius);
+  q.covering_radius = c;
+  q.covering_over_r = c / r;
+  if (settings.grain_radius > 0.0) q.covering_over_r_plus_grain = c / (r + settings.grain_radius);
   q.max_abs_phi_over_r = max_distance_to_surface(mesh, particles) / r;
   q.iterations = a.iterations;
   q.injection_rounds = a.rounds;
   q.converged = a.converged;
+  const CoverageCertificate& cert = f.certificate;
+  q.certificate = body::ParticleBody::Quality::Certificate{
+      cert.covered,   cert.covering_bound / r, cert.covering_lower / r,
+      cert.uncovered, cert.uncovered_area,     cert.floor};
   return q;
 }
 
@@ -448,17 +523,27 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   std::vector<Eigen::Vector3d> seeds = sample_surface_points(mesh, plan.z.count, rng).positions;
   // Relax and close holes.
   GpuRelaxer relaxer(context, std::move(field.texture), settings.timings);
-  Arrangement a = HoleClosing(relaxer, mesh, exact, spec, plan, settings, progress).run(std::move(seeds));
+  CoverageCertifier certifier(context, mesh, settings.timings);
+  Arrangement a =
+      HoleClosing(relaxer, certifier, exact, spec, plan, settings, progress).run(std::move(seeds));
   // Measure and make the body.
+  CoverageFigures coverage = measure_coverage_figures(certifier, mesh, a, plan, settings);
   body::ParticleBody& body = result.body;
-  body.quality = measure_quality(a, mesh, plan, settings);
+  body.quality = measure_quality(a, coverage, mesh, plan, settings);
   result.thin = find_thin_features(mesh, exact, plan.z.spacing);
-  warn_about_quality(a, plan, settings, result);
+  result.holes = deepest_holes(coverage.certificate, as_stored(a.particles), kReportedHoles);
+  warn_about_quality(coverage, a.rounds, plan, settings, result);
+  result.certificate = std::move(coverage.certificate);
+  result.certificate_passes = coverage.certificates;
+  result.certificate_seconds = coverage.certificate_seconds;
+  result.probe_seconds = coverage.probe_seconds;
   if (settings.sign == sdf::SignMethod::Winding) orient_normals_by_winding(exact, a.particles, a.normals, plan.z.radius);
   fill_body(a, exact, mesh, plan, settings, body);
   body.sdf_voxel_size = spec.voxel_size;
-  body.quality.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (settings.timings) result.timing_report = field.stats.timing_report + relaxer.timing_report();
+  body.quality.seconds = seconds_since(start);
+  if (settings.timings) {
+    result.timing_report = field.stats.timing_report + relaxer.timing_report() + certifier.timing_report();
+  }
   return result;
 }
 

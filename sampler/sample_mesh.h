@@ -4,19 +4,22 @@
 //   2. seeds spread area-uniformly with the injected seed, as many as the coverage target needs;
 //   3. GPU relaxation (attraction to the zero level set + Gaussian repulsion);
 //   4. exact projection onto the mesh, crowded pairs (closer than 0.6 spacing) thinned, coverage
-//      measured on many surface points, particles injected at the worst uncovered points; the first
-//      3 rounds relax them with their neighbours (the rest frozen), later ones only place them, until
-//      the covering radius meets the target over the full probe set or the round limit;
-//   5. quality figures and mass properties (from the closed mesh, never from the particles; for a mesh
-//      that encloses no volume by itself, from its winding-number solid: sampler/winding_solid.h).
+//      certified on the GPU (sampler/coverage_certificate.h), particles injected at the deepest
+//      uncovered points it proves; the first 3 rounds relax them with their neighbours (the rest
+//      frozen), later ones only place them, until the certificate holds or the round limit;
+//   5. quality figures: the certificate at radius r, and the covering radius over random surface
+//      probes as a second, statistical figure; mass properties (from the closed mesh, never from the
+//      particles; for a mesh that encloses no volume by itself, from its winding-number solid:
+//      sampler/winding_solid.h).
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "body/particle_body.h"
 #include "core/mesh.h"
 #include "gpu/context.h"
+#include "sampler/coverage_certificate.h"
 #include "sampler/gpu_relaxer.h"
-#include "body/particle_body.h"
 #include "sdf/settings.h"
 
 namespace ts::sampler {
@@ -30,7 +33,9 @@ struct SampleSettings {
   double density = 1000.0;     // kg/m^3
   std::uint64_t seed = 1;
   int max_rounds = 12;                 // coverage repair rounds
-  std::size_t probes = 1'000'000;      // surface points the covering radius is measured on
+  std::size_t probes = 1'000'000;      // random surface points of the statistical covering radius
+  // The coverage certificate that steers the rounds and is reported (floor: r / floor_divisor).
+  CertificateSettings certificate;
   std::size_t max_particles = 20'000'000;
   std::size_t max_sdf_bytes = 1ull << 30;  // dense SDF texture budget; the voxel grows (with a warning) past it
   // Inside and outside (particle normals, thin features, interior fill): pseudonormals need a closed,
@@ -60,11 +65,19 @@ struct ThinFeatures {
   Aabb where;                  // their bounding box
 };
 
+// Most holes a SampleResult lists (the deepest; a certificate may prove more).
+inline constexpr std::size_t kReportedHoles = 20;
+
 struct SampleResult {
   body::ParticleBody body;
   ThinFeatures thin;
   std::size_t estimated_count = 0;  // surface particles, from the area and the coverage target
   double estimated_interior = 0.0;  // with `fill`: lattice points in V(phi <= -r) ~ V - A r, / (4 sqrt(2) r^3)
+  CoverageCertificate certificate;  // of the surface particles at radius r (body.quality has its figures)
+  std::vector<UncoveredPiece> holes;  // deepest uncovered points, one per hole, deepest first (<= kReportedHoles)
+  int certificate_passes = 0;         // certificates computed, all rounds
+  double certificate_seconds = 0.0;   // s, wall time of those
+  double probe_seconds = 0.0;         // s, wall time of the statistical probe pass
   std::vector<std::string> warnings;
   std::string timing_report;
 };

@@ -11,7 +11,6 @@
 #include <CGAL/Simple_cartesian.h>
 #include <algorithm>
 #include <random>
-#include <unordered_map>
 
 #include "core/error.h"
 #include "sampler/point_grid.h"
@@ -68,42 +67,21 @@ struct RankedProbe {
   bool operator<(const RankedProbe& o) const { return depth > o.depth || (depth == o.depth && index < o.index); }
 };
 
-// Greedy selection of well-separated deep probes. Picked points are binned in a hash map of cells as
-// large as the largest exclusion radius, so a candidate checks only the picks in its 27 cells.
+// Greedy selection of well-separated deep probes (sampler/point_grid.h: SeparatedPicks).
 std::vector<UncoveredPoint> select_worst(const ProbeSource& source, const PointGrid& grid,
                                          std::vector<RankedProbe> ranked, const std::vector<Eigen::Vector3f>& positions,
                                          const CoverageSettings& settings) {
   std::vector<UncoveredPoint> picked;
   if (settings.worst_k == 0 || ranked.empty()) return picked;
   tbb::parallel_sort(ranked.begin(), ranked.end());
-  const double cell = std::max(settings.separation * ranked.front().depth, 1e-300);
-  auto cell_of = [&](const Eigen::Vector3d& p) { return (p / cell).array().floor().cast<std::int64_t>().eval(); };
-  auto key = [](const Eigen::Array<std::int64_t, 3, 1>& c) {
-    return static_cast<std::uint64_t>(c.x()) * 73856093u ^ static_cast<std::uint64_t>(c.y()) * 19349663u ^
-           static_cast<std::uint64_t>(c.z()) * 83492791u;
-  };
-  std::unordered_map<std::uint64_t, std::vector<std::size_t>> bins;
-  auto separated = [&](const Eigen::Vector3d& p) {
-    const auto c = cell_of(p);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = bins.find(key(c + Eigen::Array<std::int64_t, 3, 1>(dx, dy, dz)));
-          if (it == bins.end()) continue;
-          for (const std::size_t j : it->second) {
-            const double radius = settings.separation * picked[j].depth;
-            if ((picked[j].position - p).squaredNorm() < radius * radius) return false;
-          }
-        }
-    return true;
-  };
+  SeparatedPicks picks(settings.separation * ranked.front().depth);
   for (const RankedProbe& candidate : ranked) {
     if (picked.size() == settings.worst_k || !(candidate.depth > settings.min_depth)) break;
-    if (!separated(positions[candidate.index].cast<double>())) continue;
+    if (!picks.separated(positions[candidate.index].cast<double>())) continue;
     // The stored float position only screens; the pick is regenerated exactly, with its exact depth.
     UncoveredPoint p = source.probe(candidate.index);
     p.depth = grid.nearest(p.position).distance;
-    bins[key(cell_of(p.position))].push_back(picked.size());
+    picks.add(p.position, settings.separation * p.depth);
     picked.push_back(p);
   }
   return picked;

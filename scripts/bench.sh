@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
-# Usage: scripts/bench.sh [peers|sdf|sample|peers-sim|sim|sim-accuracy|validation|agreement|all]
+# Usage: scripts/bench.sh [peers|sdf|sample|certificate|peers-sim|sim|sim-accuracy|validation|agreement|all]
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
 #               its section of docs/benchmarks.md (--quick: knot1 and armadillo at 64^3 and 128^3, 1,000
@@ -17,6 +17,10 @@
 #               -> section peers-sim of docs/benchmarks.md                              (~5 min, 2 cores)
 #   sample      tetrasand sample against Open3D's sample_points_poisson_disk at equal counts, plus the
 #               sampler's rounds x iterations trade -> section sampler of docs/benchmarks.md (~10 min)
+#   certificate the coverage certificate against the sampler's 1M-probe pass on bunny bodies of 1k, 10k,
+#               100k and 200k particles, an independent 10M-probe check of each, and the criteria of
+#               bench/certificate_criteria.md -> section certificate of docs/benchmarks.md
+#               (--quick: 1k and 10k only)                                    (~25 min on llvmpipe, 2 cores)
 #   validation  restitution, angle of repose, column collapse (4 x 20,000 grains), Mankoc-sized silo
 #               discharge (80,000 grains) with a Beverloo fit, contact-force distribution (the silo's fill
 #               and 3 more 30,000-grain piles), on the CPU reference
@@ -51,7 +55,7 @@ while [ $# -gt 0 ]; do
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in peers|sdf|sample|peers-sim|sim|sim-accuracy|validation|agreement|all) ;;
+case "$what" in peers|sdf|sample|certificate|peers-sim|sim|sim-accuracy|validation|agreement|all) ;;
   *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;;
 esac
 [ "$quick" -eq 1 ] && sdf_cases="knot1@64,128 armadillo@64,128"
@@ -100,6 +104,13 @@ if runs sample; then
   [ "$quick" -eq 1 ] && sample_args=(--large --no-trade)
   (cd "$root" && "$py" bench/sample_bench.py --tetrasand "$bin/tetrasand" "${sample_args[@]}" --csv "$work/sample.csv" \
     --markdown docs/benchmarks.md --command "scripts/bench.sh sample${sample_args:+ (--quick: ${sample_args[*]})}") || status=1
+fi
+if runs certificate; then
+  counts=(1000 10000 100000 200000)
+  [ "$quick" -eq 1 ] && counts=(1000 10000)
+  (cd "$root" && "$py" bench/certificate_bench.py --tetrasand "$bin/tetrasand" --counts "${counts[@]}" \
+    --csv "$work/certificate.csv" --markdown docs/benchmarks.md \
+    --command "scripts/bench.sh certificate$([ "$quick" -eq 1 ] && echo ' --quick')") || status=1
 fi
 if runs validation; then
   "$bin/tetrasand_validation_runs" "$work/validation" all

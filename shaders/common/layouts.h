@@ -41,6 +41,27 @@ TS_LAYOUT(SamplerGrid) {
   uvec4 dims;             // xyz: cells along each axis of the hashed grid; w: hash table size
 };
 
+// ---- sampler: one mesh triangle of the coverage certificate (sampler/coverage_certificate.h), relative
+// to the certificate's local origin: the point (a, b) of its parameter triangle (a, b >= 0, a + b <= 1)
+// is corner + a edge1 + b edge2.
+TS_LAYOUT(CertTriangle) {
+  vec4 corner;            // xyz: vertex 0 [m, local]; w unused
+  vec4 edge1;             // xyz: vertex 1 - vertex 0 [m]; w: the triangle's longest edge [m]
+  vec4 edge2;             // xyz: vertex 2 - vertex 0 [m]; w unused
+};
+
+// ---- sampler: a sub-triangle of the certificate's midpoint subdivision with its bounds. Level L of
+// a triangle is the regular grid of step 2^-L on its parameter triangle: the "up" sub-triangle (i, j)
+// has corners (i, j), (i+1, j), (i, j+1), the "down" one (i+1, j), (i, j+1), (i+1, j+1), in steps.
+// The certificate's work queue holds the ids alone (uvec4).
+TS_LAYOUT(CertLeaf) {
+  uvec4 id;               // x: triangle, y: level | orientation << 8 (0 up, 1 down), z: i, w: j
+  vec4 bounds;            // x: upper bound U of the distance from its points to the nearest centre [m];
+                          // y: distance from its centroid to the nearest centre [m] (a lower bound);
+                          // z: 1 if the search was complete (U is the smallest corner bound), 0 if
+                          // it stopped at its limit first; w: its longest edge [m]
+};
+
 // ---- sim: contact coefficients of one pair of materials (sim::PairCoefficients), in a table indexed
 // by material_i * material_count + material_j.
 TS_LAYOUT(SimPair) {

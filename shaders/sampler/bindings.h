@@ -8,6 +8,13 @@
 //                               TS_GRID_CELL_START, TS_GRID_SORTED; texture unit UNIT_SDF
 //   sampler/reduce_steps.comp   STEP_INFO, PARTIALS
 //   sampler/project.comp        POSITIONS; texture unit UNIT_SDF
+//   common/grid_* for the certificate: TS_GRID_POSITIONS = TS_CERT_CENTRES, TS_SORT_* (1-5)
+//   sampler/certify_evaluate.comp  CERT_CENTRES, CERT_TRIANGLES, CERT_QUEUE, TS_GRID_CELL_COUNT,
+//                               TS_GRID_CELL_START, TS_GRID_SORTED, CERT_SPLITS, CERT_UNCOVERED,
+//                               CERT_BOUNDS, CERT_TOTALS
+//   common/scan_* (gpu::PrefixScan) on CERT_SPLITS and CERT_UNCOVERED: TS_SCAN_* (0-1)
+//   sampler/certify_scatter.comp   CERT_QUEUE, CERT_SPLITS, CERT_UNCOVERED, CERT_BOUNDS, CERT_NEXT_QUEUE,
+//                               CERT_HOLES
 #ifndef TETRASAND_SAMPLER_BINDINGS_H
 #define TETRASAND_SAMPLER_BINDINGS_H
 
@@ -19,6 +26,17 @@
 #define TS_SAMPLER_STEP_INFO 6                     // vec4 per particle: see relax.comp
 #define TS_SAMPLER_PARTIALS 7                      // vec4 per 256 particles: STEP_INFO summed
 #define TS_SAMPLER_POSITIONS 0                     // vec4 (project.comp): positions moved in place
+
+// The coverage certificate (sampler/coverage_certificate.cpp); the grid's slots 2, 4 and 5 stay bound.
+#define TS_CERT_CENTRES TS_GRID_POSITIONS  // vec4: xyz particle centre [m, local]
+#define TS_CERT_TRIANGLES 1                // CertTriangle per mesh triangle
+#define TS_CERT_QUEUE 3                    // uvec4 per sub-triangle of this level (CertLeaf.id)
+#define TS_CERT_SPLITS 6                   // uint per sub-triangle + 1: 4 if split, else 0; then scanned
+#define TS_CERT_UNCOVERED 7                // uint per sub-triangle + 1: 1 if left uncovered, else 0; then scanned
+#define TS_CERT_BOUNDS 8                   // vec4 per sub-triangle: CertLeaf.bounds
+#define TS_CERT_TOTALS 9                   // uint[4]: largest bound and largest witness (float bits), see the kernel
+#define TS_CERT_NEXT_QUEUE 10              // uvec4 per sub-triangle of the next level
+#define TS_CERT_HOLES 11                   // CertLeaf per sub-triangle left uncovered at this level
 
 #define TS_SAMPLER_UNIT_SDF 0  // sampler3D: xyz unit gradient, w signed distance [m]
 

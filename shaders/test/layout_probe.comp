@@ -12,6 +12,8 @@ layout(std430, binding = TS_TEST_PROBE_SDF_PRISMS) buffer SdfPrisms { SdfPrism s
 layout(std430, binding = TS_TEST_PROBE_SIM_CYLINDERS) buffer SimCylinders { SimCylinder sim_cylinders[]; };
 layout(std430, binding = TS_TEST_PROBE_SIM_SPRINGS) buffer SimSprings { SimSpringSlots sim_springs[]; };
 layout(std430, binding = TS_TEST_PROBE_SIM_SPRINGS64) buffer SimSprings64 { SimSpringSlots64 sim_springs64[]; };
+layout(std430, binding = TS_TEST_PROBE_CERT_TRIANGLES) buffer CertTriangles { CertTriangle cert_triangles[]; };
+layout(std430, binding = TS_TEST_PROBE_CERT_LEAVES) buffer CertLeaves { CertLeaf cert_leaves[]; };
 void main() {
   // Touch each block so no compiler drops it.
   sdf_triangles[0].face_normal.w += 1.0;
@@ -22,4 +24,6 @@ void main() {
   sim_cylinders[0].material.x += 1u;
   sim_springs[0].displacement[0].w += 1.0;
   sim_springs64[0].displacement[0].w += 1.0;
+  cert_triangles[0].edge2.w += 1.0;
+  cert_leaves[0].bounds.w += 1.0;
 }

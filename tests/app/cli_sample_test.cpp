@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <filesystem>
 #include <fstream>
@@ -210,7 +211,41 @@ TEST(CliSample, JsonPrintsTheBodyAndOnlyFinishedFilesRemain) {
   EXPECT_EQ(json.at("particles").get<std::string>(), "sphere.particles.ply");
   EXPECT_GE(json.at("particle_count").get<int>(), 140);
   EXPECT_TRUE(json.at("quality").contains("covering_over_r"));
+  EXPECT_EQ(json.at("format_version").get<int>(), 3);
+  // The certificate's figures, beside the probes' (which can never exceed the certified bound).
+  const auto& q = json.at("quality");
+  EXPECT_TRUE(q.at("coverage_certified").is_boolean());
+  EXPECT_GE(q.at("covering_bound_over_r").get<double>(), q.at("covering_over_r").get<double>());
+  EXPECT_LE(q.at("covering_lower_over_r").get<double>(), q.at("covering_bound_over_r").get<double>());
+  EXPECT_EQ(q.at("uncovered_subtriangles").get<int>() == 0, q.at("coverage_certified").get<bool>());
+  EXPECT_GT(q.at("certificate_floor").get<double>(), 0.0);
   EXPECT_EQ(files_in(dir), (std::set<std::string>{"sphere.body.json", "sphere.particles.ply"}));
+}
+
+TEST(CliSample, ReportPrintsTheCertificateAndTheHolesItLeaves) {
+  const std::string sphere = quoted(test::asset("sphere.obj"));
+  {  // the default rounds close the holes: certified
+    std::string out;
+    ASSERT_EQ(
+        test::run_tetrasand(
+            "sample " + sphere + " -o " + quoted(test::temp_dir()) + " --count 150 --probes 20000", &out),
+        0)
+        << out;
+    EXPECT_NE(out.find("certificate      certified: every surface point lies within r"), std::string::npos)
+        << out;
+    EXPECT_NE(out.find("probes           covering radius"), std::string::npos) << out;
+  }
+  {  // one relaxation step and no rounds leave the random seeds' holes: reported, with where they are
+    std::string out;
+    ASSERT_EQ(test::run_tetrasand("sample " + sphere + " -o " + quoted(test::temp_dir()) +
+                                      " --count 150 --probes 20000 --rounds 0 --max-iterations 1",
+                                  &out),
+              0)
+        << out;
+    EXPECT_NE(out.find("certificate      NOT certified: covering radius <="), std::string::npos) << out;
+    EXPECT_NE(out.find(" r deep at ("), std::string::npos) << out;
+    EXPECT_NE(out.find("coverage target not certified after 0 rounds"), std::string::npos) << out;
+  }
 }
 
 TEST(CliSample, FillCountsTheInteriorParticlesInTheJsonAndThePly) {
@@ -264,6 +299,18 @@ TEST(CliSample, BatchWritesASummaryAndAFailureDoesNotStopIt) {
   EXPECT_EQ(rows[0][0], "mesh");
   EXPECT_EQ(rows[1][1], "ok");
   EXPECT_EQ(rows[2][1], "failed");
+  // The certificate's columns: filled for a converted mesh, empty for a failed one.
+  const auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(rows[0].begin(), rows[0].end(), name) - rows[0].begin());
+  };
+  for (const char* name : {"coverage_certified", "covering_bound_over_r", "uncovered_subtriangles"}) {
+    const std::size_t k = column(name);
+    ASSERT_LT(k, rows[0].size()) << name;
+    EXPECT_FALSE(rows[1][k].empty()) << name;
+    EXPECT_TRUE(rows[2][k].empty()) << name;
+  }
+  EXPECT_GE(std::stod(rows[1][column("covering_bound_over_r")]),
+            std::stod(rows[1][column("covering_over_r")]));
   EXPECT_NE(rows[2].back().find("no-such-mesh.obj"), std::string::npos);
   EXPECT_EQ(rows[3][1], "ok");  // after the failure
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "cube.body.json"));

@@ -50,7 +50,17 @@ ParticleBody box_body() {
   body.sdf_voxel_size = 0.0125;
   body.source_path = "meshes/box.obj";
   body.source_sha256 = std::string(64, 'a');
-  body.quality = {0.81, 0.035, 0.047, 0.94, 0.47 / 1.5, 0.02, 1234, 1.75, true, 2};
+  body.quality = {0.81,
+                  0.035,
+                  0.047,
+                  0.94,
+                  0.47 / 1.5,
+                  0.02,
+                  1234,
+                  1.75,
+                  true,
+                  2,
+                  ParticleBody::Quality::Certificate{false, 1.07, 1.02, 12, 3e-4, 0.05 / 64.0}};
   return body;
 }
 
@@ -181,6 +191,13 @@ TEST(ParticleBody, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(back.quality.seconds, body.quality.seconds);
   EXPECT_EQ(back.quality.converged, body.quality.converged);
   EXPECT_EQ(back.quality.injection_rounds, body.quality.injection_rounds);
+  ASSERT_TRUE(back.quality.certificate.has_value());
+  EXPECT_EQ(back.quality.certificate->certified, false);
+  EXPECT_EQ(back.quality.certificate->bound_over_r, 1.07);
+  EXPECT_EQ(back.quality.certificate->lower_over_r, 1.02);
+  EXPECT_EQ(back.quality.certificate->uncovered_subtriangles, 12u);
+  EXPECT_EQ(back.quality.certificate->uncovered_area, 3e-4);
+  EXPECT_EQ(back.quality.certificate->floor, 0.05 / 64.0);
   EXPECT_EQ(back.mass_method, MassMethod::ClosedMesh);
   EXPECT_TRUE(nlohmann::json::parse(read_file(json))["mass_properties_cell"].is_null());
 
@@ -213,6 +230,16 @@ TEST(ParticleBody, JsonRoundTripKeepsEveryField) {
   const fs::path json2 = write_body(dir, "plain", no_grain);
   EXPECT_TRUE(nlohmann::json::parse(read_file(json2))["quality"]["covering_over_r_plus_grain"].is_null());
   EXPECT_FALSE(read_body(json2).quality.covering_over_r_plus_grain.has_value());
+
+  // A body with no certificate: not certified, its figures null, and read back as absent.
+  ParticleBody uncertified = body;
+  uncertified.quality.certificate.reset();
+  const fs::path json5 = write_body(dir, "uncertified", uncertified);
+  const auto q5 = nlohmann::json::parse(read_file(json5))["quality"];
+  EXPECT_EQ(q5["coverage_certified"], false);
+  EXPECT_TRUE(q5["covering_bound_over_r"].is_null());
+  EXPECT_TRUE(q5["uncovered_subtriangles"].is_null());
+  EXPECT_FALSE(read_body(json5).quality.certificate.has_value());
 }
 
 TEST(ParticleBody, JsonHasExactlyTheDocumentedKeys) {
@@ -225,9 +252,12 @@ TEST(ParticleBody, JsonHasExactlyTheDocumentedKeys) {
                                             "interior_particle_count", "particles", "density", "mass", "volume", "center_of_mass", "inertia",
                                             "principal_moments", "principal_axes", "mass_properties_method",
                                             "mass_properties_cell", "sdf_voxel_size", "quality"}));
-  EXPECT_EQ(quality_keys, (std::vector<std::string>{"relative_radius", "cv", "covering_radius", "covering_over_r",
-                                                    "covering_over_r_plus_grain", "max_abs_phi_over_r", "iterations",
-                                                    "seconds", "converged", "injection_rounds"}));
+  EXPECT_EQ(quality_keys,
+            (std::vector<std::string>{"relative_radius", "cv", "covering_radius", "covering_over_r",
+                                      "covering_over_r_plus_grain", "max_abs_phi_over_r", "iterations",
+                                      "seconds", "converged", "injection_rounds", "coverage_certified",
+                                      "covering_bound_over_r", "covering_lower_over_r",
+                                      "uncovered_subtriangles", "uncovered_area", "certificate_floor"}));
   EXPECT_EQ(j["particles"], "box.particles.ply");
   EXPECT_EQ(j["particle_count"], 300);
   EXPECT_EQ(j["format_version"], kBodyFormatVersion);
@@ -254,7 +284,28 @@ TEST(ParticleBody, ValidationErrorsNameTheFileAndTheKey) {
   EXPECT_EQ(error_after([](auto& j) { j["quality"]["converged"] = 1; }), prefix + "quality.converged: must be true or false");
   EXPECT_NE(error_after([](auto& j) { j["quality"]["colour"] = "red"; }).find(prefix + "quality.colour: unknown key"),
             std::string::npos);
-  EXPECT_NE(error_after([](auto& j) { j["format_version"] = 3; }).find(prefix + "format_version: 3 is not supported"),
+  EXPECT_NE(error_after([](auto& j) {
+              j["format_version"] = 4;
+            }).find(prefix + "format_version: 4 is not supported"),
+            std::string::npos);
+  // The certificate's figures must agree with each other.
+  EXPECT_EQ(error_after([](auto& j) { j["quality"]["coverage_certified"] = true; }),
+            prefix + "quality.coverage_certified: true with 12 uncovered sub-triangles");
+  EXPECT_EQ(error_after([](auto& j) { j["quality"]["covering_lower_over_r"] = 1.5; }),
+            prefix + "quality.covering_lower_over_r: 1.5 is above covering_bound_over_r 1.07");
+  EXPECT_EQ(error_after([](auto& j) {
+              j["quality"]["uncovered_subtriangles"] = 0;
+              j["quality"]["coverage_certified"] = true;
+            }),
+            prefix + "quality.coverage_certified: true with covering_bound_over_r 1.07");
+  EXPECT_EQ(error_after([](auto& j) { j["quality"]["covering_bound_over_r"] = nullptr; }),
+            prefix + "quality.covering_lower_over_r: must be null without covering_bound_over_r");
+  EXPECT_EQ(error_after([](auto& j) { j["quality"].erase("certificate_floor"); }),
+            prefix + "quality.certificate_floor: missing");
+  // Version 2 has no certificate keys.
+  EXPECT_NE(error_after([](auto& j) {
+              j["format_version"] = 2;
+            }).find(prefix + "quality.coverage_certified: unknown key"),
             std::string::npos);
   EXPECT_NE(error_after([](auto& j) { j["mass_properties_method"] = "guess"; }).find(prefix + "mass_properties_method: must be"),
             std::string::npos);
@@ -284,6 +335,21 @@ TEST(ParticleBody, ValidationErrorsNameTheFileAndTheKey) {
   EXPECT_NE(input_error([&] { read_body(json); }).find(prefix + "not valid JSON"), std::string::npos);
 }
 
+TEST(ParticleBody, VersionTwoFilesAreStillReadWithoutACertificate) {
+  const fs::path dir = test::temp_dir();
+  const fs::path json = write_body(dir, "box", box_body());
+  auto j = nlohmann::ordered_json::parse(read_file(json));
+  j["format_version"] = 2;
+  for (const char* key : {"coverage_certified", "covering_bound_over_r", "covering_lower_over_r",
+                          "uncovered_subtriangles", "uncovered_area", "certificate_floor"}) {
+    j["quality"].erase(key);
+  }
+  write_text(json, j.dump(2));
+  const ParticleBody back = read_body(json);
+  EXPECT_FALSE(back.quality.certificate.has_value());
+  EXPECT_EQ(back.quality.covering_over_r, box_body().quality.covering_over_r);
+}
+
 TEST(ParticleBody, VersionOneFilesAreStillRead) {
   const fs::path dir = test::temp_dir();
   const fs::path json = write_body(dir, "box", box_body());
@@ -292,6 +358,10 @@ TEST(ParticleBody, VersionOneFilesAreStillRead) {
   j.erase("interior_particle_count");
   j.erase("mass_properties_method");
   j.erase("mass_properties_cell");
+  for (const char* key : {"coverage_certified", "covering_bound_over_r", "covering_lower_over_r",
+                          "uncovered_subtriangles", "uncovered_area", "certificate_floor"}) {
+    j["quality"].erase(key);
+  }
   write_text(json, j.dump(2));
   const ParticleBody back = read_body(json);
   EXPECT_EQ(back.mass_method, MassMethod::ClosedMesh);
@@ -385,14 +455,17 @@ TEST(Body, PhysicalKeysStillCheckEveryOtherKeyThatIsGiven) {
       {R"(, "density": 1000, "volume": 0.001)", "mass: 2 kg differs from density * volume = 1 kg"},
       {R"(, "units": {"length": "mm", "mass": "kg", "time": "s"})", "units.length: must be \"m\""},
       {R"(, "quality": {"cv": 0.1})", "quality.relative_radius: missing"},
-      {R"(, "source": {"path": "cube.obj", "sha256": "abc"})", "source.sha256: must be 64 lowercase hex digits"},
-      {R"(, "principal_axes": [[2, 0, 0], [0, 1, 0], [0, 0, 1]])", "principal_axes: must be three orthonormal"},
+      {R"(, "source": {"path": "cube.obj", "sha256": "abc"})",
+       "source.sha256: must be 64 lowercase hex digits"},
+      {R"(, "principal_axes": [[2, 0, 0], [0, 1, 0], [0, 0, 1]])",
+       "principal_axes: must be three orthonormal"},
       {R"(, "principal_axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "principal_moments": [0.5, 0.5, 0.7])",
        "principal_axes: axis 2 is not an eigenvector"},
       {R"(, "mass_properties_cell": 0.01)", "mass_properties_cell: must be null for closed_mesh"},
       {R"(, "mass_properties_method": "winding_cells")", "mass_properties_cell: missing"},
-      {R"(, "interior_particle_count": 2)", "interior_particle_count: 2 interior particles, but particle 6 has a non-zero normal"},
-      {R"(, "format_version": 3)", "format_version: 3 is not supported"},
+      {R"(, "interior_particle_count": 2)",
+       "interior_particle_count: 2 interior particles, but particle 6 has a non-zero normal"},
+      {R"(, "format_version": 4)", "format_version: 4 is not supported"},
       {R"(, "sdf_voxel_size": "small")", "sdf_voxel_size: must be a number"},
   };
   for (const auto& [extra, expected] : cases) {

@@ -59,6 +59,19 @@ TEST_F(GpuLayouts, SamplerGridMatchesCpp) {
   EXPECT_EQ(query(probe, "sampler_grids[0].dims").offset, static_cast<GLint>(offsetof(SamplerGrid, dims)));
 }
 
+TEST_F(GpuLayouts, CertificateStructsMatchCpp) {
+  using layout::CertLeaf;
+  using layout::CertTriangle;
+  EXPECT_EQ(query(probe, "cert_triangles[0].corner").top_level_stride,
+            static_cast<GLint>(sizeof(CertTriangle)));
+  EXPECT_EQ(query(probe, "cert_triangles[0].edge1").offset,
+            static_cast<GLint>(offsetof(CertTriangle, edge1)));
+  EXPECT_EQ(query(probe, "cert_triangles[0].edge2").offset,
+            static_cast<GLint>(offsetof(CertTriangle, edge2)));
+  EXPECT_EQ(query(probe, "cert_leaves[0].id").top_level_stride, static_cast<GLint>(sizeof(CertLeaf)));
+  EXPECT_EQ(query(probe, "cert_leaves[0].bounds").offset, static_cast<GLint>(offsetof(CertLeaf, bounds)));
+}
+
 TEST_F(GpuLayouts, SimStructsMatchCpp) {
   using layout::SimPair;
   using layout::SimPlane;
