@@ -32,7 +32,7 @@ struct SampleSettings {
   int max_rounds = 12;                 // coverage repair rounds
   std::size_t probes = 1'000'000;      // surface points the covering radius is measured on
   std::size_t max_particles = 20'000'000;
-  std::size_t max_sdf_bytes = 1ull << 30;  // dense SDF texture budget; the voxel grows (with a warning) past it
+  std::size_t max_sdf_bytes = 1ull << 30;  // sparse SDF budget on the GPU [bytes]: past it the run stops (exit 3)
   // Inside and outside (particle normals, thin features, interior fill): pseudonormals need a closed,
   // consistently oriented mesh; the generalised winding number also works on open or non-manifold
   // ones (normals then point to where the winding number drops).
@@ -60,12 +60,22 @@ struct ThinFeatures {
   Aabb where;                  // their bounding box
 };
 
+// What the sparse SDF cost (docs/benchmarks.md reports it per band voxel).
+struct FieldStats {
+  std::size_t band_voxels = 0;          // voxels with |d| < band
+  std::size_t gpu_bytes = 0;            // the NanoVDB grid on the GPU
+  std::size_t host_bytes = 0;           // the OpenVDB level set and the NanoVDB grid on the host, at their peak
+  std::size_t readback_bytes = 0;       // GPU -> host during scan conversion (the compacted band)
+  std::size_t scan_peak_gpu_bytes = 0;  // scan conversion's slab target and buffers
+};
+
 struct SampleResult {
   body::ParticleBody body;
   ThinFeatures thin;
   std::size_t estimated_count = 0;  // surface particles, from the area and the coverage target
   double estimated_interior = 0.0;  // with `fill`: lattice points in V(phi <= -r) ~ V - A r, / (4 sqrt(2) r^3)
   std::vector<std::string> warnings;
+  FieldStats field;
   std::string timing_report;
 };
 

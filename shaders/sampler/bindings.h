@@ -5,9 +5,9 @@
 //   pass (kernel)               slots
 //   common/grid_* (the grid)    TS_GRID_POSITIONS = TS_SAMPLER_POSITIONS_IN, TS_SORT_* (1-5)
 //   sampler/relax.comp          POSITIONS_IN, POSITIONS_OUT, VELOCITIES, STEP_INFO, TS_GRID_CELL_COUNT,
-//                               TS_GRID_CELL_START, TS_GRID_SORTED; texture unit UNIT_SDF
+//                               TS_GRID_CELL_START, TS_GRID_SORTED, SPARSE_FIELD
 //   sampler/reduce_steps.comp   STEP_INFO, PARTIALS
-//   sampler/project.comp        POSITIONS; texture unit UNIT_SDF
+//   sampler/project.comp        POSITIONS, SPARSE_FIELD
 #ifndef TETRASAND_SAMPLER_BINDINGS_H
 #define TETRASAND_SAMPLER_BINDINGS_H
 
@@ -20,6 +20,6 @@
 #define TS_SAMPLER_PARTIALS 7                      // vec4 per 256 particles: STEP_INFO summed
 #define TS_SAMPLER_POSITIONS 0                     // vec4 (project.comp): positions moved in place
 
-#define TS_SAMPLER_UNIT_SDF 0  // sampler3D: xyz unit gradient, w signed distance [m]
+#define TS_SAMPLER_SPARSE_FIELD 8  // uint[]: the NanoVDB level set (sdf::SparseField), as PNanoVDB.h reads it
 
 #endif
