@@ -1,11 +1,11 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Ray casting, fragment stage: sphere tracing through the narrow-band SDF from where the pixel's
-// ray enters the box to the far face, or to the particle already drawn at this pixel (the hybrid:
-// where a particle covers the pixel only the stretch in front of it is marched, and nothing when it
-// lies in front of the box). Steps are the sampled distance, which is the band width outside the
-// band (values there saturate at +-band, and the true distance is at least that); a sign change is
-// refined by regula falsi. The normal is the SDF's gradient; depth is the hit's true depth.
+// Ray casting, fragment stage: from where the pixel's ray enters the box to the far face, or to the
+// particle already drawn at this pixel (the hybrid: where a particle covers the pixel only the
+// stretch in front of it is marched, and nothing when it lies in front of the box). NanoVDB's HDDA
+// skips the empty space (nodes and tiles without band voxels) to the first voxel past a sign change;
+// around it, sphere tracing on the trilinear field (steps of the sampled distance) finds the
+// crossing, refined by regula falsi. The normal is the SDF's gradient; depth is the hit's true depth.
 #include "preview/bindings.h"
 #include "preview/camera.glsl"
 #include "preview/volume.glsl"
@@ -18,6 +18,53 @@ uniform float min_step;            // [voxels]: grazing rays still advance
 uniform vec3 surface_color;        // sRGB
 
 in vec3 v_world;
+
+// Sphere tracing on the trilinear field over [t, t_end] (voxels along `dir` from `o`); the first
+// sign change is refined by regula falsi into t_hit.
+bool trace_window(vec3 o, vec3 dir, float t, float t_end, out float t_hit) {
+  float f = sdf_at(o + t * dir);
+  t_hit = t;
+  for (int i = 0; i < max_steps; ++i) {
+    float t_next = min(t + max(f, min_step), t_end);
+    float f_next = sdf_at(o + t_next * dir);
+    if (f_next <= 0.0) {
+      float a = t, fa = f, b = t_next, fb = f_next;
+      for (int k = 0; k < 6; ++k) {
+        float m = a + (b - a) * clamp(fa / (fa - fb), 0.1, 0.9);
+        float fm = sdf_at(o + m * dir);
+        if (fm > 0.0) {
+          a = m;
+          fa = fm;
+        } else {
+          b = m;
+          fb = fm;
+        }
+      }
+      t_hit = a + (b - a) * (fa / max(fa - fb, 1e-12));
+      return true;
+    }
+    if (t_next >= t_end) return false;
+    t = t_next;
+    f = f_next;
+  }
+  return false;
+}
+
+// The first crossing of the zero level in [t, t_exit]: the HDDA finds the voxel past a sign change
+// and the trilinear field is traced from two voxels before it to two after. A ray that grazes the
+// surface can show a sign change of the voxels that the interpolant does not have there; the search
+// then goes on past that window.
+bool find_surface(vec3 o, vec3 dir, float t, float t_exit, out float t_hit) {
+  t_hit = t;
+  for (int window = 0; window < 16 && t < t_exit; ++window) {
+    float t_cross;
+    if (!next_crossing(o, dir, t, t_exit, t_cross)) return false;
+    float t_end = min(t_cross + 2.0, t_exit);
+    if (trace_window(o, dir, max(t, t_cross - 2.0), t_end, t_hit)) return true;
+    t = t_end;
+  }
+  return false;
+}
 
 layout(location = 0) out vec4 albedo;
 layout(location = 1) out vec4 normal_layer;
@@ -44,34 +91,9 @@ void main() {
   float t = max(max(near3.x, near3.y), max(near3.z, 0.0));
   if (t >= t_exit) discard;
 
-  float f = sdf_at(o + t * dir);
   float t_hit = t;
-  bool entered_inside = f <= 0.0;  // the near plane cuts the solid
-  bool hit = entered_inside;
-  for (int i = 0; i < max_steps && !hit; ++i) {
-    float t_next = min(t + max(f, min_step), t_exit);
-    float f_next = sdf_at(o + t_next * dir);
-    if (f_next <= 0.0) {
-      float a = t, fa = f, b = t_next, fb = f_next;
-      for (int k = 0; k < 6; ++k) {
-        float m = a + (b - a) * clamp(fa / (fa - fb), 0.1, 0.9);
-        float fm = sdf_at(o + m * dir);
-        if (fm > 0.0) {
-          a = m;
-          fa = fm;
-        } else {
-          b = m;
-          fb = fm;
-        }
-      }
-      t_hit = a + (b - a) * (fa / max(fa - fb, 1e-12));
-      hit = true;
-    } else if (t_next >= t_exit) {
-      break;
-    }
-    t = t_next;
-    f = f_next;
-  }
+  bool entered_inside = sdf_at(o + t * dir) <= 0.0;  // the near plane cuts the solid
+  bool hit = entered_inside || find_surface(o, dir, t, t_exit, t_hit);
   if (!hit) discard;
 
   vec3 p = start + dir * (t_hit * voxel_size);

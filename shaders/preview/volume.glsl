@@ -1,20 +1,37 @@
-// The SDF as the preview reads it: a 3D texture of signed distance in voxel units (R32F or R16F)
-// with hardware trilinear filtering. Voxel centres sit at integer voxel coordinates.
+// The SDF as the preview reads it: the sparse NanoVDB level set (sdf::SparseField) through
+// common/sparse_field.glsl, trilinear between voxel centres, in voxel units and clamped to the band.
+// Voxel centres sit at integer voxel coordinates of the grid spec (the box of the band).
 #ifndef TETRASAND_PREVIEW_VOLUME_GLSL
 #define TETRASAND_PREVIEW_VOLUME_GLSL
 
 #include "preview/bindings.h"
 
-layout(binding = TS_PREVIEW_UNIT_VOLUME) uniform sampler3D volume;
+layout(std430, binding = TS_PREVIEW_SPARSE_FIELD) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
+#include "common/sparse_field.glsl"
+
 uniform vec3 volume_origin;  // voxel (0,0,0)'s centre, relative to the scene centre [m]
 uniform float voxel_size;    // [m]
 uniform vec3 volume_dims;    // voxels along x, y, z
 uniform float band;          // |distance| saturates here [voxels]
 
+// One accessor per invocation, made on first use: it caches the last node, so the neighbouring
+// reads of a march skip most of the tree walk.
+FieldReader volume_reader;
+bool volume_reader_ready = false;
+
+void ensure_volume_reader() {
+  if (volume_reader_ready) return;
+  volume_reader = field_reader();
+  volume_reader_ready = true;
+}
+
 vec3 to_voxel(vec3 p) { return (p - volume_origin) / voxel_size; }
 
 // Signed distance [voxels] at voxel coordinates u.
-float sdf_at(vec3 u) { return texture(volume, (u + 0.5) / volume_dims).r; }
+float sdf_at(vec3 u) {
+  ensure_volume_reader();
+  return clamp(field_trilinear(volume_reader, u) / voxel_size, -band, band);
+}
 
 // Unit outward normal: central differences one voxel apart, so the normal varies smoothly across
 // voxel faces (the trilinear interpolant's own gradient jumps there and would show as banding).
@@ -24,6 +41,21 @@ vec3 sdf_normal(vec3 u) {
                 sdf_at(u + vec3(0, 0, 1)) - sdf_at(u - vec3(0, 0, 1)));
   float len = length(g);
   return len > 1e-12 ? g / len : vec3(0.0, 0.0, 1.0);
+}
+
+// Empty-space skipping: NanoVDB's hierarchical DDA from t (voxel units along the unit `dir` from
+// `o`) to t_max, through the tree's nodes and tiles, to the first active voxel whose value has the
+// other sign than the one at t. The cells it walks are offset by half a voxel, so a cell's value is
+// its nearest voxel centre's. False when the band is never crossed.
+bool next_crossing(vec3 o, vec3 dir, float t, float t_max, out float t_cross) {
+  ensure_volume_reader();
+  pnanovdb_buf_t buf;
+  pnanovdb_vec3_t origin = o + vec3(field_index_offset) + vec3(0.5);
+  pnanovdb_vec3_t direction = dir;
+  float value = 0.0;
+  t_cross = t_max;
+  return pnanovdb_hdda_zero_crossing(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, origin, t, direction, t_max,
+                                     t_cross, value);
 }
 
 #endif
