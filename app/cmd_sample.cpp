@@ -161,8 +161,8 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--sdf-budget-mib", o.sdf_budget_mib,
-                  "Most GPU memory the sparse SDF may take [MiB]; a larger field stops the run (exit 3) with the "
-                  "particle count that fits")
+                  "Most GPU memory the sparse SDF may take [MiB]; a larger field stops the run (exit 1) with the "
+                  "particle count (or, with --voxel, the voxel) that fits")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
 }

@@ -1,7 +1,7 @@
 // Preview rendering times (docs/benchmarks.md, "preview"): an image of a large SDF (ray casting), of
 // many particle impostors, and of both (the hybrid), each with the shadow map, on whatever device
 // the context picks. The SDF is OpenVDB's meshToLevelSet of the mesh (CPU, so the figure is the
-// renderer's, not the scan conversion's), densified as `tetrasand preview SDF.vdb` does. Usage:
+// renderer's, not the scan conversion's), as a sparse NanoVDB grid, as `tetrasand preview SDF.vdb` reads it. Usage:
 //   tetrasand_bench_preview [MESH] [--size 1024] [--resolution 512] [--particles 1000000] [--repeat 3]
 #include <fmt/format.h>
 

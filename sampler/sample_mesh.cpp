@@ -233,6 +233,21 @@ SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& e
   return plan;
 }
 
+// A sparse field above --sdf-budget-mib: its bytes grow as the band's area, ~ 1 / voxel^2, so the
+// voxel that fits is h sqrt(bytes / budget), and with the voxel following the radius the particle
+// count that fits is N budget / bytes.
+[[noreturn]] void throw_over_budget(const sdf::GridSpec& spec, std::size_t bytes, std::size_t band_voxels,
+                                    const SamplingPlan& plan, const SampleSettings& settings) {
+  const double over = static_cast<double>(bytes) / static_cast<double>(settings.max_sdf_bytes);
+  const std::string remedy =
+      settings.voxel_size > 0.0
+          ? fmt::format("a --voxel of at least {:.4g} m fits it", spec.voxel_size * std::sqrt(over))
+          : fmt::format("about {:.0f} particles fit it", static_cast<double>(plan.z.count) / over);
+  throw InputError(fmt::format("the sparse SDF at voxel {:.4g} m ({} band voxels) needs {:.1f} MiB of GPU memory, above "
+                               "the budget of {} MiB (--sdf-budget-mib); {}, or raise the budget",
+                               spec.voxel_size, band_voxels, bytes / 1048576.0, settings.max_sdf_bytes >> 20, remedy));
+}
+
 // The SDF on the GPU for the relaxation: scan conversion straight into the band, an index-space level
 // set (any voxel size), a sparse NanoVDB field. The field's size is checked against the budget before
 // it is uploaded; it grows as the particle count (band voxels ~ area / voxel^2 ~ count).
@@ -251,14 +266,7 @@ sdf::SparseField scan_field(gpu::Context& context, const TriangleMesh& mesh, con
   f.readback_bytes = converted.stats.readback_bytes;
   f.scan_peak_gpu_bytes = converted.stats.peak_gpu_bytes;
   result.timing_report = converted.stats.timing_report;
-  if (nano.size() > settings.max_sdf_bytes) {
-    const double fits = static_cast<double>(plan.z.count) * static_cast<double>(settings.max_sdf_bytes) /
-                        static_cast<double>(nano.size());
-    throw GpuError(fmt::format("the sparse SDF at voxel {:.4g} m ({} band voxels) needs {:.1f} MiB of GPU memory, above "
-                               "the {} MiB budget (--sdf-budget-mib); about {:.0f} particles fit it, or raise the budget",
-                               spec.voxel_size, f.band_voxels, nano.size() / 1048576.0, settings.max_sdf_bytes >> 20,
-                               fits));
-  }
+  if (nano.size() > settings.max_sdf_bytes) throw_over_budget(spec, nano.size(), f.band_voxels, plan, settings);
   sdf::SparseField field(std::move(nano), spec, kBandVoxels);
   f.gpu_bytes = field.gpu_bytes();
   return field;

@@ -3,8 +3,8 @@
 // Ray casting, fragment stage: from where the pixel's ray enters the box to the far face, or to the
 // particle already drawn at this pixel (the hybrid: where a particle covers the pixel only the
 // stretch in front of it is marched, and nothing when it lies in front of the box). NanoVDB's HDDA
-// skips the empty space (nodes and tiles without band voxels) to the first voxel past a sign change;
-// around it, sphere tracing on the trilinear field (steps of the sampled distance) finds the
+// skips the empty space (nodes and tiles without band voxels) and walks the band's voxels; around
+// each voxel near the zero level, sphere tracing on the trilinear field (steps of the sampled distance) finds the
 // crossing, refined by regula falsi. The normal is the SDF's gradient; depth is the hit's true depth.
 #include "preview/bindings.h"
 #include "preview/camera.glsl"
@@ -50,18 +50,51 @@ bool trace_window(vec3 o, vec3 dir, float t, float t_end, out float t_hit) {
   return false;
 }
 
-// The first crossing of the zero level in [t, t_exit]: the HDDA finds the voxel past a sign change
-// and the trilinear field is traced from two voxels before it to two after. A ray that grazes the
-// surface can show a sign change of the voxels that the interpolant does not have there; the search
-// then goes on past that window.
+// The first crossing of the zero level in [t, t_exit]. NanoVDB's hierarchical DDA walks the tree:
+// nodes and tiles without band voxels are crossed in one step each, and the voxels of the band's
+// leaves one by one (cells offset by half a voxel, so a cell's value is its nearest voxel centre's).
+// Where a voxel lies within kNearSurface voxels of the zero level the trilinear field may cross
+// zero within a voxel of the ray (its value differs from the nearest centre's by at most
+// sqrt(3)/2 x sqrt(3) = 1.5 voxels), so the field is sphere-traced from two voxels before that voxel
+// to two after. Conservative at silhouettes: a grazing ray is traced wherever a crossing could be.
+const float kNearSurface = 1.6;  // [voxels]
 bool find_surface(vec3 o, vec3 dir, float t, float t_exit, out float t_hit) {
+  ensure_volume_reader();
+  pnanovdb_buf_t buf;
   t_hit = t;
-  for (int window = 0; window < 16 && t < t_exit; ++window) {
-    float t_cross;
-    if (!next_crossing(o, dir, t, t_exit, t_cross)) return false;
-    float t_end = min(t_cross + 2.0, t_exit);
-    if (trace_window(o, dir, max(t, t_cross - 2.0), t_end, t_hit)) return true;
-    t = t_end;
+  pnanovdb_vec3_t origin = o + vec3(field_index_offset) + vec3(0.5);
+  pnanovdb_vec3_t direction = dir;
+  float t_min = t, t_max = t_exit;
+  pnanovdb_vec3_t box_min = pnanovdb_coord_to_vec3(pnanovdb_root_get_bbox_min(buf, volume_reader.accessor.root));
+  pnanovdb_vec3_t box_max = pnanovdb_coord_to_vec3(pnanovdb_coord_add(
+      pnanovdb_root_get_bbox_max(buf, volume_reader.accessor.root), pnanovdb_coord_uniform(1)));
+  if (!pnanovdb_hdda_ray_clip(box_min, box_max, origin, t_min, direction, t_max)) return false;
+  float near_surface = kNearSurface * voxel_size;  // field values are in world units
+  float traced_to = t_min;  // the field has no crossing before here
+  pnanovdb_vec3_t pos = pnanovdb_hdda_ray_start(origin, t_min, direction);
+  pnanovdb_coord_t ijk = pnanovdb_hdda_pos_to_ijk(pos);
+  int dim = int(pnanovdb_readaccessor_get_dim(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk));
+  pnanovdb_hdda_t hdda;
+  pnanovdb_hdda_init(hdda, origin, t_min, direction, t_max, dim);
+  while (pnanovdb_hdda_step(hdda)) {
+    pnanovdb_vec3_t next = pnanovdb_hdda_ray_start(origin, hdda.tmin + 1.0001, direction);
+    ijk = pnanovdb_hdda_pos_to_ijk(next);
+    dim = int(pnanovdb_readaccessor_get_dim(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk));
+    pnanovdb_hdda_update(hdda, origin, direction, dim);
+    if (hdda.dim > 1 || !pnanovdb_readaccessor_is_active(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk)) {
+      continue;
+    }
+    while (pnanovdb_hdda_step(hdda) &&
+           pnanovdb_readaccessor_is_active(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, hdda.voxel)) {
+      pnanovdb_address_t address = pnanovdb_readaccessor_get_value_address(PNANOVDB_GRID_TYPE_FLOAT, buf,
+                                                                           volume_reader.accessor, hdda.voxel);
+      float value = pnanovdb_read_float(buf, address);
+      float t_end = min(hdda.tmin + 2.0, t_exit);
+      if (value < near_surface && t_end > traced_to) {
+        if (trace_window(o, dir, max(traced_to, hdda.tmin - 2.0), t_end, t_hit)) return true;
+        traced_to = t_end;
+      }
+    }
   }
   return false;
 }

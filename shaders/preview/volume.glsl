@@ -43,19 +43,4 @@ vec3 sdf_normal(vec3 u) {
   return len > 1e-12 ? g / len : vec3(0.0, 0.0, 1.0);
 }
 
-// Empty-space skipping: NanoVDB's hierarchical DDA from t (voxel units along the unit `dir` from
-// `o`) to t_max, through the tree's nodes and tiles, to the first active voxel whose value has the
-// other sign than the one at t. The cells it walks are offset by half a voxel, so a cell's value is
-// its nearest voxel centre's. False when the band is never crossed.
-bool next_crossing(vec3 o, vec3 dir, float t, float t_max, out float t_cross) {
-  ensure_volume_reader();
-  pnanovdb_buf_t buf;
-  pnanovdb_vec3_t origin = o + vec3(field_index_offset) + vec3(0.5);
-  pnanovdb_vec3_t direction = dir;
-  float value = 0.0;
-  t_cross = t_max;
-  return pnanovdb_hdda_zero_crossing(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, origin, t, direction, t_max,
-                                     t_cross, value);
-}
-
 #endif
