@@ -151,9 +151,8 @@ void check_options(const Options& o) {
   }
 }
 
-preview::SdfVolume volume_from_vdb(const Options& o, gpu::Context& context) {
-  preview::SdfVolume volume =
-      preview::volume_from_level_set(*sdf::read_level_set(o.input), o.input, context.limits().max_3d_texture_size);
+preview::SdfVolume volume_from_vdb(const Options& o) {
+  preview::SdfVolume volume = preview::volume_from_level_set(*sdf::read_level_set(o.input), o.input);
   if (volume.band < 2.0) {
     log::warn("{}: the narrow band is {:.3g} voxels; below 2 the surface normals may show steps", o.input, volume.band);
   }
@@ -193,11 +192,12 @@ struct Content {
 void load_field(const Options& o, gpu::Context& context, preview::Renderer& renderer, Content& content) {
   if (o.input.empty()) return;
   content.inputs.emplace_back(o.input);
-  const preview::SdfVolume volume = is_vdb(o.input) ? volume_from_vdb(o, context) : volume_from_mesh_file(o, context, content.mesh);
+  preview::SdfVolume volume = is_vdb(o.input) ? volume_from_vdb(o) : volume_from_mesh_file(o, context, content.mesh);
   content.voxel_size = volume.spec.voxel_size;
-  content.field = fmt::format("SDF {} x {} x {} voxels of {:.4g} m (band {:.3g})", volume.spec.dims.x(), volume.spec.dims.y(),
-                            volume.spec.dims.z(), content.voxel_size, volume.band);
-  renderer.set_volume(volume);
+  content.field = fmt::format("SDF {} x {} x {} voxels of {:.4g} m (band {:.3g}; sparse: {} band voxels, {:.1f} MiB)",
+                              volume.spec.dims.x(), volume.spec.dims.y(), volume.spec.dims.z(), content.voxel_size,
+                              volume.band, volume.band_voxels, volume.grid.size() / 1048576.0);
+  renderer.set_volume(std::move(volume));
 }
 
 void load_particles(const Options& o, preview::Renderer& renderer, Content& content) {

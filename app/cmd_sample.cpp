@@ -174,8 +174,8 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--sdf-budget-mib", o.sdf_budget_mib,
-                  "GPU memory for the dense SDF texture [MiB]; past it the voxel grows beyond r / 2 (with a warning), "
-                  "which coarsens very large counts: raise it on GPUs with more memory")
+                  "Most GPU memory the sparse SDF may take [MiB]; a larger field stops the run (exit 1) with the "
+                  "particle count (or, with --voxel, the voxel) that fits")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
 }
@@ -309,7 +309,16 @@ int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
   } else {
     print_body_report(o, result, json, context);
   }
-  if (o.sampling.timings) fmt::print("{}", result.timing_report);
+  if (o.sampling.timings) {
+    const sampler::FieldStats& f = result.field;
+    const double per_voxel = f.band_voxels ? 1.0 / static_cast<double>(f.band_voxels) : 0.0;
+    fmt::print("sparse SDF: {} band voxels; GPU {:.1f} MiB ({:.1f} bytes a band voxel), host {:.1f} MiB ({:.1f} bytes a "
+               "band voxel) at its peak, scan conversion {:.1f} MiB on the GPU and {:.1f} MiB read back\n",
+               f.band_voxels, f.gpu_bytes / 1048576.0, static_cast<double>(f.gpu_bytes) * per_voxel,
+               f.host_bytes / 1048576.0, static_cast<double>(f.host_bytes) * per_voxel,
+               f.scan_peak_gpu_bytes / 1048576.0, f.readback_bytes / 1048576.0);
+    fmt::print("{}", result.timing_report);
+  }
   if (o.preview) {
     const std::filesystem::path png = std::filesystem::path(o.output) / (name + ".preview.png");
     preview::write_body_preview(context, mesh, body, png, {o.mesh});

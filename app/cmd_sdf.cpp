@@ -3,9 +3,11 @@
 #include <tbb/parallel_for.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 
+#include <nlohmann/json.hpp>
 #include <openvdb/tools/SignedFloodFill.h>
 
 #include "app/commands.h"
@@ -19,6 +21,7 @@
 #include "sdf/openvdb_compare.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
+#include "sdf/sparse_field.h"
 #include "sdf/vdb_io.h"
 
 namespace ts::app {
@@ -34,12 +37,32 @@ struct Options {
   std::string sign = "pseudonormal";
   double scale = 1.0;
   double slab_mb = 1024;
-  bool timings = false, compare = false;
+  bool timings = false, compare = false, json = false;
+};
+
+// The suffix chooses the file format: OpenVDB (.vdb) or NanoVDB (.nvdb), case-insensitive.
+bool is_nanovdb_path(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".vdb" && ext != ".nvdb") {
+    throw Error(ExitCode::Usage, fmt::format("-o {}: the output must end in .vdb (OpenVDB) or .nvdb (NanoVDB)", path));
+  }
+  return ext == ".nvdb";
+}
+
+// What the run cost: the band, memory per band voxel, host traffic (--timings, --json).
+struct Figures {
+  std::size_t band_voxels = 0;
+  std::size_t host_bytes = 0;       // the OpenVDB level set on the host
+  std::size_t nanovdb_bytes = 0;    // the same as a NanoVDB grid: what a GPU field of it takes
+  std::size_t scan_gpu_bytes = 0;   // scan conversion's slab target and buffers at their peak
+  std::size_t readback_bytes = 0;   // GPU -> host during scan conversion
+  double scan_seconds = 0.0, total_seconds = 0.0;
 };
 
 void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option("MESH", o.mesh, "Closed triangle mesh (any format assimp reads)")->required();
-  cmd->add_option("-o,--output", o.output, "Output .vdb file")->required();
+  cmd->add_option("-o,--output", o.output, "Output file: .vdb (OpenVDB level set) or .nvdb (NanoVDB)")->required();
   auto* voxel = cmd->add_option("--voxel", o.voxel, "Voxel size [world units, m]")->check(CLI::PositiveNumber);
   cmd->add_option("--resolution", o.resolution, "Voxels along the longest side (instead of --voxel)")
       ->check(CLI::PositiveNumber)
@@ -56,6 +79,7 @@ void add_options(CLI::App* cmd, Options& o) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_flag("--timings", o.timings, "Per-kernel GPU times and peak GPU memory");
+  cmd->add_flag("--json", o.json, "Print the run's figures (grid, band voxels, memory per band voxel, times) as JSON");
   cmd->add_flag("--compare-openvdb", o.compare,
                 "Also build OpenVDB's meshToLevelSet and the exact SDF; print how both compare with exact distance");
 }
@@ -114,7 +138,15 @@ class ScanProgress {
   int reported_tenths_ = 0;
 };
 
-void write_level_set(const Options& o, const sdf::ScanConvertResult& result, const gpu::Context& context) {
+// Writes the level set in the format the suffix asks for; returns the size of its NanoVDB form (the
+// GPU field's) when it was made or `measure` asks for it, else 0.
+std::size_t write_level_set(const Options& o, const sdf::ScanConvertResult& result, const gpu::Context& context,
+                            bool measure) {
+  if (is_nanovdb_path(o.output)) {
+    const sdf::NanoGrid nano = sdf::to_nanovdb(*result.grid);
+    sdf::write_nvdb(o.output, nano, {o.mesh});
+    return nano.size();
+  }
   const std::map<std::string, std::string> metadata{
       {"tetrasand:source", o.mesh},
       {"tetrasand:source_sha256", sha256_file(o.mesh)},
@@ -122,6 +154,40 @@ void write_level_set(const Options& o, const sdf::ScanConvertResult& result, con
       {"tetrasand:sign", o.sign},
       {"tetrasand:renderer", context.summary()}};
   sdf::write_vdb(o.output, result.grid, metadata, {o.mesh});
+  return measure ? sdf::to_nanovdb(*result.grid).size() : 0;
+}
+
+void print_figures(const Figures& f) {
+  const double per = f.band_voxels ? 1.0 / static_cast<double>(f.band_voxels) : 0.0;
+  fmt::print("memory: {} band voxels; host level set {:.1f} MiB ({:.1f} bytes a band voxel), as NanoVDB {:.1f} MiB "
+             "({:.1f} bytes a band voxel); scan conversion {:.1f} MiB on the GPU at its peak, {:.1f} MiB read back\n",
+             f.band_voxels, f.host_bytes / 1048576.0, static_cast<double>(f.host_bytes) * per,
+             f.nanovdb_bytes / 1048576.0, static_cast<double>(f.nanovdb_bytes) * per, f.scan_gpu_bytes / 1048576.0,
+             f.readback_bytes / 1048576.0);
+}
+
+void print_json(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec, const sdf::ScanConvertStats& st,
+                const Figures& f, const gpu::Context& context) {
+  const nlohmann::ordered_json out = {
+      {"mesh", o.mesh},
+      {"output", o.output},
+      {"triangles", mesh.triangle_count()},
+      {"grid", {{"dims", {spec.dims.x(), spec.dims.y(), spec.dims.z()}}, {"voxel_size", spec.voxel_size}, {"band", o.band}}},
+      {"band_voxels", f.band_voxels},
+      {"host_bytes", f.host_bytes},
+      {"host_bytes_per_band_voxel", f.band_voxels ? static_cast<double>(f.host_bytes) / f.band_voxels : 0.0},
+      {"nanovdb_bytes", f.nanovdb_bytes},
+      {"nanovdb_bytes_per_band_voxel", f.band_voxels ? static_cast<double>(f.nanovdb_bytes) / f.band_voxels : 0.0},
+      {"scan_peak_gpu_bytes", f.scan_gpu_bytes},
+      {"readback_bytes", f.readback_bytes},
+      {"slabs", st.slabs},
+      {"draws", st.draws},
+      {"degenerate_triangles", st.degenerate_triangles},
+      {"needle_triangles", st.needle_triangles},
+      {"scan_seconds", f.scan_seconds},
+      {"total_seconds", f.total_seconds},
+      {"renderer", context.summary()}};
+  fmt::print("{}\n", out.dump(2));
 }
 
 void print_summary(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
@@ -160,6 +226,7 @@ void print_comparison(const Options& o, const TriangleMesh& mesh, const sdf::Gri
 
 int run_sdf(const Options& o, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
+  is_nanovdb_path(o.output);  // a wrong suffix is a usage error before any work
   const TriangleMesh mesh = load_sdf_mesh(o);
   const sdf::GridSpec spec = grid_of(o, mesh);
   gpu::Context context(context_options(global));
@@ -174,8 +241,16 @@ int run_sdf(const Options& o, const GlobalOptions& global) {
   progress.end();
   // The winding-number signs replace the pseudonormal ones where the mesh cannot give them.
   if (o.sign == "winding") sdf::resign_by_winding_number(*result.grid, sdf::ExactDistance(mesh));
-  write_level_set(o, result, context);
+  Figures figures{result.stats.band_voxels, result.grid->memUsage(), 0, result.stats.peak_gpu_bytes,
+                  result.stats.readback_bytes, result.stats.seconds, 0.0};
+  figures.nanovdb_bytes = write_level_set(o, result, context, o.timings || o.json);
+  figures.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (o.json) {
+    print_json(o, mesh, spec, result.stats, figures, context);
+    return 0;
+  }
   print_summary(o, mesh, spec, result.stats);
+  if (o.timings) print_figures(figures);
   if (o.compare) print_comparison(o, mesh, spec, result);
   fmt::print("total {:.2f} s on {}\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
              context.summary());

@@ -18,7 +18,7 @@ function(tetrasand_add_shaders target)
       COMMAND ${CMAKE_COMMAND} -E make_directory ${stamp_dir} ${dst_dir}
       # -G (GL SPIR-V) is the mode in which Debian's glslang 12 resolves #include; auto-mapping keeps
       # plain GL uniforms legal there. The output is discarded: drivers compile the GLSL at run time.
-      COMMAND ${GLSLANG_VALIDATOR} --quiet -G --auto-map-locations --auto-map-bindings -o /dev/null -I${shader_root} ${src}
+      COMMAND ${GLSLANG_VALIDATOR} --quiet -G --auto-map-locations --auto-map-bindings -o /dev/null -I${shader_root} -I${NANOVDB_INCLUDE_DIR} ${src}
       COMMAND ${CMAKE_COMMAND} -E copy_if_different ${src} ${dst}
       COMMAND ${CMAKE_COMMAND} -E touch ${stamp}
       DEPENDS ${src} ${shared_headers}
@@ -44,4 +44,17 @@ function(tetrasand_add_shader_headers target)
     install(FILES ${CMAKE_SOURCE_DIR}/shaders/${rel} DESTINATION share/tetrasand/shaders/${rel_dir})
   endforeach()
   add_custom_target(${target} ALL DEPENDS ${outs})
+endfunction()
+
+# Vendor headers the kernels include (today NanoVDB's PNanoVDB.h, from Debian's libnanovdb-dev):
+# copied beside our shaders in the build tree and installed with them, so a binary that travels with
+# its share/ folder (the GPU machine has no libnanovdb-dev) finds them.
+function(tetrasand_add_vendor_shader_header target include_dir rel)
+  set(dst ${TETRASAND_SHADER_BUILD_DIR}/${rel})
+  add_custom_command(OUTPUT ${dst}
+    COMMAND ${CMAKE_COMMAND} -E copy_if_different ${include_dir}/${rel} ${dst}
+    DEPENDS ${include_dir}/${rel} VERBATIM)
+  add_custom_target(${target} ALL DEPENDS ${dst})
+  get_filename_component(rel_dir ${rel} DIRECTORY)
+  install(FILES ${include_dir}/${rel} DESTINATION share/tetrasand/shaders/${rel_dir})
 endfunction()

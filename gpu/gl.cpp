@@ -177,6 +177,7 @@ void Program::set(const char* name, float x, float y, float z) const { glProgram
 void Program::set(const char* name, float x, float y, float z, float w) const {
   glProgramUniform4f(id_, uniform(name), x, y, z, w);
 }
+void Program::set(const char* name, int x, int y) const { glProgramUniform2i(id_, uniform(name), x, y); }
 void Program::set(const char* name, int x, int y, int z) const { glProgramUniform3i(id_, uniform(name), x, y, z); }
 void Program::set_double(const char* name, double value) const { glProgramUniform1d(id_, uniform(name), value); }
 void Program::set_double(const char* name, double x, double y, double z) const {

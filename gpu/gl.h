@@ -78,6 +78,7 @@ class Program {
   void set(const char* name, float x, float y) const;
   void set(const char* name, float x, float y, float z) const;
   void set(const char* name, float x, float y, float z, float w) const;
+  void set(const char* name, int x, int y) const;
   void set(const char* name, int x, int y, int z) const;
   void set_matrix4(const char* name, const float* column_major) const;
   // Double-precision uniforms (GLSL `double`/`dvec3`, core since GL 4.0).

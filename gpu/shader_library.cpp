@@ -77,6 +77,11 @@ void ShaderLibrary::append(const fs::path& file, ShaderSource& out, std::vector<
     if (std::regex_search(line, match, include_re)) {
       fs::path target = file.parent_path() / match[1].str();
       if (!fs::exists(target)) target = root_ / match[1].str();
+#ifdef TETRASAND_VENDOR_SHADER_DIR
+      // A shader folder without the vendor headers (TETRASAND_SHADER_DIR at the source tree): the
+      // package's own copy, where the build found it.
+      if (!fs::exists(target)) target = fs::path(TETRASAND_VENDOR_SHADER_DIR) / match[1].str();
+#endif
       append(target, out, stack, false, {});
       out.text += "#line " + std::to_string(number + 1) + " " + std::to_string(file_number) + "\n";
     } else if (std::regex_search(line, extension_re)) {

@@ -19,8 +19,6 @@ namespace ts::preview {
 
 namespace {
 
-constexpr std::size_t kMaxR32Bytes = std::size_t{256} << 20;  // larger volumes are stored as R16F
-
 // A render target of the preview: one mip level, sampled with `filter`, clamped at the edges.
 gpu::Texture make_target(GLenum format, int width, int height, GLenum filter, const char* what) {
   gpu::Texture texture = gpu::Texture::create_2d(format, width, height, what);
@@ -140,45 +138,6 @@ void check_settings(const RenderSettings& s, const Aabb& content) {
   }
 }
 
-// The SDF as a 3D texture with hardware trilinear filtering.
-gpu::Texture upload_volume(const SdfVolume& volume) {
-  const Eigen::Vector3i& d = volume.spec.dims;
-  const bool half = volume.spec.voxel_count() * sizeof(float) > kMaxR32Bytes;
-  gpu::Texture texture =
-      gpu::Texture::create_3d(half ? GL_R16F : GL_R32F, d.x(), d.y(), d.z(), "preview SDF");
-  // Upload in slabs of about 64 MiB so the driver's staging copy stays small.
-  const std::size_t slice = static_cast<std::size_t>(d.x()) * d.y();
-  const int slab = std::max(1, static_cast<int>((std::size_t{64} << 20) / (4 * slice)));
-  for (int z = 0; z < d.z(); z += slab) {
-    texture.upload(volume.distance.data() + slice * z, GL_RED, GL_FLOAT, z, std::min(slab, d.z() - z));
-  }
-  texture.set_sampling(GL_LINEAR);
-  return texture;
-}
-
-// The box of the surface: voxels at or inside the zero level, grown by half a voxel; `fallback`
-// when there are none.
-Aabb surface_box(const SdfVolume& volume, const Aabb& fallback) {
-  const Eigen::Vector3i& d = volume.spec.dims;
-  std::vector<Aabb> slices(static_cast<std::size_t>(d.z()));
-  tbb::parallel_for(0, d.z(), [&](int k) {
-    for (int j = 0; j < d.y(); ++j)
-      for (int i = 0; i < d.x(); ++i)
-        if (volume.distance[volume.spec.linear_index(i, j, k)] <= 0.0f)
-          slices[k].extend(volume.spec.voxel_center(i, j, k));
-  });
-  Aabb box;
-  for (const Aabb& s : slices) {
-    if (!s.valid()) continue;
-    box.extend(s.min);
-    box.extend(s.max);
-  }
-  if (!box.valid()) return fallback;
-  box.min.array() -= 0.5 * volume.spec.voxel_size;
-  box.max.array() += 0.5 * volume.spec.voxel_size;
-  return box;
-}
-
 }  // namespace
 
 Eigen::Vector3d default_light(const Camera& camera, const Eigen::Vector3d& up) {
@@ -233,8 +192,8 @@ struct Renderer::Impl {
   gpu::Program particles_program, raycast_program, shade_program;
   gpu::VertexArray vao;  // none of the passes reads vertex attributes, but GL draws need one bound
 
-  // The SDF: texture, metadata, and the box of its surface.
-  gpu::Texture volume_texture;
+  // The SDF: the sparse field, its metadata, and the box of its surface.
+  sdf::SparseField field;
   sdf::GridSpec volume_spec;
   double volume_band = 0.0;
   bool has_volume = false;
@@ -325,7 +284,7 @@ void Renderer::Impl::upload_particles(const Eigen::Vector3d& new_origin) {
 }
 
 void Renderer::Impl::bind_volume(const gpu::Program& p) const {
-  volume_texture.bind_unit(TS_PREVIEW_UNIT_VOLUME);
+  field.bind(p, TS_PREVIEW_SPARSE_FIELD);
   set_vec3(p, "volume_origin", Eigen::Vector3d(volume_spec.origin - origin));
   p.set("voxel_size", static_cast<float>(volume_spec.voxel_size));
   p.set("volume_dims", static_cast<float>(volume_spec.dims.x()), static_cast<float>(volume_spec.dims.y()),
@@ -345,9 +304,8 @@ void Renderer::Impl::draw_particles(const gpu::Program& p) {
 void Renderer::Impl::draw_volume(const gpu::Program& p) {
   if (!has_volume) return;
   bind_volume(p);
-  const Eigen::Vector3i& d = volume_spec.dims;
-  // Enough steps to cross the box at the band's stride, and many more for grazing rays.
-  p.set("max_steps", static_cast<int>(4 * (d.x() + d.y() + d.z()) / std::max(1.0, volume_band)) + 512);
+  // Steps of the refinement near each crossing the HDDA finds (a few voxels long), grazing rays included.
+  p.set("max_steps", 512);
   p.set("min_step", 0.02f);
   // Front faces culled: one fragment per covered pixel, on the far face, also with the eye inside.
   gpu::StateScope state;
@@ -507,25 +465,19 @@ void Renderer::Impl::colour_surface(const RenderSettings& s, const CameraState& 
 Renderer::Renderer(gpu::Context& context, bool timings) : impl_(std::make_unique<Impl>(context, timings)) {}
 Renderer::~Renderer() = default;
 
-void Renderer::set_volume(const SdfVolume& volume) {
+void Renderer::set_volume(SdfVolume volume) {
   Impl& m = *impl_;
   const Eigen::Vector3i& d = volume.spec.dims;
-  if (volume.empty() || d.minCoeff() < 2 || volume.distance.size() != volume.spec.voxel_count()) {
+  if (volume.empty() || d.minCoeff() < 2) {
     throw InputError("the SDF to preview is empty or smaller than 2 voxels along an axis");
   }
-  const int max_side = m.context.limits().max_3d_texture_size;
-  if (d.maxCoeff() > max_side) {
-    throw InputError(fmt::format("the SDF grid is {} x {} x {} voxels; this GPU's 3D textures hold at most {} per side "
-                                 "(use a lower --resolution or a larger --voxel)",
-                                 d.x(), d.y(), d.z(), max_side));
-  }
-  m.volume_texture = upload_volume(volume);
+  m.field = sdf::SparseField(std::move(volume.grid), volume.spec, volume.band);
   m.check("preview SDF upload");
   m.volume_spec = volume.spec;
   m.volume_band = volume.band;
   m.volume_box = volume.world_box();
   m.has_volume = true;
-  m.surface_box = surface_box(volume, m.volume_box);
+  m.surface_box = volume.surface;
 }
 
 void Renderer::set_particles(const Particles& particles) {

@@ -77,9 +77,9 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Uploads the SDF as a 3D texture: R32F up to 256 MiB, R16F above (distances are in voxels, so
-  // half precision keeps 1e-3 voxel). GpuError when a side exceeds the device's 3D texture limit.
-  void set_volume(const SdfVolume& volume);
+  // Uploads the SDF's sparse NanoVDB grid as one storage buffer (sdf::SparseField): memory follows
+  // the band, not the box. GpuError naming the size when it exceeds the device's largest storage block.
+  void set_volume(SdfVolume volume);
   void set_particles(const Particles& particles);
 
   // The box of what is drawn: the SDF's surface (voxels at or inside the zero level) and the

@@ -1,16 +1,44 @@
 #include "preview/volume.h"
 
 #include <fmt/format.h>
-#include <openvdb/tools/Dense.h>
-#include <tbb/parallel_for.h>
 
-#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
 #include "sdf/pseudonormals.h"
+#include "sdf/scan_convert.h"
 
 namespace ts::preview {
+namespace {
+
+// The box of the voxels at or inside the zero level (the band's inner half encloses the inside, so
+// the inactive inside tiles add nothing), grown by half a voxel; the whole box when there are none.
+Aabb surface_box(const openvdb::FloatGrid& grid, const sdf::GridSpec& spec, const Aabb& fallback) {
+  openvdb::CoordBBox inside;
+  for (auto it = grid.cbeginValueOn(); it; ++it) {
+    if (*it <= 0.0f) inside.expand(it.getBoundingBox());
+  }
+  if (inside.empty()) return fallback;
+  const openvdb::Coord lo = inside.min(), hi = inside.max();
+  Aabb box;
+  box.extend(spec.voxel_center(lo.x() - spec.index_offset.x(), lo.y() - spec.index_offset.y(), lo.z() - spec.index_offset.z()));
+  box.extend(spec.voxel_center(hi.x() - spec.index_offset.x(), hi.y() - spec.index_offset.y(), hi.z() - spec.index_offset.z()));
+  box.min.array() -= 0.5 * spec.voxel_size;
+  box.max.array() += 0.5 * spec.voxel_size;
+  return box;
+}
+
+SdfVolume make_volume(const openvdb::FloatGrid& grid, const sdf::GridSpec& spec, double band) {
+  SdfVolume v;
+  v.spec = spec;
+  v.band = band;
+  v.grid = sdf::to_nanovdb(grid);
+  v.band_voxels = grid.activeVoxelCount();
+  v.surface = surface_box(grid, spec, v.world_box());
+  return v;
+}
+
+}  // namespace
 
 Aabb SdfVolume::world_box() const {
   Aabb box;
@@ -19,20 +47,7 @@ Aabb SdfVolume::world_box() const {
   return box;
 }
 
-SdfVolume volume_from_dense(const sdf::DenseSdf& dense, double band_voxels) {
-  SdfVolume v;
-  v.spec = dense.spec;
-  v.band = band_voxels;
-  v.distance.resize(dense.values.size());
-  const float scale = static_cast<float>(1.0 / dense.spec.voxel_size), band = static_cast<float>(band_voxels);
-  tbb::parallel_for(std::size_t{0}, v.distance.size(), [&](std::size_t i) {
-    v.distance[i] = std::clamp(dense.values[i].w() * scale, -band, band);
-  });
-  return v;
-}
-
-SdfVolume volume_from_level_set(const openvdb::FloatGrid& grid, const std::filesystem::path& file, int max_side,
-                                std::size_t max_voxels) {
+SdfVolume volume_from_level_set(const openvdb::FloatGrid& grid, const std::filesystem::path& file) {
   const openvdb::math::Transform& transform = grid.transform();
   const openvdb::Vec3d size = transform.voxelSize();
   // A uniform scale plus a translation: index (i, j, k) -> origin + h (i, j, k).
@@ -47,44 +62,24 @@ SdfVolume volume_from_level_set(const openvdb::FloatGrid& grid, const std::files
   const double background = std::abs(static_cast<double>(grid.background()));
   if (!(background > 0.0)) throw InputError(file, "the level set's background value is 0: no narrow band to ray-cast");
   openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
+  if (box.empty()) throw InputError(file, "the level set has no active voxels: nothing to ray-cast");
   box.expand(2);
-  const openvdb::Coord dim = box.dim();
-  const std::size_t voxels = static_cast<std::size_t>(dim.x()) * dim.y() * dim.z();
-  if (max_side > 0 && std::max({dim.x(), dim.y(), dim.z()}) > max_side) {
-    throw InputError(file, fmt::format("the level set spans {} x {} x {} voxels; this GPU's 3D textures hold at most {} "
-                                       "per side",
-                                       dim.x(), dim.y(), dim.z(), max_side));
-  }
-  if (voxels > max_voxels) {
-    throw InputError(file, fmt::format("the level set spans {} x {} x {} voxels, above the preview's cap of {} voxels",
-                                       dim.x(), dim.y(), dim.z(), max_voxels));
-  }
-  SdfVolume v;
-  v.band = background / h;
-  v.spec.voxel_size = h;
-  v.spec.dims = Eigen::Vector3i(dim.x(), dim.y(), dim.z());
-  v.spec.index_offset = Eigen::Vector3i(box.min().x(), box.min().y(), box.min().z());
+  sdf::GridSpec spec;
+  spec.voxel_size = h;
+  spec.dims = Eigen::Vector3i(box.dim().x(), box.dim().y(), box.dim().z());
+  spec.index_offset = Eigen::Vector3i(box.min().x(), box.min().y(), box.min().z());
   const openvdb::Vec3d origin = transform.indexToWorld(box.min());
-  v.spec.origin = Eigen::Vector3d(origin.x(), origin.y(), origin.z());
-  v.distance.resize(voxels);
-  // LayoutXYZ: x fastest, exactly GridSpec::linear_index.
-  openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, v.distance.data());
-  openvdb::tools::copyToDense(grid, dense);
-  const float scale = static_cast<float>(1.0 / h), band = static_cast<float>(v.band);
-  tbb::parallel_for(std::size_t{0}, voxels, [&](std::size_t i) {
-    v.distance[i] = std::clamp(v.distance[i] * scale, -band, band);
-  });
-  return v;
+  spec.origin = Eigen::Vector3d(origin.x(), origin.y(), origin.z());
+  return make_volume(grid, spec, background / h);
 }
 
 SdfVolume volume_from_mesh(gpu::Context& context, const TriangleMesh& mesh, const sdf::SdfSettings& settings) {
   const sdf::GridSpec spec = sdf::make_grid(bounding_box(mesh), settings);
   sdf::ScanConvertOptions scan;
   scan.band = settings.band;
-  scan.keep_dense = true;
-  scan.build_grid = false;
+  scan.index_space_grid = true;  // read by index on the GPU: any voxel size
   const sdf::ScanConvertResult result = sdf::scan_convert(context, mesh, sdf::compute_pseudonormals(mesh), spec, scan);
-  return volume_from_dense(result.dense, settings.band);
+  return make_volume(*result.grid, spec, settings.band);
 }
 
 }  // namespace ts::preview

@@ -10,28 +10,23 @@
 
 namespace ts::sampler {
 
-GpuRelaxer::GpuRelaxer(gpu::Context& context, sdf::SdfTexture field, bool timings)
+GpuRelaxer::GpuRelaxer(gpu::Context& context, sdf::SparseField field, bool timings)
     : context_(context),
       spec_(field.spec()),
-      texture_(std::move(field)),
+      field_(std::move(field)),
       queue_(timings, context.debug()),
       relax_(gpu::Program::compute(library_, "sampler/relax.comp")),
       project_(gpu::Program::compute(library_, "sampler/project.comp")),
       reduce_(gpu::Program::compute(library_, "sampler/reduce_steps.comp")),
       grid_(library_) {
-  if (texture_.empty()) throw Error(ExitCode::Internal, "GpuRelaxer needs scan_convert's texture (keep_texture)");
+  if (field_.empty()) throw Error(ExitCode::Internal, "GpuRelaxer needs an uploaded sdf::SparseField");
 }
 
 std::size_t GpuRelaxer::gpu_bytes() const {
-  return spec_.voxel_count() * 16 + positions_[0].bytes() * 2 + step_info_.bytes() + partials_.bytes() + grid_.bytes();
+  return field_.gpu_bytes() + positions_[0].bytes() * 2 + step_info_.bytes() + partials_.bytes() + grid_.bytes();
 }
 
-void GpuRelaxer::bind_sdf(const gpu::Program& program) const {
-  texture_.texture().bind_unit(TS_SAMPLER_UNIT_SDF);
-  program.set("voxel_size", static_cast<float>(spec_.voxel_size));
-  program.set("sdf_dims", static_cast<float>(spec_.dims.x()), static_cast<float>(spec_.dims.y()),
-              static_cast<float>(spec_.dims.z()));
-}
+void GpuRelaxer::bind_sdf(const gpu::Program& program) const { field_.bind(program, TS_SAMPLER_SPARSE_FIELD); }
 
 void GpuRelaxer::project(std::uint32_t count, int steps) {
   positions_[0].bind(TS_SAMPLER_POSITIONS);

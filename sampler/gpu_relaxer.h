@@ -11,6 +11,7 @@
 #include "gpu/gl.h"
 #include "gpu/hash_grid.h"
 #include "sdf/scan_convert.h"
+#include "sdf/sparse_field.h"
 
 namespace ts::sampler {
 
@@ -45,9 +46,9 @@ struct RelaxStats {
 
 class GpuRelaxer {
  public:
-  // Takes the SDF texture scan conversion left on the GPU (ScanConvertOptions::keep_texture: RGBA32F,
-  // xyz gradient, w distance, trilinear filtering); nothing is uploaded.
-  GpuRelaxer(gpu::Context& context, sdf::SdfTexture field, bool timings = false);
+  // Takes the sparse SDF already on the GPU (sdf::SparseField: trilinear distance, central-difference
+  // gradient); nothing is uploaded.
+  GpuRelaxer(gpu::Context& context, sdf::SparseField field, bool timings = false);
   GpuRelaxer(const GpuRelaxer&) = delete;
   GpuRelaxer& operator=(const GpuRelaxer&) = delete;
 
@@ -67,7 +68,7 @@ class GpuRelaxer {
   void project(std::uint32_t count, int steps);
   gpu::Context& context_;
   sdf::GridSpec spec_;
-  sdf::SdfTexture texture_;
+  sdf::SparseField field_;
   gpu::ShaderLibrary library_;
   gpu::Queue queue_;
   gpu::Program relax_, project_, reduce_;

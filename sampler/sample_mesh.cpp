@@ -90,31 +90,14 @@ void check_filled_size(const Sizing& z, const MassProperties& mass, std::size_t 
                                z.radius, interior, z.count, cap, z.radius * hi));
 }
 
-// The SDF grid: voxel r / 2 unless the user set one; grown while the dense texture would exceed the
-// budget (then the trilinear error grows too, so say so).
-sdf::GridSpec choose_grid(const TriangleMesh& mesh, double radius, const SampleSettings& s,
-                          std::vector<std::string>& warnings) {
+// The SDF grid: voxel r / 2 unless the user set one, so trilinear interpolation error stays far below
+// r. The grid is sparse on the GPU (only its band is stored), so the box's size sets no limit.
+sdf::GridSpec choose_grid(const TriangleMesh& mesh, double radius, const SampleSettings& s) {
   sdf::SdfSettings grid;
   grid.voxel_size = s.voxel_size > 0.0 ? s.voxel_size : 0.5 * radius;
   grid.band = kBandVoxels;
-  // The texture budget below decides; make_grid's own cap (far larger) must not refuse first.
-  grid.max_voxels = std::numeric_limits<std::size_t>::max();
-  for (;;) {
-    const sdf::GridSpec spec = sdf::make_grid(bounding_box(mesh), grid);
-    if (static_cast<double>(spec.voxel_count()) * 16.0 <= static_cast<double>(s.max_sdf_bytes)) {
-      if (grid.voxel_size > 0.5 * radius && s.voxel_size <= 0.0) {
-        warnings.push_back(fmt::format("the SDF voxel was enlarged to {:.4g} m (r / {:.2f}) to fit the {} MiB texture "
-                                       "budget; relaxation is coarser, the exact projection keeps particles on the surface",
-                                       grid.voxel_size, radius / grid.voxel_size, s.max_sdf_bytes >> 20));
-      }
-      return spec;
-    }
-    if (s.voxel_size > 0.0) {
-      throw InputError(fmt::format("SDF voxel {:.4g} m needs {} MiB of GPU texture, above the budget of {} MiB",
-                                   s.voxel_size, spec.voxel_count() * 16 >> 20, s.max_sdf_bytes >> 20));
-    }
-    grid.voxel_size *= 1.25;
-  }
+  grid.max_voxels = std::numeric_limits<std::size_t>::max();  // the box is never allocated
+  return sdf::make_grid(bounding_box(mesh), grid);
 }
 
 // After an injection, the particles within `radius` of a new one move, the others are frozen; the new
@@ -249,16 +232,43 @@ SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& e
   return plan;
 }
 
-// The SDF, left on the GPU as a dense texture for the relaxation.
-sdf::ScanConvertResult scan_field(gpu::Context& context, const TriangleMesh& mesh, const sdf::GridSpec& spec,
-                                  const SampleSettings& settings) {
+// A sparse field above --sdf-budget-mib: its bytes grow as the band's area, ~ 1 / voxel^2, so the
+// voxel that fits is h sqrt(bytes / budget), and with the voxel following the radius the particle
+// count that fits is N budget / bytes.
+[[noreturn]] void throw_over_budget(const sdf::GridSpec& spec, std::size_t bytes, std::size_t band_voxels,
+                                    const SamplingPlan& plan, const SampleSettings& settings) {
+  const double over = static_cast<double>(bytes) / static_cast<double>(settings.max_sdf_bytes);
+  const std::string remedy =
+      settings.voxel_size > 0.0
+          ? fmt::format("a --voxel of at least {:.4g} m fits it", spec.voxel_size * std::sqrt(over))
+          : fmt::format("about {:.0f} particles fit it", static_cast<double>(plan.z.count) / over);
+  throw InputError(fmt::format("the sparse SDF at voxel {:.4g} m ({} band voxels) needs {:.1f} MiB of GPU memory, above "
+                               "the budget of {} MiB (--sdf-budget-mib); {}, or raise the budget",
+                               spec.voxel_size, band_voxels, bytes / 1048576.0, settings.max_sdf_bytes >> 20, remedy));
+}
+
+// The SDF on the GPU for the relaxation: scan conversion straight into the band, an index-space level
+// set (any voxel size), a sparse NanoVDB field. The field's size is checked against the budget before
+// it is uploaded; it grows as the particle count (band voxels ~ area / voxel^2 ~ count).
+sdf::SparseField scan_field(gpu::Context& context, const TriangleMesh& mesh, const sdf::GridSpec& spec,
+                            const SamplingPlan& plan, const SampleSettings& settings, SampleResult& result) {
   const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
   sdf::ScanConvertOptions scan;
   scan.band = kBandVoxels;
-  scan.keep_texture = true;
-  scan.build_grid = false;
+  scan.index_space_grid = true;
   scan.timings = settings.timings;
-  return sdf::scan_convert(context, mesh, normals, spec, scan);
+  const sdf::ScanConvertResult converted = sdf::scan_convert(context, mesh, normals, spec, scan);
+  sdf::NanoGrid nano = sdf::to_nanovdb(*converted.grid);
+  FieldStats& f = result.field;
+  f.band_voxels = converted.stats.band_voxels;
+  f.host_bytes = converted.grid->memUsage() + nano.size();
+  f.readback_bytes = converted.stats.readback_bytes;
+  f.scan_peak_gpu_bytes = converted.stats.peak_gpu_bytes;
+  result.timing_report = converted.stats.timing_report;
+  if (nano.size() > settings.max_sdf_bytes) throw_over_budget(spec, nano.size(), f.band_voxels, plan, settings);
+  sdf::SparseField field(std::move(nano), spec, kBandVoxels);
+  f.gpu_bytes = field.gpu_bytes();
+  return field;
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -517,12 +527,12 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   const sdf::ExactDistance exact(mesh);
   const SamplingPlan plan = plan_sampling(mesh, exact, settings, result);
   // The field, and seeds spread over the surface.
-  const sdf::GridSpec spec = choose_grid(mesh, plan.z.radius, settings, result.warnings);
-  sdf::ScanConvertResult field = scan_field(context, mesh, spec, settings);
+  const sdf::GridSpec spec = choose_grid(mesh, plan.z.radius, settings);
+  sdf::SparseField field = scan_field(context, mesh, spec, plan, settings, result);
   std::mt19937_64 rng(settings.seed);
   std::vector<Eigen::Vector3d> seeds = sample_surface_points(mesh, plan.z.count, rng).positions;
   // Relax and close holes.
-  GpuRelaxer relaxer(context, std::move(field.texture), settings.timings);
+  GpuRelaxer relaxer(context, std::move(field), settings.timings);
   CoverageCertifier certifier(context, mesh, settings.timings);
   Arrangement a =
       HoleClosing(relaxer, certifier, exact, spec, plan, settings, progress).run(std::move(seeds));
@@ -541,9 +551,7 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   fill_body(a, exact, mesh, plan, settings, body);
   body.sdf_voxel_size = spec.voxel_size;
   body.quality.seconds = seconds_since(start);
-  if (settings.timings) {
-    result.timing_report = field.stats.timing_report + relaxer.timing_report() + certifier.timing_report();
-  }
+  if (settings.timings) result.timing_report += relaxer.timing_report() + certifier.timing_report();
   return result;
 }
 

@@ -37,7 +37,7 @@ struct SampleSettings {
   // The coverage certificate that steers the rounds and is reported (floor: r / floor_divisor).
   CertificateSettings certificate;
   std::size_t max_particles = 20'000'000;
-  std::size_t max_sdf_bytes = 1ull << 30;  // dense SDF texture budget; the voxel grows (with a warning) past it
+  std::size_t max_sdf_bytes = 1ull << 30;  // sparse SDF budget on the GPU [bytes]: past it the run stops (exit 3)
   // Inside and outside (particle normals, thin features, interior fill): pseudonormals need a closed,
   // consistently oriented mesh; the generalised winding number also works on open or non-manifold
   // ones (normals then point to where the winding number drops).
@@ -68,6 +68,15 @@ struct ThinFeatures {
 // Most holes a SampleResult lists (the deepest; a certificate may prove more).
 inline constexpr std::size_t kReportedHoles = 20;
 
+// What the sparse SDF cost (docs/benchmarks.md reports it per band voxel).
+struct FieldStats {
+  std::size_t band_voxels = 0;          // voxels with |d| < band
+  std::size_t gpu_bytes = 0;            // the NanoVDB grid on the GPU
+  std::size_t host_bytes = 0;           // the OpenVDB level set and the NanoVDB grid on the host, at their peak
+  std::size_t readback_bytes = 0;       // GPU -> host during scan conversion (the compacted band)
+  std::size_t scan_peak_gpu_bytes = 0;  // scan conversion's slab target and buffers
+};
+
 struct SampleResult {
   body::ParticleBody body;
   ThinFeatures thin;
@@ -79,6 +88,7 @@ struct SampleResult {
   double certificate_seconds = 0.0;   // s, wall time of those
   double probe_seconds = 0.0;         // s, wall time of the statistical probe pass
   std::vector<std::string> warnings;
+  FieldStats field;
   std::string timing_report;
 };
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
-# Usage: scripts/bench.sh [peers|sdf|sample|certificate|peers-sim|sim|sim-accuracy|validation|agreement|all]
+# Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|peers-sim|sim|sim-accuracy|validation|agreement|all]
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
 #               its section of docs/benchmarks.md (--quick: knot1 and armadillo at 64^3 and 128^3, 1,000
@@ -33,6 +33,10 @@
 #               (--cases 'knot1@64,128 icosphere:8@64' for fewer; NAME = libcgal-demo mesh, or a path)
 #               -> section sdf of docs/benchmarks.md, docs/benchmarks/sdf_error_vs_time.png
 #               (12 min on llvmpipe, 2 idle cores; over an hour on 2 loaded ones)
+#   sparse      GPU memory of the SDF against resolution: the sparse NanoVDB field (what the sampler and the
+#               preview hold) against the dense textures they held before, band voxels, bytes per band
+#               voxel, bytes read back; bunny, knot1, armadillo at 64^3..1024^3 (--quick: 64, 128)
+#               -> section sparse of docs/benchmarks.md, docs/benchmarks/sparse_memory.png (~5 min, 2 cores)
 #   all         every one of the above, in one run
 # Exit status: 0 when every physical comparison is within its stated tolerance, 1 otherwise.
 # The preview bench (tetrasand_bench_preview) has no peer; see docs/benchmarks.md.
@@ -55,7 +59,7 @@ while [ $# -gt 0 ]; do
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in peers|sdf|sample|certificate|peers-sim|sim|sim-accuracy|validation|agreement|all) ;;
+case "$what" in peers|sdf|sparse|sample|certificate|peers-sim|sim|sim-accuracy|validation|agreement|all) ;;
   *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;;
 esac
 [ "$quick" -eq 1 ] && sdf_cases="knot1@64,128 armadillo@64,128"
@@ -121,6 +125,21 @@ if runs agreement; then
   "$bin/tetrasand_validation_runs" "$work/agreement" agreement
   "$py" "$root/bench/validation/report.py" "$work/agreement" "$root/docs" >/dev/null
   echo "bench: wrote the agreement section of docs/validation.md"
+fi
+if runs sparse; then
+  meshes="$build/test-data/cgal/data/meshes"
+  if [ ! -d "$meshes" ]; then
+    tarball=/usr/share/doc/libcgal-dev/data.tar.gz
+    [ -f "$tarball" ] || { echo "bench: $tarball not found (Debian package libcgal-dev)" >&2; exit 1; }
+    mkdir -p "$work/cgal" && tar -xzf "$tarball" -C "$work/cgal" data/meshes
+    meshes="$work/cgal/data/meshes"
+  fi
+  sparse_res=64,128,256,512,1024
+  [ "$quick" -eq 1 ] && sparse_res=64,128
+  "$py" "$root/bench/sparse_memory.py" "$bin/tetrasand" "$root/assets/bunny.obj,$meshes/knot1.off,$meshes/armadillo.off" \
+    "$sparse_res" --markdown "$root/docs/benchmarks.md" --plot "$root/docs/benchmarks/sparse_memory.png" \
+    --command "scripts/bench.sh sparse$([ "$quick" -eq 1 ] && echo ' --quick')" || status=1
+  echo "bench: wrote section sparse of docs/benchmarks.md and docs/benchmarks/sparse_memory.png"
 fi
 if runs sdf; then
   # libcgal-demo's meshes: where the tests unpacked them, else unpacked here.

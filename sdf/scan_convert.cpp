@@ -14,6 +14,7 @@
 #include "core/log.h"
 #include "gpu/gl.h"
 #include "gpu/graphics.h"
+#include "gpu/hash_grid.h"
 #include "gpu/layouts.h"
 #include "shaders/sdf/bindings.h"
 
@@ -189,14 +190,16 @@ struct SlabTarget {
   gpu::Framebuffer framebuffer;
 };
 
-openvdb::FloatGrid::Ptr make_level_set(const GridSpec& spec, float band) {
-  if (!(spec.voxel_size >= kMinVdbVoxelSize)) {
+openvdb::FloatGrid::Ptr make_level_set(const GridSpec& spec, float band, bool index_space) {
+  if (!index_space && !(spec.voxel_size >= kMinVdbVoxelSize)) {
     throw InputError("voxel size " + std::to_string(spec.voxel_size) +
                      " is below the smallest OpenVDB can store (1.3e-5 world units); scale the mesh to smaller "
                      "units (e.g. --scale 1000 for millimetres)");
   }
   auto grid = openvdb::FloatGrid::create(band * static_cast<float>(spec.voxel_size));
-  grid->setTransform(openvdb::math::Transform::createLinearTransform(spec.voxel_size));
+  // An index-space grid (voxel size 1, values still in world units) holds any voxel size: the GPU
+  // field reads it by index alone.
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(index_space ? 1.0 : spec.voxel_size));
   grid->setGridClass(openvdb::GRID_LEVEL_SET);
   grid->setName("surface");
   return grid;
@@ -233,29 +236,6 @@ void flood_fill_outside(const GridSpec& s, std::vector<std::uint8_t>& state) {
 void fill_dense_off_band(DenseSdf& dense, const std::vector<std::uint8_t>& state, float band_world) {
   for (std::size_t idx = 0; idx < dense.values.size(); ++idx)
     if (state[idx] != kInBand) dense.values[idx] = {0.0f, 0.0f, 0.0f, state[idx] == kOutside ? band_world : -band_world};
-}
-
-// The texture holds the raw slabs (distance in voxels, untouched voxels at kUntouched); one compute
-// pass scales the band to world units and gives the rest +-band from a 1-bit inside mask, the only
-// data uploaded (1/128 of the field).
-void finish_texture(gpu::Queue& queue, const gpu::ShaderLibrary& library, const SdfTexture& texture,
-                    const std::vector<std::uint8_t>& state, float band, float voxel_size, std::size_t& peak_bytes) {
-  const GridSpec& spec = texture.spec();
-  std::vector<std::uint32_t> inside((state.size() + 31) / 32, 0u);
-  for (std::size_t idx = 0; idx < state.size(); ++idx)
-    if (state[idx] == kOffBand) inside[idx >> 5] |= 1u << (idx & 31u);
-  gpu::Buffer bits = gpu::Buffer::from<std::uint32_t>(inside);
-  peak_bytes += bits.bytes();
-  gpu::Program program = gpu::Program::compute(library, "sdf/finish_texture.comp");
-  program.set("dims", spec.dims.x(), spec.dims.y(), spec.dims.z());
-  program.set("band", band);
-  program.set("voxel_size", voxel_size);
-  bits.bind(TS_SDF_INSIDE_BITS);
-  const gpu::ImageBinding field(TS_SDF_FIELD_IMAGE, texture.texture(), GL_READ_WRITE);
-  auto groups = [](int n, int local) { return static_cast<std::uint32_t>((n + local - 1) / local); };
-  queue.dispatch(
-      program, groups(spec.dims.x(), 8), groups(spec.dims.y(), 8), groups(spec.dims.z(), 4),
-      GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
 }
 
 int choose_slab_layers(const GridSpec& spec, std::size_t budget) {
@@ -305,14 +285,20 @@ class SlabScanner {
   // Clears the target and draws every prism touching grid layers [z0, z0 + layers); returns the
   // number of draws.
   int draw(int z0, int layers);
-  // The target's first `layers` layers read back: 4 floats per voxel, x fastest, then y, then layer.
-  std::span<const float> read(int layers);
-  const gpu::Texture& target() const { return target_.color; }
-  // Render target and geometry buffers [bytes].
+  // The band voxels of the target's first `layers` layers, compacted on the GPU and read back: their
+  // slab indices (x fastest, then y, then layer; ascending) and 4 floats each (unit gradient,
+  // signed distance [voxels]). Only the band crosses to the host.
+  struct Band {
+    std::span<const std::size_t> indices;
+    std::span<const float> values;
+  };
+  Band read_band(int layers, float band);
+  // Render target, geometry and compaction buffers [bytes] (the largest they have been).
   std::size_t gpu_bytes() const {
     return bytes_per_layer(spec_) * static_cast<std::size_t>(plan_.slab_layers) + triangles_.bytes() +
-           prisms_.bytes() + indices_.bytes();
+           prisms_.bytes() + indices_.bytes() + flags_.bytes() + band_indices_.bytes() + band_values_.bytes();
   }
+  std::size_t readback_bytes() const { return readback_bytes_; }  // host traffic so far
 
  private:
   const GridSpec& spec_;
@@ -323,7 +309,14 @@ class SlabScanner {
   gpu::Buffer triangles_, prisms_, indices_;
   gpu::VertexArray vertices_;
   SlabTarget target_;
-  std::vector<float> readback_;
+  // Band compaction: flags (scanned in place into offsets), the compacted band, its host copy.
+  gpu::Program flag_band_, scatter_band_;
+  gpu::PrefixScan scan_;
+  gpu::Buffer flags_, band_indices_, band_values_;
+  std::vector<std::uint32_t> index_words_;
+  std::vector<std::size_t> band_slab_indices_;
+  std::vector<float> band_values_host_;
+  std::size_t readback_bytes_ = 0;
   gpu::StateScope state_;  // last: restores the state before the target is released
 };
 
@@ -337,8 +330,12 @@ SlabScanner::SlabScanner(const gpu::ShaderLibrary& library, gpu::Queue& queue, c
       indices_(gpu::Buffer::from<std::uint32_t>(plan.lists.indices)),
       vertices_(gpu::VertexArray::create()),
       target_(spec.dims.x(), spec.dims.y(), plan.slab_layers),
-      readback_(4 * static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y()) *
-                static_cast<std::size_t>(plan.slab_layers)) {
+      flag_band_(gpu::Program::compute(library, "sdf/band_flags.comp")),
+      scatter_band_(gpu::Program::compute(library, "sdf/band_scatter.comp")),
+      scan_(library),
+      flags_(static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y()) *
+             static_cast<std::size_t>(plan.slab_layers) * sizeof(std::uint32_t)) {
+  target_.color.set_sampling(GL_NEAREST);  // read by texelFetch; a complete texture needs a non-mip filter
   for (int invocations : kVariantInvocations) {
     gpu::Program& program = programs_.emplace_back(
         gpu::Program::graphics(library, "sdf/scan_convert.vert", "sdf/scan_convert.geom",
@@ -349,14 +346,15 @@ SlabScanner::SlabScanner(const gpu::ShaderLibrary& library, gpu::Queue& queue, c
     program.set("draw_layers", plan.block);
     timer_names_.push_back(fmt::format("sdf/scan_convert ({} GS invocations)", invocations));
   }
-  triangles_.bind(TS_SDF_TRIANGLES);
-  prisms_.bind(TS_SDF_PRISMS);
   vertices_.set_element_buffer(indices_);
   state_.framebuffer(target_.framebuffer).viewport(spec.dims.x(), spec.dims.y()).vertex_array(vertices_);
   state_.depth_test(GL_LESS).no_cull().no_blend();
 }
 
 int SlabScanner::draw(int z0, int layers) {
+  // Rebound every slab: the band compaction of the last slab used the same slot numbers.
+  triangles_.bind(TS_SDF_TRIANGLES);
+  prisms_.bind(TS_SDF_PRISMS);
   target_.framebuffer.clear_color(0, {0.0f, 0.0f, 0.0f, kUntouched});
   target_.framebuffer.clear_depth(1.0f);
   int draws = 0;
@@ -375,22 +373,50 @@ int SlabScanner::draw(int z0, int layers) {
   return draws;
 }
 
-std::span<const float> SlabScanner::read(int layers) {
-  const std::size_t floats =
-      readback_.size() / static_cast<std::size_t>(plan_.slab_layers) * static_cast<std::size_t>(layers);
+SlabScanner::Band SlabScanner::read_band(int layers, float band) {
+  const std::uint32_t voxels = static_cast<std::uint32_t>(spec_.dims.x()) * static_cast<std::uint32_t>(spec_.dims.y()) *
+                               static_cast<std::uint32_t>(layers);
+  for (gpu::Program* program : {&flag_band_, &scatter_band_}) {
+    program->set("layer_size", spec_.dims.x(), spec_.dims.y());
+    program->set("voxels", voxels);
+    program->set("band", band);
+  }
+  target_.color.bind_unit(TS_SDF_UNIT_SLAB);
+  flags_.bind(TS_SDF_BAND_FLAGS);
+  // Host reads of what a kernel wrote need the buffer-update barrier besides the storage one.
+  constexpr GLbitfield kToHost = GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT;
+  queue_.dispatch_items(flag_band_, voxels, kToHost);
+  // The last flag, read before the scan overwrites it, plus the last offset: the band's size.
+  const std::uint32_t last_flag = flags_.read<std::uint32_t>(1, voxels - 1)[0];
+  scan_.run(queue_, flags_, voxels);
+  const std::size_t count = flags_.read<std::uint32_t>(1, voxels - 1)[0] + last_flag;
+  if (band_indices_.bytes() < count * sizeof(std::uint32_t)) {
+    band_indices_ = gpu::Buffer(std::max<std::size_t>(count, 1) * sizeof(std::uint32_t));
+    band_values_ = gpu::Buffer(std::max<std::size_t>(count, 1) * 4 * sizeof(float));
+  }
+  flags_.bind(TS_SDF_BAND_OFFSETS);
+  band_indices_.bind(TS_SDF_BAND_INDICES);
+  band_values_.bind(TS_SDF_BAND_VALUES);
+  queue_.dispatch_items(scatter_band_, voxels, kToHost);
+  gpu::Texture::unbind_unit(TS_SDF_UNIT_SLAB);
+  index_words_.resize(count);
+  band_values_host_.resize(4 * count);
   queue_.timed("sdf/readback", [&] {
-    target_.color.read(readback_.data(), floats * sizeof(float), GL_RGBA, GL_FLOAT, 0, layers);
+    if (count == 0) return;
+    band_indices_.download(index_words_.data(), count * sizeof(std::uint32_t));
+    band_values_.download(band_values_host_.data(), count * 4 * sizeof(float));
   });
-  return {readback_.data(), floats};
+  readback_bytes_ += 8 + count * (sizeof(std::uint32_t) + 4 * sizeof(float));
+  band_slab_indices_.assign(index_words_.begin(), index_words_.end());
+  return {band_slab_indices_, band_values_host_};
 }
 
-// A finished slab: grid layers [z0, z0 + layers), read back, and still in the render target.
+// A finished slab: grid layers [z0, z0 + layers), of which only the band was read back.
 struct Slab {
   const GridSpec& spec;
   int z0 = 0, layers = 0;
-  std::span<const float> values;      // 4 per voxel (slab order): unit gradient, signed distance [voxels]
   std::span<const std::size_t> band;  // the voxels with |distance| < band, ascending slab order
-  const gpu::Texture& target;         // layers [0, layers) hold the slab
+  std::span<const float> values;      // 4 per band voxel: unit gradient, signed distance [voxels]
 
   std::size_t layer_voxels() const {
     return static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y());
@@ -408,12 +434,6 @@ struct Slab {
   }
 };
 
-void find_band_voxels(std::span<const float> values, float band, std::vector<std::size_t>& out) {
-  out.clear();
-  for (std::size_t voxel = 0; voxel < values.size() / 4; ++voxel)
-    if (std::abs(values[4 * voxel + 3]) < band) out.push_back(voxel);
-}
-
 // One output of scan conversion: fed every finished slab in z order, then finished once.
 class SlabConsumer {
  public:
@@ -425,13 +445,13 @@ class SlabConsumer {
 // The OpenVDB level set: band voxels in world units, then a signed flood fill for the rest.
 class LevelSetOutput final : public SlabConsumer {
  public:
-  LevelSetOutput(const GridSpec& spec, float band, openvdb::FloatGrid::Ptr& grid)
+  LevelSetOutput(const GridSpec& spec, float band, bool index_space, openvdb::FloatGrid::Ptr& grid)
       : voxel_size_(static_cast<float>(spec.voxel_size)),
-        grid_(grid = make_level_set(spec, band)),
+        grid_(grid = make_level_set(spec, band, index_space)),
         accessor_(grid_->getAccessor()) {}
   void consume(const Slab& slab) override {
-    for (std::size_t voxel : slab.band)
-      accessor_.setValue(slab.vdb_coord(voxel), slab.values[4 * voxel + 3] * voxel_size_);
+    for (std::size_t k = 0; k < slab.band.size(); ++k)
+      accessor_.setValue(slab.vdb_coord(slab.band[k]), slab.values[4 * k + 3] * voxel_size_);
   }
   void finish() override { openvdb::tools::signedFloodFill(grid_->tree()); }
 
@@ -442,7 +462,7 @@ class LevelSetOutput final : public SlabConsumer {
 };
 
 // Which voxels the band holds and, after the last slab, which of the others lie outside: the signs
-// off the band for the dense copy and the texture (one flood fill for both).
+// off the band for the dense copy.
 class BandSigns final : public SlabConsumer {
  public:
   explicit BandSigns(const GridSpec& spec) : spec_(spec), state_(spec.voxel_count(), kOffBand) {}
@@ -466,9 +486,9 @@ class DenseOutput final : public SlabConsumer {
     dense_.values.assign(spec.voxel_count(), Eigen::Vector4f(0, 0, 0, kUntouched));
   }
   void consume(const Slab& slab) override {
-    for (std::size_t voxel : slab.band) {
-      const float* v = &slab.values[4 * voxel];
-      dense_.values[slab.grid_index(voxel)] = {v[0], v[1], v[2], v[3] * voxel_size_};
+    for (std::size_t k = 0; k < slab.band.size(); ++k) {
+      const float* v = &slab.values[4 * k];
+      dense_.values[slab.grid_index(slab.band[k])] = {v[0], v[1], v[2], v[3] * voxel_size_};
     }
   }
   void finish() override { fill_dense_off_band(dense_, signs_.state(), band_ * voxel_size_); }
@@ -479,59 +499,20 @@ class DenseOutput final : public SlabConsumer {
   DenseSdf& dense_;
 };
 
-// The GPU texture: each slab copied in on the GPU, finished by one compute pass (finish_texture).
-class TextureOutput final : public SlabConsumer {
- public:
-  TextureOutput(const GridSpec& spec, float band, int max_3d_texture_size, const BandSigns& signs,
-                gpu::Queue& queue, const gpu::ShaderLibrary& library, SdfTexture& texture,
-                std::size_t& peak_bytes)
-      : band_(band),
-        signs_(signs),
-        queue_(queue),
-        library_(library),
-        texture_(texture),
-        peak_bytes_(peak_bytes) {
-    texture_ = SdfTexture(spec, max_3d_texture_size);
-    peak_bytes_ += texture_.bytes();
-  }
-  void consume(const Slab& slab) override {
-    queue_.timed("sdf/copy to texture",
-                 [&] { slab.target.copy_to(texture_.texture(), slab.z0, slab.layers); });
-  }
-  void finish() override {
-    finish_texture(queue_, library_, texture_, signs_.state(), band_,
-                   static_cast<float>(texture_.spec().voxel_size), peak_bytes_);
-  }
-
- private:
-  float band_;
-  const BandSigns& signs_;
-  gpu::Queue& queue_;
-  const gpu::ShaderLibrary& library_;
-  SdfTexture& texture_;
-  std::size_t& peak_bytes_;
-};
-
-// The outputs the options choose, in the order they finish (the signs before the dense copy and the
-// texture that read them).
-std::vector<std::unique_ptr<SlabConsumer>> make_outputs(const gpu::Context& context, const GridSpec& spec,
-                                                        const ScanConvertOptions& options, gpu::Queue& queue,
-                                                        const gpu::ShaderLibrary& library,
+// The outputs the options choose, in the order they finish (the signs before the dense copy that
+// reads them).
+std::vector<std::unique_ptr<SlabConsumer>> make_outputs(const GridSpec& spec, const ScanConvertOptions& options,
                                                         ScanConvertResult& result) {
   const float band = static_cast<float>(options.band);
   std::vector<std::unique_ptr<SlabConsumer>> outputs;
-  if (options.build_grid) outputs.push_back(std::make_unique<LevelSetOutput>(spec, band, result.grid));
-  if (!options.keep_dense && !options.keep_texture) return outputs;
+  if (options.build_grid) {
+    outputs.push_back(std::make_unique<LevelSetOutput>(spec, band, options.index_space_grid, result.grid));
+  }
+  if (!options.keep_dense) return outputs;
   auto signs = std::make_unique<BandSigns>(spec);
   const BandSigns& shared_signs = *signs;
   outputs.push_back(std::move(signs));
-  if (options.keep_dense)
-    outputs.push_back(std::make_unique<DenseOutput>(spec, band, shared_signs, result.dense));
-  if (options.keep_texture) {
-    outputs.push_back(std::make_unique<TextureOutput>(spec, band, context.limits().max_3d_texture_size,
-                                                      shared_signs, queue, library, result.texture,
-                                                      result.stats.peak_gpu_bytes));
-  }
+  outputs.push_back(std::make_unique<DenseOutput>(spec, band, shared_signs, result.dense));
   return outputs;
 }
 
@@ -540,16 +521,14 @@ void scan_slabs(SlabScanner& scanner, const std::vector<std::unique_ptr<SlabCons
                 const GridSpec& spec, const ScanConvertOptions& options, bool check_errors,
                 ScanConvertStats& stats) {
   const float band = static_cast<float>(options.band);
-  std::vector<std::size_t> band_voxels;
   for (int z0 = 0; z0 < spec.dims.z(); z0 += stats.layers_per_slab) {
     const int layers = std::min(stats.layers_per_slab, spec.dims.z() - z0);
     stats.draws += scanner.draw(z0, layers);
-    const std::span<const float> values = scanner.read(layers);
-    find_band_voxels(values, band, band_voxels);
-    const Slab slab{spec, z0, layers, values, band_voxels, scanner.target()};
+    const SlabScanner::Band voxels = scanner.read_band(layers, band);
+    const Slab slab{spec, z0, layers, voxels.indices, voxels.values};
     for (const auto& output : outputs) output->consume(slab);
-    if (check_errors) gpu::check_gl("SDF scan conversion (shaders sdf/scan_convert.*)");
-    stats.band_voxels += band_voxels.size();
+    if (check_errors) gpu::check_gl("SDF scan conversion (shaders sdf/scan_convert.*, sdf/band_*.comp)");
+    stats.band_voxels += voxels.indices.size();
     ++stats.slabs;
     if (options.progress) options.progress(static_cast<double>(z0 + layers) / spec.dims.z());
   }
@@ -587,12 +566,13 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
   stats.layers_per_slab = plan.slab_layers;
   stats.degenerate_triangles = plan.geometry.degenerate;
   stats.needle_triangles = plan.geometry.needles;
-  stats.peak_gpu_bytes = scanner.gpu_bytes();
-  const auto outputs = make_outputs(context, spec, options, queue, library, result);
+  const auto outputs = make_outputs(spec, options, result);
   scan_slabs(scanner, outputs, spec, options, queue.checks_errors(), stats);
+  stats.peak_gpu_bytes = scanner.gpu_bytes();
+  stats.readback_bytes = scanner.readback_bytes();
   // Voxels outside the band take +-band: a closed band separates the inside from the outside, so a
   // flood fill classifies the whole grid (OpenVDB's signedFloodFill for the level set; a fill from
-  // the grid border for the dense copy and the texture).
+  // the grid border for the dense copy).
   for (const auto& output : outputs) output->finish();
   if (options.timings) stats.timing_report = queue.timing_report();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -1,8 +1,9 @@
 #pragma once
 // GPU scan conversion of a triangle mesh into a narrow-band signed distance field (thesis 6.2 and
 // 6.2.1, after Erleben & Dohlmann 2006). The grid is processed in z-slabs so GPU memory is bounded by
-// the slab, not the box; each slab is read back as it finishes and its band voxels go into an
-// OpenVDB level set. See docs/architecture.md, "sdf".
+// the slab, not the box; as each slab finishes its band voxels are compacted on the GPU (a prefix sum
+// over band flags) and only they are read back, into an OpenVDB level set, so host traffic and host
+// memory follow the band too. See docs/architecture.md, "sdf".
 #include <openvdb/openvdb.h>
 
 #include <Eigen/Core>
@@ -15,7 +16,6 @@
 #include "gpu/context.h"
 #include "sdf/grid.h"
 #include "sdf/pseudonormals.h"
-#include "sdf/sdf_texture.h"
 
 namespace ts::sdf {
 
@@ -23,11 +23,12 @@ struct ScanConvertOptions {
   double band = 3.0;                         // half-width of the narrow band [voxels]
   std::size_t max_slab_bytes = 1ull << 30;   // GPU render-target budget per slab [bytes]
   bool timings = false;                      // per-kernel GPU timer queries
-  bool keep_dense = false;                   // also return the whole grid densely on the host (tests, preview)
-  // Also leave the whole grid in a GPU 3D texture (the sampler, in the same process): filled slab by
-  // slab on the GPU; only a 1-bit-per-voxel inside mask from the CPU flood fill is uploaded.
-  bool keep_texture = false;
-  bool build_grid = true;                    // the OpenVDB level set (needs voxel_size >= kMinVdbVoxelSize)
+  bool keep_dense = false;                   // also return the whole grid densely on the host (tests)
+  bool build_grid = true;                    // the OpenVDB level set
+  // The level set's transform: world units (voxel_size, for .vdb files; needs voxel_size >=
+  // kMinVdbVoxelSize), or index space (voxel size 1, values still in world units: any voxel size,
+  // for a GPU field built in the same process, sdf::SparseField).
+  bool index_space_grid = false;
   std::function<void(double fraction_done)> progress;  // called after each slab
 };
 
@@ -35,8 +36,9 @@ struct ScanConvertStats {
   int slabs = 0;
   int layers_per_slab = 0;
   int draws = 0;
-  std::size_t peak_gpu_bytes = 0;      // render targets + geometry buffers (+ texture and mask if keep_texture)
+  std::size_t peak_gpu_bytes = 0;      // render target, geometry and band-compaction buffers
   std::size_t band_voxels = 0;         // voxels with |d| < band written to the grid
+  std::size_t readback_bytes = 0;      // GPU -> host traffic: the compacted band (20 bytes a voxel) and counts
   std::size_t degenerate_triangles = 0;  // zero area: skipped, their edges belong to their neighbours
   std::size_t needle_triangles = 0;      // slivers bounded by an in-plane rectangle instead of a miter
   double seconds = 0.0;
@@ -54,7 +56,6 @@ struct ScanConvertResult {
   openvdb::FloatGrid::Ptr grid;  // level set in world units, background = band * voxel_size (if build_grid)
   ScanConvertStats stats;
   DenseSdf dense;                // only when options.keep_dense
-  SdfTexture texture;            // only when options.keep_texture: the same values as `dense`, on the GPU
 };
 
 // Requires a current context (gpu::Context). Throws GpuError when the GPU cannot hold one layer.

@@ -1,11 +1,11 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Ray casting, fragment stage: sphere tracing through the narrow-band SDF from where the pixel's
-// ray enters the box to the far face, or to the particle already drawn at this pixel (the hybrid:
-// where a particle covers the pixel only the stretch in front of it is marched, and nothing when it
-// lies in front of the box). Steps are the sampled distance, which is the band width outside the
-// band (values there saturate at +-band, and the true distance is at least that); a sign change is
-// refined by regula falsi. The normal is the SDF's gradient; depth is the hit's true depth.
+// Ray casting, fragment stage: from where the pixel's ray enters the box to the far face, or to the
+// particle already drawn at this pixel (the hybrid: where a particle covers the pixel only the
+// stretch in front of it is marched, and nothing when it lies in front of the box). NanoVDB's HDDA
+// skips the empty space (nodes and tiles without band voxels) and walks the band's voxels; around
+// each voxel near the zero level, sphere tracing on the trilinear field (steps of the sampled distance) finds the
+// crossing, refined by regula falsi. The normal is the SDF's gradient; depth is the hit's true depth.
 #include "preview/bindings.h"
 #include "preview/camera.glsl"
 #include "preview/volume.glsl"
@@ -18,6 +18,86 @@ uniform float min_step;            // [voxels]: grazing rays still advance
 uniform vec3 surface_color;        // sRGB
 
 in vec3 v_world;
+
+// Sphere tracing on the trilinear field over [t, t_end] (voxels along `dir` from `o`); the first
+// sign change is refined by regula falsi into t_hit.
+bool trace_window(vec3 o, vec3 dir, float t, float t_end, out float t_hit) {
+  float f = sdf_at(o + t * dir);
+  t_hit = t;
+  for (int i = 0; i < max_steps; ++i) {
+    float t_next = min(t + max(f, min_step), t_end);
+    float f_next = sdf_at(o + t_next * dir);
+    if (f_next <= 0.0) {
+      float a = t, fa = f, b = t_next, fb = f_next;
+      for (int k = 0; k < 6; ++k) {
+        float m = a + (b - a) * clamp(fa / (fa - fb), 0.1, 0.9);
+        float fm = sdf_at(o + m * dir);
+        if (fm > 0.0) {
+          a = m;
+          fa = fm;
+        } else {
+          b = m;
+          fb = fm;
+        }
+      }
+      t_hit = a + (b - a) * (fa / max(fa - fb, 1e-12));
+      return true;
+    }
+    if (t_next >= t_end) return false;
+    t = t_next;
+    f = f_next;
+  }
+  return false;
+}
+
+// The first crossing of the zero level in [t, t_exit]. NanoVDB's hierarchical DDA walks the tree:
+// nodes and tiles without band voxels are crossed in one step each, and the voxels of the band's
+// leaves one by one (cells offset by half a voxel, so a cell's value is its nearest voxel centre's).
+// Where a voxel lies within kNearSurface voxels of the zero level the trilinear field may cross
+// zero within a voxel of the ray (its value differs from the nearest centre's by at most
+// sqrt(3)/2 x sqrt(3) = 1.5 voxels), so the field is sphere-traced from two voxels before that voxel
+// to two after. Conservative at silhouettes: a grazing ray is traced wherever a crossing could be.
+const float kNearSurface = 1.6;  // [voxels]
+bool find_surface(vec3 o, vec3 dir, float t, float t_exit, out float t_hit) {
+  ensure_volume_reader();
+  pnanovdb_buf_t buf;
+  t_hit = t;
+  pnanovdb_vec3_t origin = o + vec3(field_index_offset) + vec3(0.5);
+  pnanovdb_vec3_t direction = dir;
+  float t_min = t, t_max = t_exit;
+  pnanovdb_vec3_t box_min = pnanovdb_coord_to_vec3(pnanovdb_root_get_bbox_min(buf, volume_reader.accessor.root));
+  pnanovdb_vec3_t box_max = pnanovdb_coord_to_vec3(pnanovdb_coord_add(
+      pnanovdb_root_get_bbox_max(buf, volume_reader.accessor.root), pnanovdb_coord_uniform(1)));
+  if (!pnanovdb_hdda_ray_clip(box_min, box_max, origin, t_min, direction, t_max)) return false;
+  float near_surface = kNearSurface * voxel_size;  // field values are in world units
+  float traced_to = t_min;  // the field has no crossing before here
+  pnanovdb_vec3_t pos = pnanovdb_hdda_ray_start(origin, t_min, direction);
+  pnanovdb_coord_t ijk = pnanovdb_hdda_pos_to_ijk(pos);
+  int dim = int(pnanovdb_readaccessor_get_dim(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk));
+  pnanovdb_hdda_t hdda;
+  pnanovdb_hdda_init(hdda, origin, t_min, direction, t_max, dim);
+  while (pnanovdb_hdda_step(hdda)) {
+    pnanovdb_vec3_t next = pnanovdb_hdda_ray_start(origin, hdda.tmin + 1.0001, direction);
+    ijk = pnanovdb_hdda_pos_to_ijk(next);
+    dim = int(pnanovdb_readaccessor_get_dim(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk));
+    pnanovdb_hdda_update(hdda, origin, direction, dim);
+    if (hdda.dim > 1 || !pnanovdb_readaccessor_is_active(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk)) {
+      continue;
+    }
+    while (pnanovdb_hdda_step(hdda) &&
+           pnanovdb_readaccessor_is_active(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, hdda.voxel)) {
+      pnanovdb_address_t address = pnanovdb_readaccessor_get_value_address(PNANOVDB_GRID_TYPE_FLOAT, buf,
+                                                                           volume_reader.accessor, hdda.voxel);
+      float value = pnanovdb_read_float(buf, address);
+      float t_end = min(hdda.tmin + 2.0, t_exit);
+      if (value < near_surface && t_end > traced_to) {
+        if (trace_window(o, dir, max(traced_to, hdda.tmin - 2.0), t_end, t_hit)) return true;
+        traced_to = t_end;
+      }
+    }
+  }
+  return false;
+}
 
 layout(location = 0) out vec4 albedo;
 layout(location = 1) out vec4 normal_layer;
@@ -44,34 +124,9 @@ void main() {
   float t = max(max(near3.x, near3.y), max(near3.z, 0.0));
   if (t >= t_exit) discard;
 
-  float f = sdf_at(o + t * dir);
   float t_hit = t;
-  bool entered_inside = f <= 0.0;  // the near plane cuts the solid
-  bool hit = entered_inside;
-  for (int i = 0; i < max_steps && !hit; ++i) {
-    float t_next = min(t + max(f, min_step), t_exit);
-    float f_next = sdf_at(o + t_next * dir);
-    if (f_next <= 0.0) {
-      float a = t, fa = f, b = t_next, fb = f_next;
-      for (int k = 0; k < 6; ++k) {
-        float m = a + (b - a) * clamp(fa / (fa - fb), 0.1, 0.9);
-        float fm = sdf_at(o + m * dir);
-        if (fm > 0.0) {
-          a = m;
-          fa = fm;
-        } else {
-          b = m;
-          fb = fm;
-        }
-      }
-      t_hit = a + (b - a) * (fa / max(fa - fb, 1e-12));
-      hit = true;
-    } else if (t_next >= t_exit) {
-      break;
-    }
-    t = t_next;
-    f = f_next;
-  }
+  bool entered_inside = sdf_at(o + t * dir) <= 0.0;  // the near plane cuts the solid
+  bool hit = entered_inside || find_surface(o, dir, t, t_exit, t_hit);
   if (!hit) discard;
 
   vec3 p = start + dir * (t_hit * voxel_size);

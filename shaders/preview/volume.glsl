@@ -1,20 +1,37 @@
-// The SDF as the preview reads it: a 3D texture of signed distance in voxel units (R32F or R16F)
-// with hardware trilinear filtering. Voxel centres sit at integer voxel coordinates.
+// The SDF as the preview reads it: the sparse NanoVDB level set (sdf::SparseField) through
+// common/sparse_field.glsl, trilinear between voxel centres, in voxel units and clamped to the band.
+// Voxel centres sit at integer voxel coordinates of the grid spec (the box of the band).
 #ifndef TETRASAND_PREVIEW_VOLUME_GLSL
 #define TETRASAND_PREVIEW_VOLUME_GLSL
 
 #include "preview/bindings.h"
 
-layout(binding = TS_PREVIEW_UNIT_VOLUME) uniform sampler3D volume;
+layout(std430, binding = TS_PREVIEW_SPARSE_FIELD) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
+#include "common/sparse_field.glsl"
+
 uniform vec3 volume_origin;  // voxel (0,0,0)'s centre, relative to the scene centre [m]
 uniform float voxel_size;    // [m]
 uniform vec3 volume_dims;    // voxels along x, y, z
 uniform float band;          // |distance| saturates here [voxels]
 
+// One accessor per invocation, made on first use: it caches the last node, so the neighbouring
+// reads of a march skip most of the tree walk.
+FieldReader volume_reader;
+bool volume_reader_ready = false;
+
+void ensure_volume_reader() {
+  if (volume_reader_ready) return;
+  volume_reader = field_reader();
+  volume_reader_ready = true;
+}
+
 vec3 to_voxel(vec3 p) { return (p - volume_origin) / voxel_size; }
 
 // Signed distance [voxels] at voxel coordinates u.
-float sdf_at(vec3 u) { return texture(volume, (u + 0.5) / volume_dims).r; }
+float sdf_at(vec3 u) {
+  ensure_volume_reader();
+  return clamp(field_trilinear(volume_reader, u) / voxel_size, -band, band);
+}
 
 // Unit outward normal: central differences one voxel apart, so the normal varies smoothly across
 // voxel faces (the trilinear interpolant's own gradient jumps there and would show as banding).

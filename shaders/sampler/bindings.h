@@ -5,9 +5,9 @@
 //   pass (kernel)               slots
 //   common/grid_* (the grid)    TS_GRID_POSITIONS = TS_SAMPLER_POSITIONS_IN, TS_SORT_* (1-5)
 //   sampler/relax.comp          POSITIONS_IN, POSITIONS_OUT, VELOCITIES, STEP_INFO, TS_GRID_CELL_COUNT,
-//                               TS_GRID_CELL_START, TS_GRID_SORTED; texture unit UNIT_SDF
+//                               TS_GRID_CELL_START, TS_GRID_SORTED, SPARSE_FIELD
 //   sampler/reduce_steps.comp   STEP_INFO, PARTIALS
-//   sampler/project.comp        POSITIONS; texture unit UNIT_SDF
+//   sampler/project.comp        POSITIONS, SPARSE_FIELD
 //   common/grid_* for the certificate: TS_GRID_POSITIONS = TS_CERT_CENTRES, TS_SORT_* (1-5)
 //   sampler/certify_evaluate.comp  CERT_CENTRES, CERT_TRIANGLES, CERT_QUEUE, TS_GRID_CELL_COUNT,
 //                               TS_GRID_CELL_START, TS_GRID_SORTED, CERT_SPLITS, CERT_UNCOVERED,
@@ -38,6 +38,6 @@
 #define TS_CERT_NEXT_QUEUE 10              // uvec4 per sub-triangle of the next level
 #define TS_CERT_HOLES 11                   // CertLeaf per sub-triangle left uncovered at this level
 
-#define TS_SAMPLER_UNIT_SDF 0  // sampler3D: xyz unit gradient, w signed distance [m]
+#define TS_SAMPLER_SPARSE_FIELD 8  // uint[]: the NanoVDB level set (sdf::SparseField), as PNanoVDB.h reads it
 
 #endif

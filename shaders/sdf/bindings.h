@@ -1,20 +1,24 @@
-// Buffer bindings and image units of the sdf passes, shared by GLSL and C++ (sdf/scan_convert.cpp).
+// Buffer bindings and texture units of the sdf passes, shared by GLSL and C++ (sdf/scan_convert.cpp).
 //
 // Slots per pass (program):
 //   scan conversion (scan_convert.vert + scan_convert.geom + scan_convert.frag):
 //     buffers TS_SDF_PRISMS (geometry stage), TS_SDF_TRIANGLES (fragment stage)
-//   finish texture (finish_texture.comp):
-//     buffer TS_SDF_INSIDE_BITS, image unit TS_SDF_FIELD_IMAGE
+//   band flags (band_flags.comp): texture unit TS_SDF_UNIT_SLAB, buffer TS_SDF_BAND_FLAGS
+//   exclusive scan of the flags (common/scan_*.comp): TS_SCAN_VALUES = the flags, scanned in place
+//   band scatter (band_scatter.comp): texture unit TS_SDF_UNIT_SLAB, buffers TS_SDF_BAND_OFFSETS,
+//     TS_SDF_BAND_INDICES, TS_SDF_BAND_VALUES
 //
-// The finishing pass runs after the last scan-conversion draw and both bind their slots before they
-// run, so the two passes may share slot numbers.
+// Each pass binds its slots before it runs, so the passes may share slot numbers.
 #ifndef TETRASAND_SDF_BINDINGS_H
 #define TETRASAND_SDF_BINDINGS_H
 
-#define TS_SDF_TRIANGLES 0    // SdfTriangle[]: the triangles in grid-local voxel units
-#define TS_SDF_PRISMS 1       // SdfPrism[]: each triangle's bounding prism
-#define TS_SDF_INSIDE_BITS 0  // uint[]: bit v set for an inside voxel off the band (linear index v)
+#define TS_SDF_TRIANGLES 0     // SdfTriangle[]: the triangles in grid-local voxel units
+#define TS_SDF_PRISMS 1        // SdfPrism[]: each triangle's bounding prism
 
-#define TS_SDF_FIELD_IMAGE 0  // image3D rgba32f: the SDF texture, finished in place
+#define TS_SDF_UNIT_SLAB 0     // sampler2DArray rgba32f: the finished slab (unit gradient, distance [voxels])
+#define TS_SDF_BAND_FLAGS 0    // uint per slab voxel: 1 in the band
+#define TS_SDF_BAND_OFFSETS 0  // uint per slab voxel: exclusive scan of the flags (the same buffer)
+#define TS_SDF_BAND_INDICES 1  // uint per band voxel: its slab index, ascending
+#define TS_SDF_BAND_VALUES 2   // vec4 per band voxel: its value as the slab holds it
 
 #endif

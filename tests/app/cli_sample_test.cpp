@@ -262,26 +262,35 @@ TEST(CliSample, FillCountsTheInteriorParticlesInTheJsonAndThePly) {
   EXPECT_GE(json.at("particle_count").get<int>(), interior + 140);
 }
 
-TEST(CliSample, SdfBudgetBoundsTheTextureAndAnExplicitVoxelPastItIsRefused) {
+TEST(CliSample, SdfBudgetCapsTheSparseFieldAndNamesWhatFits) {
   const std::string sphere = quoted(test::asset("sphere.obj"));
-  {  // a fine voxel on a 10 cm sphere needs about 200^3 voxels x 16 B = 120 MiB: refused under 8 MiB
+  {  // a fine voxel on a 10 cm sphere: about 1M band voxels, ~12 MiB of NanoVDB, refused under 8 MiB
     const auto dir = test::temp_dir();
     std::string out;
     EXPECT_EQ(test::run_tetrasand("sample " + sphere + " -o " + quoted(dir) + kFast + "--voxel 0.0005 --sdf-budget-mib 8", &out),
               1)
         << out;
     EXPECT_NE(out.find("above the budget of 8 MiB"), std::string::npos) << out;
+    EXPECT_NE(out.find("a --voxel of at least"), std::string::npos) << out;
     EXPECT_TRUE(files_in(dir).empty());
   }
-  {  // the automatic voxel grows to fit instead, and says so
+  {  // the automatic voxel stays r / 2 and is never coarsened to fit: the run stops with the count that fits
     const auto dir = test::temp_dir();
     std::string out;
-    ASSERT_EQ(test::run_tetrasand("sample " + sphere + " -o " + quoted(dir) + " --count 600 --probes 20000 --rounds 2 --sdf-budget-mib 1 --json", &out),
+    EXPECT_EQ(test::run_tetrasand("sample " + sphere + " -o " + quoted(dir) + " --count 600 --probes 20000 --sdf-budget-mib 1", &out),
+              1)
+        << out;
+    EXPECT_NE(out.find("particles fit it"), std::string::npos) << out;
+    EXPECT_TRUE(files_in(dir).empty());
+  }
+  {  // under the default budget the voxel is r / 2
+    const auto dir = test::temp_dir();
+    std::string out;
+    ASSERT_EQ(test::run_tetrasand("sample " + sphere + " -o " + quoted(dir) + " --count 300 --probes 20000 --rounds 2 --json", &out),
               0)
         << out;
-    EXPECT_NE(out.find("to fit the 1 MiB texture budget"), std::string::npos) << out;
     const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
-    EXPECT_GT(json.at("sdf_voxel_size").get<double>(), json.at("particle_radius").get<double>() / 2.0);
+    EXPECT_NEAR(json.at("sdf_voxel_size").get<double>(), json.at("particle_radius").get<double>() / 2.0, 1e-9);
   }
 }
 

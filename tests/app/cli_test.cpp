@@ -64,7 +64,8 @@ TEST(CliSdf, BadParametersAndFilesExitNonZeroWithAMessage) {
   // The output may never replace the input.
   const auto copy = dir / "cube.obj";
   std::filesystem::copy_file(cube, copy);
-  EXPECT_EQ(test::run_tetrasand("sdf '" + copy.string() + "' -o '" + copy.string() + "' --resolution 8", &out), 1) << out;
+  EXPECT_EQ(test::run_tetrasand("sdf '" + copy.string() + "' -o '" + copy.string() + "' --resolution 8", &out), 2) << out;
+  EXPECT_NE(out.find("must end in .vdb"), std::string::npos) << out;
   EXPECT_EQ(std::filesystem::file_size(copy), std::filesystem::file_size(cube));
   EXPECT_FALSE(std::filesystem::exists(dir / "a.vdb"));
 }

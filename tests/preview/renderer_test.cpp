@@ -5,6 +5,7 @@
 #include "preview/renderer.h"
 
 #include <gtest/gtest.h>
+#include <openvdb/tools/Composite.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
 #include <cmath>
@@ -258,10 +259,10 @@ TEST(PreviewRenderer, LevelSetFilesRenderLikeMeshes) {
   sdf::ensure_openvdb_initialized();
   const auto grid = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(0.05f, openvdb::Vec3f(0.2f, 0.0f, 0.0f),
                                                                              0.002f, 3.0f);
-  const SdfVolume volume = volume_from_level_set(*grid, "sphere.vdb");
+  SdfVolume volume = volume_from_level_set(*grid, "sphere.vdb");
   EXPECT_NEAR(volume.band, 3.0, 1e-6);
   Renderer renderer(context());
-  renderer.set_volume(volume);
+  renderer.set_volume(std::move(volume));
   const double height = 0.11;
   const int size = 160;
   const RenderResult r = renderer.render(ortho_settings(
@@ -270,16 +271,39 @@ TEST(PreviewRenderer, LevelSetFilesRenderLikeMeshes) {
   EXPECT_NEAR(static_cast<double>(count(r, Layer::Surface)) * pixel * pixel / (kPi * 0.05 * 0.05), 1.0, 0.01);
 }
 
-TEST(PreviewRenderer, RotatedOrOversizedLevelSetsAreRefused) {
+TEST(PreviewRenderer, RotatedOrEmptyLevelSetsAreRefused) {
   sdf::ensure_openvdb_initialized();
   auto grid = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.0f), 0.1f, 3.0f);
+  EXPECT_NO_THROW(volume_from_level_set(*grid, "sphere.vdb"));
   openvdb::math::Transform::Ptr t = openvdb::math::Transform::createLinearTransform(0.1);
   t->preRotate(0.3, openvdb::math::Z_AXIS);
-  // Too many voxels per side for the GPU is refused before anything is densified.
-  EXPECT_THROW(volume_from_level_set(*grid, "sphere.vdb", 8), InputError);
-  EXPECT_NO_THROW(volume_from_level_set(*grid, "sphere.vdb", 64));
   grid->setTransform(t);
   EXPECT_THROW(volume_from_level_set(*grid, "rotated.vdb"), InputError);
+  const auto empty = openvdb::createLevelSet<openvdb::FloatGrid>(0.1, 3.0);
+  EXPECT_THROW(volume_from_level_set(*empty, "empty.vdb"), InputError);
+}
+
+// Two small spheres 4000 voxels apart along each axis: a box of about 4046^3 voxels, whose dense
+// copy would need 246 GiB. The sparse field holds the two bands only, and the HDDA
+// crosses the empty space between them.
+TEST(PreviewRenderer, LevelSetsWhoseBoxNoDenseCopyHoldsRenderSparse) {
+  sdf::ensure_openvdb_initialized();
+  const float h = 0.001f;
+  auto grid = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(0.02f, openvdb::Vec3f(0.0f), h, 3.0f);
+  const auto far = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(0.02f, openvdb::Vec3f(4.0f, 4.0f, 4.0f), h, 3.0f);
+  openvdb::tools::csgUnion(*grid, *far->deepCopy());
+  SdfVolume volume = volume_from_level_set(*grid, "two_spheres.vdb");
+  EXPECT_GT(volume.spec.voxel_count(), std::size_t{60} << 30);
+  EXPECT_LT(volume.grid.size(), std::size_t{16} << 20);
+  Renderer renderer(context());
+  renderer.set_volume(std::move(volume));
+  // Looking along -y at the far sphere, framed tightly: a disc of its radius, found across the box.
+  const double height = 0.05;
+  const int size = 96;
+  const RenderResult r = renderer.render(ortho_settings(
+      ortho_camera(Eigen::Vector3d(4.0, 4.0, 4.0), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), height), size));
+  const double pixel = height / size;
+  EXPECT_NEAR(static_cast<double>(count(r, Layer::Surface)) * pixel * pixel / (kPi * 0.02 * 0.02), 1.0, 0.03);
 }
 
 TEST(PreviewRenderer, ImageSizesOutsideTheDeviceLimitsAreInputErrors) {

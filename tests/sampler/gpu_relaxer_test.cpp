@@ -54,8 +54,7 @@ TEST_F(Relaxer, SpreadsRandomSeedsEvenlyOverASphere) {
   const TriangleMesh sphere = test::icosphere(radius, 4);
   const sdf::GridSpec spec = grid_around_sphere(radius, d_hex / 2.0, 6);
   sdf::ScanConvertOptions options;
-  options.keep_texture = true;
-  options.build_grid = false;
+  options.index_space_grid = true;
   options.band = 5.0;
   auto field = sdf::scan_convert(context, sphere, sdf::compute_pseudonormals(sphere), spec, options);
 
@@ -68,7 +67,7 @@ TEST_F(Relaxer, SpreadsRandomSeedsEvenlyOverASphere) {
   }
   const NearestNeighbours before = nearest_neighbours(positions);
 
-  GpuRelaxer relaxer(context, std::move(field.texture));
+  GpuRelaxer relaxer(context, sdf::SparseField(*field.grid, spec, options.band));
   RelaxSettings settings;
   settings.spacing = d_hex;
   settings.band_limit = 4.5 * spec.voxel_size;
@@ -91,8 +90,7 @@ TEST_F(Relaxer, SameSeedsGiveBitwiseTheSameResult) {
   const TriangleMesh sphere = test::icosphere(1.0, 2);
   const sdf::GridSpec spec = grid_around_sphere(1.0, 0.1, 6);
   sdf::ScanConvertOptions options;
-  options.keep_texture = true;
-  options.build_grid = false;
+  options.index_space_grid = true;
   auto field = sdf::scan_convert(context, sphere, sdf::compute_pseudonormals(sphere), spec, options);
   std::mt19937_64 rng(7);
   std::normal_distribution<double> gauss;
@@ -102,7 +100,7 @@ TEST_F(Relaxer, SameSeedsGiveBitwiseTheSameResult) {
   settings.spacing = 0.2;
   settings.band_limit = 0.25;
   settings.max_iterations = 50;
-  GpuRelaxer relaxer(context, std::move(field.texture));
+  GpuRelaxer relaxer(context, sdf::SparseField(*field.grid, spec, options.band));
   auto a = seeds, b = seeds;
   relaxer.relax(a, settings);
   relaxer.relax(b, settings);

@@ -18,6 +18,7 @@ namespace ts::sdf {
 namespace {
 
 using test::box_mesh;
+using test::grid_around;
 using test::icosphere;
 
 // Brute force: exact closest point (Ericson 5.1.5) over all triangles, sign by pseudonormal.
@@ -46,18 +47,6 @@ double exact_signed_distance(const TriangleMesh& mesh, const Pseudonormals& pn, 
   return sign * best;
 }
 
-GridSpec grid_around(const TriangleMesh& mesh, double h, int padding) {
-  Eigen::Vector3d lo = mesh.vertices[0], hi = mesh.vertices[0];
-  for (const auto& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-  GridSpec s;
-  s.voxel_size = h;
-  for (int a = 0; a < 3; ++a) {
-    s.index_offset[a] = static_cast<int>(std::floor(lo[a] / h)) - padding;
-    s.dims[a] = static_cast<int>(std::ceil(hi[a] / h)) + padding - s.index_offset[a] + 1;
-  }
-  s.origin = h * s.index_offset.cast<double>();
-  return s;
-}
 
 struct Agreement {
   std::size_t band_voxels = 0, missing = 0, sign_errors = 0;
@@ -230,56 +219,6 @@ TEST_F(ScanConvert, DenseCopyAgreesWithTheLevelSetEverywhere) {
         const openvdb::Coord c(spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k);
         ASSERT_FLOAT_EQ(result.dense.values[spec.linear_index(i, j, k)].w(), acc.getValue(c)) << i << " " << j << " " << k;
       }
-}
-
-TEST_F(ScanConvert, GpuTextureEqualsTheDenseHostFieldVoxelForVoxelWithOffBandSigns) {
-  // A torus: inside voxels off the band (the tube's core) and an outside region enclosed by the
-  // band in the x-y plane (the hole) that the flood fill must reach around the tube.
-  const TriangleMesh torus = make_torus(1.0, 0.45, 32, 16);
-  const GridSpec spec = grid_around(torus, 0.08, 4);
-  ScanConvertOptions dense_only;
-  dense_only.keep_dense = true;
-  dense_only.build_grid = false;
-  const auto host = run(torus, spec, dense_only);
-  ScanConvertOptions texture_only;
-  texture_only.keep_texture = true;
-  texture_only.build_grid = false;
-  texture_only.max_slab_bytes = bytes_per_layer(spec) * 3;  // slabs copied in at many z offsets
-  const auto device = run(torus, spec, texture_only);
-  ASSERT_GT(device.stats.slabs, 5);
-  ASSERT_TRUE(host.texture.empty());
-  ASSERT_FALSE(device.texture.empty());
-  ASSERT_EQ(device.texture.spec().dims, spec.dims);
-  EXPECT_GE(device.stats.peak_gpu_bytes, device.texture.bytes());
-
-  GLint filter = 0;
-  glGetTextureParameteriv(device.texture.id(), GL_TEXTURE_MIN_FILTER, &filter);
-  EXPECT_EQ(filter, GL_LINEAR);
-  std::vector<Eigen::Vector4f> texels(spec.voxel_count());
-  glGetTextureImage(device.texture.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(texels.size() * sizeof(Eigen::Vector4f)),
-                    texels.data());
-  ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
-
-  const float far = 3.0f * static_cast<float>(spec.voxel_size);
-  std::size_t inside_off_band = 0, outside_off_band = 0;
-  for (int k = 0; k < spec.dims.z(); ++k)
-    for (int j = 0; j < spec.dims.y(); ++j)
-      for (int i = 0; i < spec.dims.x(); ++i) {
-        const std::size_t idx = spec.linear_index(i, j, k);
-        const Eigen::Vector4f& h = host.dense.values[idx];
-        for (int c = 0; c < 4; ++c) ASSERT_EQ(texels[idx][c], h[c]) << i << " " << j << " " << k << " component " << c;
-        if (h.w() == far) ++outside_off_band;
-        if (h.w() == -far) ++inside_off_band;
-      }
-  EXPECT_GT(inside_off_band, 200u);
-  EXPECT_GT(outside_off_band, 200u);
-  auto at = [&](const Eigen::Vector3d& p) {
-    const Eigen::Vector3d v = spec.to_voxel(p);
-    return texels[spec.linear_index(static_cast<int>(std::lround(v.x())), static_cast<int>(std::lround(v.y())),
-                                    static_cast<int>(std::lround(v.z())))].w();
-  };
-  EXPECT_EQ(at({1.0, 0.0, 0.0}), -far);  // the tube's core
-  EXPECT_EQ(at({0.0, 0.0, 0.0}), far);   // the hole
 }
 
 TEST_F(ScanConvert, SmallSlabsGiveTheSameFieldAsOneSlab) {

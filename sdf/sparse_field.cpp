@@ -1,0 +1,85 @@
+#include "sdf/sparse_field.h"
+
+#include <fmt/format.h>
+
+#include <nanovdb/util/IO.h>
+#include <nanovdb/util/OpenToNanoVDB.h>
+
+#include <cmath>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace ts::sdf {
+
+NanoGrid to_nanovdb(const openvdb::FloatGrid& level_set) {
+  // openToNanoVDB wants a shared pointer; the deep copy costs host memory of the band once more,
+  // which the caller frees with its own grid (the sampler's is a temporary).
+  return nanovdb::openToNanoVDB<nanovdb::HostBuffer>(level_set, nanovdb::StatsMode::BBox,
+                                                     nanovdb::ChecksumMode::Disable);
+}
+
+namespace {
+
+// The largest resolution (voxels along the longest side) whose field fits `limit` bytes: the band,
+// and so the grid, grows as the square of the resolution.
+int largest_fitting_resolution(const GridSpec& spec, std::size_t bytes, std::size_t limit) {
+  const int longest = std::max({spec.dims.x(), spec.dims.y(), spec.dims.z()});
+  return static_cast<int>(std::floor(longest * std::sqrt(static_cast<double>(limit) / static_cast<double>(bytes))));
+}
+
+}  // namespace
+
+SparseField::SparseField(const openvdb::FloatGrid& level_set, const GridSpec& spec, double band_voxels)
+    : SparseField(to_nanovdb(level_set), spec, band_voxels) {}
+
+SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels)
+    : spec_(spec),
+      band_(band_voxels),
+      background_(static_cast<float>(band_voxels * spec.voxel_size)),
+      host_(std::move(grid)) {
+  const nanovdb::FloatGrid* nano = host_.grid<float>();
+  if (!nano) throw Error(ExitCode::Internal, "SparseField: the NanoVDB grid is not a float grid");
+  band_voxels_ = nano->activeVoxelCount();
+  GLint64 max_block = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+  const std::size_t bytes = host_.size();
+  // PNanoVDB addresses the buffer with 32-bit byte offsets, and one storage block is all a kernel reads.
+  const std::size_t limit = std::min<std::size_t>(static_cast<std::size_t>(max_block), std::size_t{1} << 32);
+  if (bytes > limit) {
+    throw GpuError(fmt::format("the sparse SDF ({} band voxels, {:.1f} MiB) exceeds this GPU's largest storage "
+                               "block ({:.1f} MiB); the largest grid that fits has about {} voxels along its longest "
+                               "side (use a larger voxel)",
+                               band_voxels_, bytes / 1048576.0, limit / 1048576.0,
+                               largest_fitting_resolution(spec, bytes, limit)));
+  }
+  try {
+    buffer_ = gpu::Buffer(bytes, host_.data());
+  } catch (const GpuError& e) {
+    throw GpuError(fmt::format("{} for the sparse SDF ({} band voxels); the largest grid that might fit has about {} "
+                               "voxels along its longest side",
+                               e.what(), band_voxels_, largest_fitting_resolution(spec, bytes, bytes / 2)));
+  }
+}
+
+void SparseField::bind(const gpu::Program& program, GLuint binding) const {
+  buffer_.bind(binding);
+  program.set("field_index_offset", spec_.index_offset.x(), spec_.index_offset.y(), spec_.index_offset.z());
+  program.set("field_voxel_size", static_cast<float>(spec_.voxel_size));
+  program.set("field_background", background_);
+}
+
+void write_nvdb(const std::filesystem::path& file, const NanoGrid& grid, const std::vector<std::filesystem::path>& inputs) {
+  write_atomically(
+      file,
+      [&](const std::filesystem::path& tmp) {
+        try {
+          nanovdb::io::writeGrid(tmp.string(), grid, nanovdb::io::Codec::NONE);
+        } catch (const std::exception& e) {
+          throw InputError(file, fmt::format("cannot write the NanoVDB file: {}", e.what()));
+        }
+      },
+      inputs);
+}
+
+}  // namespace ts::sdf

@@ -1,0 +1,72 @@
+// The narrow-band SDF as a sparse NanoVDB float level set (sdf::SparseField), read through NanoVDB's
+// PNanoVDB.h (Debian libnanovdb-dev; copied beside the shaders by the build). The including kernel
+// declares, before including this file, the grid's buffer at its own stage's binding slot: a
+// readonly std430 block named SparseField holding `uint pnanovdb_buf_data[]` (see sampler/relax.comp).
+// Positions are in grid-local voxel units (voxel (0,0,0) of the grid spec at 0), so float precision
+// does not depend on where the grid sits in index space; values are world units.
+#ifndef TETRASAND_COMMON_SPARSE_FIELD_GLSL
+#define TETRASAND_COMMON_SPARSE_FIELD_GLSL
+
+#define PNANOVDB_GLSL
+#include "nanovdb/PNanoVDB.h"
+
+uniform ivec3 field_index_offset;  // NanoVDB index of the grid spec's voxel (0,0,0)
+uniform float field_voxel_size;    // [world units]
+uniform float field_background;    // |value| off the band [world units]
+
+// One accessor per invocation: it caches the last leaf, so neighbouring reads skip the tree walk.
+struct FieldReader {
+  pnanovdb_readaccessor_t accessor;
+};
+
+FieldReader field_reader() {
+  pnanovdb_buf_t buf;
+  pnanovdb_grid_handle_t grid;
+  grid.address.byte_offset = 0u;
+  pnanovdb_root_handle_t root = pnanovdb_tree_get_root(buf, pnanovdb_grid_get_tree(buf, grid));
+  FieldReader reader;
+  pnanovdb_readaccessor_init(reader.accessor, root);
+  return reader;
+}
+
+// The value of grid voxel `g` (grid-local integer coordinates) [world units]; off the band the
+// background's +-value (tiles and inactive voxels keep the flood fill's sign).
+float field_voxel(inout FieldReader reader, ivec3 g) {
+  pnanovdb_buf_t buf;
+  pnanovdb_coord_t ijk = g + field_index_offset;
+  pnanovdb_address_t address =
+      pnanovdb_readaccessor_get_value_address(PNANOVDB_GRID_TYPE_FLOAT, buf, reader.accessor, ijk);
+  return pnanovdb_read_float(buf, address);
+}
+
+// Trilinear interpolation at grid-local position `x` [voxels], the same weights in the same order
+// as sdf::sparse_trilinear on the host.
+float field_trilinear(inout FieldReader reader, vec3 x) {
+  vec3 base = floor(x);
+  vec3 t = x - base;
+  ivec3 g = ivec3(base);
+  float c000 = field_voxel(reader, g);
+  float c100 = field_voxel(reader, g + ivec3(1, 0, 0));
+  float c010 = field_voxel(reader, g + ivec3(0, 1, 0));
+  float c110 = field_voxel(reader, g + ivec3(1, 1, 0));
+  float c001 = field_voxel(reader, g + ivec3(0, 0, 1));
+  float c101 = field_voxel(reader, g + ivec3(1, 0, 1));
+  float c011 = field_voxel(reader, g + ivec3(0, 1, 1));
+  float c111 = field_voxel(reader, g + ivec3(1, 1, 1));
+  float c00 = mix(c000, c100, t.x), c10 = mix(c010, c110, t.x);
+  float c01 = mix(c001, c101, t.x), c11 = mix(c011, c111, t.x);
+  return mix(mix(c00, c10, t.y), mix(c01, c11, t.y), t.z);
+}
+
+// xyz: unit gradient of the interpolated field by central differences one voxel apart (smooth across
+// voxel faces; zero off the band, where the field is constant), w: the interpolated value [world units].
+vec4 field_sample(inout FieldReader reader, vec3 x) {
+  float value = field_trilinear(reader, x);
+  vec3 gradient = vec3(field_trilinear(reader, x + vec3(0.5, 0.0, 0.0)) - field_trilinear(reader, x - vec3(0.5, 0.0, 0.0)),
+                       field_trilinear(reader, x + vec3(0.0, 0.5, 0.0)) - field_trilinear(reader, x - vec3(0.0, 0.5, 0.0)),
+                       field_trilinear(reader, x + vec3(0.0, 0.0, 0.5)) - field_trilinear(reader, x - vec3(0.0, 0.0, 0.5)));
+  float len = length(gradient);
+  return vec4(len > 1e-6 * field_voxel_size ? gradient / len : vec3(0.0), value);
+}
+
+#endif

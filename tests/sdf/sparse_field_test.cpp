@@ -1,0 +1,169 @@
+// The sparse GPU field (sdf::SparseField): what GLSL reads through PNanoVDB.h must be what the host's
+// NanoVDB and OpenVDB grids hold, at every voxel, between voxels and off the band, and .nvdb files
+// must be valid NanoVDB.
+#include "sdf/sparse_field.h"
+
+#include <gtest/gtest.h>
+
+#include <nanovdb/util/IO.h>
+#include <openvdb/tools/Interpolation.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <random>
+
+#include "core/primitives.h"
+#include "gpu/context.h"
+#include "gpu/gl.h"
+#include "sdf/pseudonormals.h"
+#include "sdf/scan_convert.h"
+#include "shaders/test/bindings.h"
+#include "tests/test_meshes.h"
+#include "tests/test_support.h"
+
+namespace ts::sdf {
+namespace {
+
+using test::grid_around;
+
+class SparseFieldTest : public ::testing::Test {
+ protected:
+  // The torus has an inside off the band (the tube's core) and an outside the band encloses in the
+  // x-y plane (the hole), so both signs off the band are exercised.
+  void SetUp() override {
+    torus_ = make_torus(1.0, 0.45, 32, 16);
+    spec_ = grid_around(torus_, 0.08, 4);
+    ScanConvertOptions options;
+    options.band = 3.0;
+    options.index_space_grid = true;
+    options.keep_dense = true;
+    options.max_slab_bytes = bytes_per_layer(spec_) * 3;  // many slabs: the compaction at many z offsets
+    result_ = scan_convert(context_, torus_, compute_pseudonormals(torus_), spec_, options);
+  }
+
+  // Runs the probe kernel (shaders/test/sparse_field_probe.comp) at grid-local `points`.
+  std::vector<Eigen::Vector4f> probe(const SparseField& field, const std::vector<Eigen::Vector4f>& points, int mode) {
+    gpu::ShaderLibrary library;
+    gpu::Program program = gpu::Program::compute(library, "test/sparse_field_probe.comp");
+    gpu::Buffer in = gpu::Buffer::from<Eigen::Vector4f>(points);
+    gpu::Buffer out(points.size() * sizeof(Eigen::Vector4f));
+    field.bind(program, TS_TEST_FIELD_GRID);
+    in.bind(TS_TEST_FIELD_POINTS);
+    out.bind(TS_TEST_FIELD_VALUES);
+    program.set("count", static_cast<unsigned>(points.size()));
+    program.set("mode", mode);
+    gpu::Queue queue(false, true);
+    queue.dispatch_items(program, points.size(), GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    return out.read<Eigen::Vector4f>(points.size());
+  }
+
+  gpu::Context context_;
+  TriangleMesh torus_;
+  GridSpec spec_;
+  ScanConvertResult result_;
+};
+
+TEST_F(SparseFieldTest, GlslReadsTheLevelSetAtEveryVoxelBitForBit) {
+  ASSERT_GT(result_.stats.slabs, 5);
+  const SparseField field(*result_.grid, spec_, 3.0);
+  EXPECT_EQ(field.band_voxels(), result_.grid->activeVoxelCount());
+  EXPECT_EQ(field.band_voxels(), result_.stats.band_voxels);
+  std::vector<Eigen::Vector4f> points;
+  for (int k = 0; k < spec_.dims.z(); ++k)
+    for (int j = 0; j < spec_.dims.y(); ++j)
+      for (int i = 0; i < spec_.dims.x(); ++i) points.emplace_back(i, j, k, 0.0f);
+  const auto values = probe(field, points, 0);
+  const float far = field.background();
+  std::size_t inside_off_band = 0, outside_off_band = 0;
+  for (std::size_t v = 0; v < points.size(); ++v) {
+    const Eigen::Vector4f& dense = result_.dense.values[v];  // spec.linear_index order, as `points`
+    ASSERT_EQ(values[v].x(), dense.w()) << "voxel " << points[v].transpose();
+    inside_off_band += dense.w() == -far;
+    outside_off_band += dense.w() == far;
+  }
+  EXPECT_GT(inside_off_band, 200u);
+  EXPECT_GT(outside_off_band, 200u);
+}
+
+TEST_F(SparseFieldTest, TrilinearValuesAgreeWithOpenVdbToFloatPrecision) {
+  const SparseField field(*result_.grid, spec_, 3.0);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Eigen::Vector4f> points;
+  std::vector<double> expected;
+  const openvdb::FloatGrid& grid = *result_.grid;
+  auto accessor = grid.getConstAccessor();
+  std::size_t in_band = 0;
+  while (points.size() < 20000) {
+    // The GPU reads float positions: the expected value is taken at the same float-rounded point.
+    const Eigen::Vector3f x(static_cast<float>(u(rng) * (spec_.dims.x() - 1)), static_cast<float>(u(rng) * (spec_.dims.y() - 1)),
+                            static_cast<float>(u(rng) * (spec_.dims.z() - 1)));
+    const openvdb::Vec3d index(double(x.x()) + spec_.index_offset.x(), double(x.y()) + spec_.index_offset.y(),
+                               double(x.z()) + spec_.index_offset.z());
+    const double value = openvdb::tools::BoxSampler::sample(accessor, index);
+    in_band += std::abs(value) < field.background();
+    points.emplace_back(x.x(), x.y(), x.z(), 0.0f);
+    expected.push_back(value);
+  }
+  const auto values = probe(field, points, 1);
+  double worst = 0.0;
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    worst = std::max(worst, std::abs(values[p].x() - expected[p]) / spec_.voxel_size);
+  }
+  EXPECT_GT(in_band, 2000u);  // the points must test the band, not only the constant background
+  // Float weights and corner values of up to 3 voxels carry 24 bits: a few ulps are ~1e-6 voxel.
+  EXPECT_LT(worst, 1e-5) << "worst difference [voxels]";
+}
+
+TEST_F(SparseFieldTest, OffTheGridIsTheOutsideBackgroundAndTheGradientIsTheNormal) {
+  const SparseField field(*result_.grid, spec_, 3.0);
+  // Far outside the grid (no node there): +background. On the torus's outer equator, radially out:
+  // the unit gradient is the outward normal (1, 0, 0) and the value about the distance.
+  const Eigen::Vector3d on_surface = spec_.to_voxel(Eigen::Vector3d(1.45 + 0.04, 0.0, 0.0));
+  const std::vector<Eigen::Vector4f> points = {{-500.0f, -500.0f, 900.0f, 0.0f},
+                                               {static_cast<float>(on_surface.x()), static_cast<float>(on_surface.y()),
+                                                static_cast<float>(on_surface.z()), 0.0f}};
+  const auto values = probe(field, points, 2);
+  EXPECT_EQ(values[0].w(), field.background());
+  EXPECT_EQ(values[0].head<3>(), Eigen::Vector3f::Zero());
+  EXPECT_NEAR(values[1].w(), 0.04, 0.01);
+  EXPECT_NEAR(values[1].x(), 1.0, 0.02);
+  EXPECT_NEAR(values[1].head<3>().norm(), 1.0, 1e-5);
+}
+
+TEST_F(SparseFieldTest, GpuMemoryFollowsTheBandNotTheBox) {
+  // The same torus at a voxel 4x finer: the band (and the grid's bytes) grows about 16x, the box
+  // about 64x (28x here: the fixed 4-voxel padding is a larger share of the coarse box).
+  const SparseField coarse(*result_.grid, spec_, 3.0);
+  const GridSpec fine_spec = grid_around(torus_, 0.02, 4);
+  ScanConvertOptions options;
+  options.index_space_grid = true;
+  const auto fine = scan_convert(context_, torus_, compute_pseudonormals(torus_), fine_spec, options);
+  const SparseField fine_field(*fine.grid, fine_spec, 3.0);
+  const double band_growth = static_cast<double>(fine_field.band_voxels()) / coarse.band_voxels();
+  const double byte_growth = static_cast<double>(fine_field.gpu_bytes()) / coarse.gpu_bytes();
+  const double box_growth = static_cast<double>(fine_spec.voxel_count()) / spec_.voxel_count();
+  EXPECT_NEAR(band_growth, 16.0, 2.5);
+  EXPECT_LT(byte_growth, 20.0);
+  EXPECT_GT(box_growth, 1.5 * band_growth);
+  // Read back during scan conversion: the band only (20 bytes a band voxel plus counts), a share of
+  // the 16 bytes a voxel of the whole box that a dense read-back moves, and a shrinking one.
+  EXPECT_LT(fine.stats.readback_bytes, 21 * fine.stats.band_voxels + 64 * static_cast<std::size_t>(fine.stats.slabs));
+  const double fine_share = static_cast<double>(fine.stats.readback_bytes) / (16.0 * fine_spec.voxel_count());
+  const double coarse_share = static_cast<double>(result_.stats.readback_bytes) / (16.0 * spec_.voxel_count());
+  EXPECT_LT(fine_share, 0.6 * coarse_share);
+  EXPECT_LT(fine_share, 0.35);
+}
+
+TEST_F(SparseFieldTest, NanoVdbFilesPassNanovdbValidate) {
+  const auto dir = test::temp_dir();
+  const auto file = dir / "torus.nvdb";
+  write_nvdb(file, to_nanovdb(*result_.grid), {});
+  const NanoGrid back = nanovdb::io::readGrid(file.string());
+  ASSERT_TRUE(back.grid<float>());
+  EXPECT_EQ(back.grid<float>()->activeVoxelCount(), result_.grid->activeVoxelCount());
+  EXPECT_EQ(std::system(("nanovdb_validate " + file.string() + " > " + (dir / "validate.txt").string() + " 2>&1").c_str()), 0);
+}
+
+}  // namespace
+}  // namespace ts::sdf
