@@ -98,7 +98,7 @@ ParticlesPly read_particles_ply(const fs::path& path) {
   const std::string bytes = read_file(path);
   // A particle file is ours (little-endian by its format, docs/body-format.md) or made by hand: a
   // header keyword this reader does not know is a mistake to report, not an exporter's habit.
-  const ply::HeaderRules rules{.big_endian = false, .unknown_lines = false};
+  const ply::HeaderRules rules{.big_endian = false, .unknown_lines = false, .lines_between_properties = true};
   const ply::Header header = ply::parse_header(path, bytes, rules);
   ply::DataReader data(path, bytes, header);
   for (const ply::Element& element : header.elements) {
