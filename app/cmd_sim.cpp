@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "app/commands.h"
+#include "app/numeric_options.h"
 #include "core/log.h"
 #include "gpu/context.h"
 #include "preview/sim_frames.h"
@@ -30,7 +31,7 @@ struct Options {
 void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option("SCENE", o.scene, "Scene file (TOML; see assets/scenes/README.md)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o.output, "Output directory (metrics.csv, particle dumps, frames)")->capture_default_str();
-  cmd->add_option("--duration", o.duration, "Simulated time [s], overriding the scene's")->check(CLI::PositiveNumber);
+  cmd->add_option("--duration", o.duration, "Simulated time [s], overriding the scene's")->check(positive());
   cmd->add_flag("--cpu", o.cpu, "Use the double-precision CPU reference instead of the GPU pipeline");
   cmd->add_option("--precision", o.precision, "GPU arithmetic: float or double (GLSL fp64)")
       ->check(CLI::IsMember({"float", "double"}))

@@ -19,10 +19,14 @@ void write_vdb(const std::filesystem::path& path, const openvdb::FloatGrid::Ptr&
   write_atomically(
       path,
       [&](const std::filesystem::path& tmp) {
-        openvdb::io::File file(tmp.string());
-        openvdb::GridPtrVec grids{grid};
-        file.write(grids);
-        file.close();
+        try {
+          openvdb::io::File file(tmp.string());
+          openvdb::GridPtrVec grids{grid};
+          file.write(grids);
+          file.close();
+        } catch (const openvdb::IoError& e) {  // the place is not writable (permission, space)
+          throw InputError(path, std::string("cannot write file (") + e.what() + ")");
+        }
       },
       inputs);
 }
