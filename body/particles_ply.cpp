@@ -67,8 +67,8 @@ ParticlesPly read_vertices(const fs::path& file, ply::DataReader& data, const pl
 
 }  // namespace
 
-void write_particles_ply(const fs::path& path, const std::vector<Eigen::Vector3f>& positions,
-                         const std::vector<Eigen::Vector3f>& normals) {
+std::string particles_ply_bytes(const std::vector<Eigen::Vector3f>& positions,
+                                const std::vector<Eigen::Vector3f>& normals) {
   const bool with_normals = !normals.empty();
   if (with_normals && normals.size() != positions.size()) {
     throw Error(ExitCode::Internal, fmt::format("write_particles_ply: {} normals for {} positions",
@@ -91,7 +91,12 @@ void write_particles_ply(const fs::path& path, const std::vector<Eigen::Vector3f
       out += 3 * sizeof(float);
     }
   }
-  write_file_atomically(path, bytes);
+  return bytes;
+}
+
+void write_particles_ply(const fs::path& path, const std::vector<Eigen::Vector3f>& positions,
+                         const std::vector<Eigen::Vector3f>& normals) {
+  write_file_atomically(path, particles_ply_bytes(positions, normals));
 }
 
 ParticlesPly read_particles_ply(const fs::path& path) {
