@@ -18,6 +18,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/mass_properties.h"
+#include "tests/body/test_bodies.h"
 #include "tests/input_error.h"
 #include "tests/test_meshes.h"
 #include "tests/test_support.h"
@@ -39,11 +40,7 @@ ParticleBody random_body(std::size_t count, std::uint64_t seed) {
     body.positions.emplace_back(u(rng) + 1.0f, 0.5f * u(rng) + 0.5f, 0.25f * u(rng) + 0.25f);
     body.normals.push_back(Eigen::Vector3f(u(rng), u(rng), u(rng) + 2.0f).normalized());
   }
-  body.particle_radius = 0.01;
-  body.sdf_voxel_size = 0.005;
-  body.source_path = "meshes/box.obj";
-  body.source_sha256 = std::string(64, 'a');
-  body.quality = {0.81, 0.035, 0.047, 0.94, 0.47 / 1.5, 0.02, 1234, 1.75, true, 2};
+  test::set_sampling_keys(body, 0.01);
   return body;
 }
 
