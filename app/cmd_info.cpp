@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/numeric_options.h"
 #include "core/error.h"
 #include "core/mass_properties.h"
 #include "core/mesh_io.h"
@@ -47,8 +48,12 @@ std::string mass_text(const MassProperties& m) {
 void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option("MESH", o.mesh, "Mesh file (OBJ, PLY, STL, OFF, glTF/GLB, ... anything assimp reads)")->required();
   cmd->add_flag("--json", o.json, "Print the report as JSON");
-  cmd->add_option("--density", o.density, "Density for the mass properties [kg/m^3]")->capture_default_str();
-  cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor (e.g. 0.001 for millimetres)")->capture_default_str();
+  cmd->add_option("--density", o.density, "Density for the mass properties [kg/m^3]")
+      ->check(finite())
+      ->capture_default_str();
+  cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor (e.g. 0.001 for millimetres)")
+      ->check(finite())
+      ->capture_default_str();
   cmd->add_flag("--no-self-intersections", o.skip_self_intersections, "Skip the self-intersection test (large meshes)");
 }
 

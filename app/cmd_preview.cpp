@@ -7,6 +7,7 @@
 #include <regex>
 
 #include "app/commands.h"
+#include "app/numeric_options.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mesh_io.h"
@@ -82,7 +83,7 @@ void add_input_options(CLI::App* cmd, Options& o) {
   cmd->add_option("--particles", o.particles, "Particles over the surface: NAME.body.json or a PLY of centres");
   cmd->add_option("--particle-radius", o.particle_radius,
                   "Particle radius [m] (default: the body.json's, else half the median neighbour distance)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   cmd->add_option("--size", o.size, "Image size WIDTHxHEIGHT [pixels]")->capture_default_str();
 }
 
@@ -91,19 +92,26 @@ void add_camera_options(CLI::App* cmd, Options& o) {
   cmd->add_option("--view", o.view, "Named view relative to --up: front, side, top or iso")
       ->check(CLI::IsMember({"front", "side", "top", "iso"}))
       ->capture_default_str();
-  auto* eye = cmd->add_option("--eye", o.eye, "Camera position X,Y,Z [m] (instead of --view)")->delimiter(',')->expected(3);
+  auto* eye = cmd->add_option("--eye", o.eye, "Camera position X,Y,Z [m] (instead of --view)")
+                  ->delimiter(',')
+                  ->expected(3)
+                  ->check(finite());
   cmd->add_option("--target", o.target, "Point looked at X,Y,Z [m] (default: the centre of what is drawn)")
       ->delimiter(',')
       ->expected(3)
+      ->check(finite())
       ->needs(eye);
-  cmd->add_option("--up", o.up, "World up X,Y,Z: the ground's normal and the image's up (meshes: y up by default)")
+  cmd->add_option("--up", o.up,
+                  "World up X,Y,Z: the ground's normal and the image's up (meshes: y up by default)")
       ->delimiter(',')
       ->expected(3)
+      ->check(finite())
       ->capture_default_str();
-  cmd->add_option("--fov", o.fov, "Vertical field of view [degrees]")->capture_default_str();
+  cmd->add_option("--fov", o.fov, "Vertical field of view [degrees]")->check(finite())->capture_default_str();
   cmd->add_flag("--ortho", o.ortho, "Orthographic lens (framed to fit)");
-  cmd->add_option("--turntable", o.turntable, "N views turning about --up: OUT_000.png ... (or one --contact-sheet)")
-      ->check(CLI::Range(1, 10000));
+  cmd->add_option("--turntable", o.turntable,
+                  "N views turning about --up: OUT_000.png ... (or one --contact-sheet)")
+      ->check(int_range(1, 10000));
   cmd->add_flag("--contact-sheet", o.contact_sheet, "With --turntable: tile all views into OUT.png");
 }
 
@@ -114,26 +122,31 @@ void add_colour_options(CLI::App* cmd, Options& o) {
                   "particle-distance (distance to the nearest particle centre, in radii)")
       ->check(CLI::IsMember({"none", "error", "particle-distance"}))
       ->capture_default_str();
-  cmd->add_option("--color-max", o.color_max, "Value at the top of the colour map (default 0.25 voxel / 1.5 radii)")
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--color-max", o.color_max,
+                  "Value at the top of the colour map (default 0.25 voxel / 1.5 radii)")
+      ->check(positive());
 }
 
 // How a MESH input is scan-converted.
 void add_sdf_options(CLI::App* cmd, Options& o) {
-  auto* voxel = cmd->add_option("--voxel", o.voxel, "MESH: SDF voxel size [m]")->check(CLI::PositiveNumber);
+  auto* voxel = cmd->add_option("--voxel", o.voxel, "MESH: SDF voxel size [m]")->check(positive());
   cmd->add_option("--resolution", o.resolution, "MESH: SDF voxels along the longest side")
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->excludes(voxel)
       ->capture_default_str();
-  cmd->add_option("--band", o.band, "MESH: narrow-band half-width [voxels], >= 2 for clean normals")->capture_default_str();
+  cmd->add_option("--band", o.band, "MESH: narrow-band half-width [voxels], >= 2 for clean normals")
+      ->check(finite())
+      ->capture_default_str();
   cmd->add_option("--scale", o.scale, "MESH and particles: multiply coordinates by this factor first")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
 }
 
 void add_lighting_options(CLI::App* cmd, Options& o) {
-  cmd->add_option("--light", o.light, "Direction towards the key light X,Y,Z (default: upper left, behind the camera)")
+  cmd->add_option("--light", o.light,
+                  "Direction towards the key light X,Y,Z (default: upper left, behind the camera)")
       ->delimiter(',')
-      ->expected(3);
+      ->expected(3)
+      ->check(finite());
   cmd->add_flag("--no-ground", o.no_ground, "No ground plane");
   cmd->add_flag("--no-shadows", o.no_shadows, "No shadow map");
   cmd->add_flag("--timings", o.timings, "Per-pass GPU times");
@@ -174,7 +187,7 @@ preview::SdfVolume volume_from_mesh_file(const Options& o, gpu::Context& context
   grid.voxel_size = o.voxel;
   grid.resolution = o.resolution;
   grid.band = o.band;
-  return preview::volume_from_mesh(context, *mesh, grid);
+  return naming_file(o.input, [&] { return preview::volume_from_mesh(context, *mesh, grid); });
 }
 
 // What the picture shows and how it is coloured, kept alive while it renders.

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/numeric_options.h"
 #include "body/body_file.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -147,36 +148,44 @@ void add_input_options(CLI::App* cmd, Options& o) {
 // Size, density, placement and the accuracy of the arrangement.
 void add_sampling_options(CLI::App* cmd, Options& o) {
   sampler::SampleSettings& s = o.sampling;
-  auto* radius = cmd->add_option("--radius", s.radius, "Particle radius [m]")->check(CLI::PositiveNumber);
-  cmd->add_option("--count", s.count, "Particle count instead of a radius")->check(CLI::PositiveNumber)->excludes(radius);
-  cmd->add_option("--density", s.density, "Density of the solid [kg/m^3]")->check(CLI::PositiveNumber)->capture_default_str();
-  cmd->add_option("--seed", s.seed, "Seed of the generator that places the particles")->capture_default_str();
-  cmd->add_option("--coverage", s.coverage,
-                  "Target covering radius / r: 1 = the particle spheres cover the surface; up to (r + r_grain) / r "
-                  "still stops grains of radius r_grain")
-      ->check(CLI::PositiveNumber)
+  auto* radius = cmd->add_option("--radius", s.radius, "Particle radius [m]")->check(positive());
+  cmd->add_option("--count", s.count, "Particle count instead of a radius")
+      ->check(positive())
+      ->excludes(radius);
+  cmd->add_option("--density", s.density, "Density of the solid [kg/m^3]")
+      ->check(positive())
+      ->capture_default_str();
+  cmd->add_option("--seed", s.seed, "Seed of the generator that places the particles")
+      ->check(finite())
+      ->capture_default_str();
+  cmd->add_option(
+         "--coverage", s.coverage,
+         "Target covering radius / r: 1 = the particle spheres cover the surface; up to (r + r_grain) / r "
+         "still stops grains of radius r_grain")
+      ->check(positive())
       ->capture_default_str();
   cmd->add_option("--grain-radius", s.grain_radius, "Grain radius [m] for the leak figure c / (r + r_grain)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--voxel", s.voxel_size, "SDF voxel [m] (default r / 2)")->check(CLI::PositiveNumber);
-  cmd->add_option("--rounds", s.max_rounds, "Most hole-closing rounds")->check(CLI::NonNegativeNumber)->capture_default_str();
+      ->check(positive());
+  cmd->add_option("--voxel", s.voxel_size, "SDF voxel [m] (default r / 2)")->check(positive());
+  cmd->add_option("--rounds", s.max_rounds, "Most hole-closing rounds")->check(non_negative())->capture_default_str();
   cmd->add_option("--probes", s.probes,
                   "Random surface points of the statistical covering radius (beside the certificate)")
+      ->check(finite())
       ->capture_default_str();
   cmd->add_option(
          "--certificate-floor", s.certificate.floor_divisor,
          "The coverage certificate splits triangles no finer than r / this (its bound is within max(r, c) / "
          "this of the covering radius c)")
-      ->check(CLI::Range(1.0, 4096.0))
+      ->check(range(1.0, 4096.0))
       ->capture_default_str();
-  cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor first")->check(CLI::PositiveNumber);
+  cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor first")->check(positive());
   cmd->add_option("--max-iterations", s.relax.max_iterations, "Most relaxation steps of the first relaxation (later rounds: 200)")
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->capture_default_str();
   cmd->add_option("--sdf-budget-mib", o.sdf_budget_mib,
                   "Most GPU memory the sparse SDF may take [MiB]; a larger field stops the run (exit 1) with the "
                   "particle count (or, with --voxel, the voxel) that fits")
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->capture_default_str();
 }
 
@@ -295,7 +304,8 @@ int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
   sampler::SampleSettings settings = o.sampling;
   settings.max_sdf_bytes = o.sdf_budget_mib << 20;
   const TriangleMesh mesh = load_sample_mesh(o, settings);
-  sampler::SampleResult result = sample_with_progress(context, mesh, settings);
+  sampler::SampleResult result =
+      naming_file(o.mesh, [&] { return sample_with_progress(context, mesh, settings); });
   body::ParticleBody& body = result.body;
   body.source_path = o.mesh;
   body.source_sha256 = sha256_file(o.mesh);

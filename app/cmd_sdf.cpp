@@ -11,6 +11,7 @@
 #include <openvdb/tools/SignedFloodFill.h>
 
 #include "app/commands.h"
+#include "app/numeric_options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -63,20 +64,23 @@ struct Figures {
 void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option("MESH", o.mesh, "Closed triangle mesh (any format assimp reads)")->required();
   cmd->add_option("-o,--output", o.output, "Output file: .vdb (OpenVDB level set) or .nvdb (NanoVDB)")->required();
-  auto* voxel = cmd->add_option("--voxel", o.voxel, "Voxel size [world units, m]")->check(CLI::PositiveNumber);
+  auto* voxel = cmd->add_option("--voxel", o.voxel, "Voxel size [world units, m]")->check(positive());
   cmd->add_option("--resolution", o.resolution, "Voxels along the longest side (instead of --voxel)")
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->excludes(voxel)
       ->capture_default_str();
-  cmd->add_option("--band", o.band, "Half-width of the narrow band [voxels], >= 1")->capture_default_str();
-  cmd->add_option("--padding", o.padding, "Voxels beyond the bounding box (default: band + 1)");
+  cmd->add_option("--band", o.band, "Half-width of the narrow band [voxels], >= 1")
+      ->check(finite())
+      ->capture_default_str();
+  cmd->add_option("--padding", o.padding, "Voxels beyond the bounding box (default: band + 1)")
+      ->check(finite());
   cmd->add_option("--sign", o.sign, "Sign method: pseudonormal (closed meshes) or winding (robust to holes)")
       ->check(CLI::IsMember({"pseudonormal", "winding"}))
       ->capture_default_str();
   cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor first (e.g. 1000: metres -> mm)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   cmd->add_option("--max-slab-mb", o.slab_mb, "GPU memory for one z-slab of the grid [MiB]")
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->capture_default_str();
   cmd->add_flag("--timings", o.timings, "Per-kernel GPU times and peak GPU memory");
   cmd->add_flag("--json", o.json, "Print the run's figures (grid, band voxels, memory per band voxel, times) as JSON");
@@ -95,7 +99,10 @@ TriangleMesh load_sdf_mesh(const Options& o) {
     log::warn("{}: the mesh is not closed ({}); pseudonormal signs may be wrong near the holes: use --sign winding",
               o.mesh, closed_solid_problems(report));
   }
-  if (report.closed() && report.signed_volume < 0) {
+  if (encloses_no_volume(report)) {
+    log::warn("{}: the mesh {}: the field has no inside", o.mesh, closed_solid_problems(report));
+  }
+  if (is_inside_out(report)) {
     log::warn("{}: the mesh is inside out (negative volume): inside and outside are swapped", o.mesh);
   }
   return mesh;
@@ -228,7 +235,7 @@ int run_sdf(const Options& o, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   is_nanovdb_path(o.output);  // a wrong suffix is a usage error before any work
   const TriangleMesh mesh = load_sdf_mesh(o);
-  const sdf::GridSpec spec = grid_of(o, mesh);
+  const sdf::GridSpec spec = naming_file(o.mesh, [&] { return grid_of(o, mesh); });
   gpu::Context context(context_options(global));
   sdf::ScanConvertOptions scan;
   scan.band = o.band;
@@ -237,7 +244,8 @@ int run_sdf(const Options& o, const GlobalOptions& global) {
   ScanProgress progress;
   scan.progress = [&progress](double done) { progress(done); };
   const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
-  sdf::ScanConvertResult result = sdf::scan_convert(context, mesh, normals, spec, scan);
+  sdf::ScanConvertResult result =
+      naming_file(o.mesh, [&] { return sdf::scan_convert(context, mesh, normals, spec, scan); });
   progress.end();
   // The winding-number signs replace the pseudonormal ones where the mesh cannot give them.
   if (o.sign == "winding") sdf::resign_by_winding_number(*result.grid, sdf::ExactDistance(mesh));

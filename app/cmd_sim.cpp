@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "app/commands.h"
+#include "app/numeric_options.h"
 #include "core/log.h"
 #include "gpu/context.h"
 #include "preview/sim_frames.h"
@@ -35,7 +36,7 @@ void add_options(CLI::App* cmd, Options& o) {
   CLI::Option* output = cmd->add_option("-o,--output", o.output,
                                         "Output directory (metrics.csv, particle dumps, frames, checkpoints)")
                             ->capture_default_str();
-  cmd->add_option("--duration", o.duration, "Simulated time [s], overriding the scene's")->check(CLI::PositiveNumber);
+  cmd->add_option("--duration", o.duration, "Simulated time [s], overriding the scene's")->check(positive());
   cmd->add_flag("--cpu", o.cpu, "Use the double-precision CPU reference instead of the GPU pipeline");
   cmd->add_option("--precision", o.precision, "GPU arithmetic: float or double (GLSL fp64)")
       ->check(CLI::IsMember({"float", "double"}))

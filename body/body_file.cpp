@@ -1,11 +1,13 @@
 #include "body/body_file.h"
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <vector>
 
 #include "body/json_fields.h"
@@ -23,6 +25,42 @@ using detail::Json;
 // What the simulator needs of a body (BodyKeys::Physical).
 const std::vector<std::string> kPhysicalKeys = {"particle_radius", "mass", "center_of_mass", "inertia",
                                                 "particles"};
+
+// The hidden journal of a body's replacement (write_files_atomically), beside NAME.body.json.
+fs::path journal_of(const fs::path& json_path) {
+  std::string name(".");  // piece by piece: GCC 12 warns falsely (-Wrestrict) on "." + std::string
+  name.append(json_path.filename().string());
+  name.append(".journal");
+  return json_path.parent_path() / name;
+}
+
+// The files a replacement of the body `json_path` writes: the JSON and, for NAME.body.json, the
+// NAME.particles.ply that write_body writes beside it.
+std::vector<fs::path> replaced_with(const fs::path& json_path) {
+  const std::string name = json_path.filename().string();
+  constexpr std::string_view kSuffix = ".body.json";
+  if (!name.ends_with(kSuffix) || name.size() == kSuffix.size()) return {json_path};
+  return {json_path,
+          json_path.parent_path() / (name.substr(0, name.size() - kSuffix.size()) + ".particles.ply")};
+}
+
+// Writes `bytes` to a temporary path; a failed write names `target`.
+std::function<void(const fs::path&)> bytes_writer(const fs::path& target, const std::string& bytes) {
+  return [target, &bytes](const fs::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) throw InputError(target, "cannot write file (disk full or no permission?)");
+  };
+}
+
+// Which file a path names now (a replacement renames a new file over it): device and inode, or
+// zeros when there is none.
+std::pair<std::uint64_t, std::uint64_t> file_identity(const fs::path& path) {
+  struct stat s {};
+  if (::stat(path.c_str(), &s) != 0) return {0, 0};
+  return {static_cast<std::uint64_t>(s.st_dev), static_cast<std::uint64_t>(s.st_ino)};
+}
 
 // ---------------------------------------------------------------------------------------------
 // Checks shared by the writer and the reader
@@ -365,22 +403,19 @@ fs::path write_body(const fs::path& dir, const std::string& name, const Particle
   const std::string ply_name = name + ".particles.ply";
   const fs::path json_path = dir / (name + ".body.json");
   validate_for_writing(json_path, body);
-  // Replaced only as a whole: the JSON is written to its temporary file first, then the PLY is
-  // written and renamed into place, then the JSON. Any failure before that last rename (disk full, a
-  // directory in the way, an interrupted write) leaves the previous pair as it was and removes the
-  // temporary files; and a reader that finds the new JSON finds the PLY it names.
+  // Replaced only as a whole, also when killed: both files under temporary names, then a journal
+  // naming them is published, then the renames (core/atomic_file.h). A reader finds the old pair or
+  // the new one.
   const std::string json_text = body_json(body, ply_name).dump(2) + "\n";
-  write_atomically(json_path, [&](const fs::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(json_text.data(), static_cast<std::streamsize>(json_text.size()));
-    out.close();
-    if (!out) throw InputError(json_path, "cannot write file (disk full or no permission?)");
-    write_particles_ply(dir / ply_name, body.positions, body.normals);
-  });
+  const std::string ply_bytes = particles_ply_bytes(body.positions, body.normals);
+  write_files_atomically(journal_of(json_path), {{dir / ply_name, bytes_writer(dir / ply_name, ply_bytes)},
+                                                 {json_path, bytes_writer(json_path, json_text)}});
   return json_path;
 }
 
-ParticleBody read_body(const fs::path& json_path, BodyKeys keys) {
+namespace {
+
+ParticleBody read_body_once(const fs::path& json_path, BodyKeys keys) {
   const Json j = parse_json(json_path);
   const std::int64_t version = format_version(json_path, j);
   const std::vector<std::string> known = body_keys(version);
@@ -404,6 +439,26 @@ ParticleBody read_body(const fs::path& json_path, BodyKeys keys) {
       keys == BodyKeys::All || (version >= 2 && j.contains("interior_particle_count"));
   read_particles(f, json_path.parent_path(), ply, counts, interior_normals, b);
   return b;
+}
+
+}  // namespace
+
+ParticleBody read_body(const fs::path& json_path, BodyKeys keys) {
+  // A pair being replaced while it is read may be read half old, half new: read again then.
+  constexpr int kAttempts = 3;
+  for (int attempt = 1;; ++attempt) {
+    complete_interrupted_writes(journal_of(json_path), replaced_with(json_path));
+    const auto before = file_identity(json_path);
+    try {
+      ParticleBody body = read_body_once(json_path, keys);
+      if (file_identity(json_path) == before && !fs::exists(journal_of(json_path))) return body;
+    } catch (const InputError&) {
+      if (file_identity(json_path) == before && !fs::exists(journal_of(json_path))) throw;
+    }
+    if (attempt == kAttempts) {
+      throw InputError(json_path, fmt::format("was replaced while being read, {} times over", kAttempts));
+    }
+  }
 }
 
 }  // namespace ts::body

@@ -20,18 +20,20 @@ enum class BodyKeys {
   Physical,
 };
 
-// Writes DIR/NAME.particles.ply, then DIR/NAME.body.json (format version kBodyFormatVersion), each
-// atomically, the JSON staged in its temporary file before the PLY is replaced: a failure leaves a
-// previous pair whole, and a reader that finds the JSON always finds the PLY it names. Creates DIR.
-// Throws ts::InputError naming the key of an invalid body (nothing is written then). Returns the
-// JSON's path.
+// Writes DIR/NAME.particles.ply and DIR/NAME.body.json (format version kBodyFormatVersion) as one
+// whole, also when the process is killed (core/atomic_file.h write_files_atomically, with the hidden
+// journal DIR/.NAME.body.json.journal): a reader finds the previous pair or the new one, never one
+// of each, and what a killed writer left is completed or removed by the next write or read. Creates
+// DIR. Throws ts::InputError naming the key of an invalid body (nothing is written then). Returns
+// the JSON's path.
 std::filesystem::path write_body(const std::filesystem::path& dir, const std::string& name,
                                  const ParticleBody& body);
 
 // Reads and validates NAME.body.json (format versions 1 and 2) and the PLY it names. Whatever
 // `keys`, a body has at least one particle, particle_count (when given) matches the PLY, and inertia
 // is symmetric positive definite. Errors are ts::InputError "FILE: KEY: problem" (the key path, e.g.
-// quality.cv).
+// quality.cv). A replacement that a killed writer left pending is completed first; one under way in
+// a live process is an InputError; a pair replaced while it is read is read again.
 ParticleBody read_body(const std::filesystem::path& json, BodyKeys keys = BodyKeys::All);
 
 }  // namespace ts::body

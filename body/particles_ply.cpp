@@ -67,8 +67,8 @@ ParticlesPly read_vertices(const fs::path& file, ply::DataReader& data, const pl
 
 }  // namespace
 
-void write_particles_ply(const fs::path& path, const std::vector<Eigen::Vector3f>& positions,
-                         const std::vector<Eigen::Vector3f>& normals) {
+std::string particles_ply_bytes(const std::vector<Eigen::Vector3f>& positions,
+                                const std::vector<Eigen::Vector3f>& normals) {
   const bool with_normals = !normals.empty();
   if (with_normals && normals.size() != positions.size()) {
     throw Error(ExitCode::Internal, fmt::format("write_particles_ply: {} normals for {} positions",
@@ -91,14 +91,19 @@ void write_particles_ply(const fs::path& path, const std::vector<Eigen::Vector3f
       out += 3 * sizeof(float);
     }
   }
-  write_file_atomically(path, bytes);
+  return bytes;
+}
+
+void write_particles_ply(const fs::path& path, const std::vector<Eigen::Vector3f>& positions,
+                         const std::vector<Eigen::Vector3f>& normals) {
+  write_file_atomically(path, particles_ply_bytes(positions, normals));
 }
 
 ParticlesPly read_particles_ply(const fs::path& path) {
   const std::string bytes = read_file(path);
   // A particle file is ours (little-endian by its format, docs/body-format.md) or made by hand: a
   // header keyword this reader does not know is a mistake to report, not an exporter's habit.
-  const ply::HeaderRules rules{.big_endian = false, .unknown_lines = false};
+  const ply::HeaderRules rules{.big_endian = false, .unknown_lines = false, .lines_between_properties = true};
   const ply::Header header = ply::parse_header(path, bytes, rules);
   ply::DataReader data(path, bytes, header);
   for (const ply::Element& element : header.elements) {

@@ -4,6 +4,7 @@
 // --particles` reads from any PLY of points.
 #include <Eigen/Core>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace ts::body {
@@ -13,8 +14,12 @@ struct ParticlesPly {
   std::vector<Eigen::Vector3f> normals;    // one per position, or empty when the file has no nx ny nz
 };
 
-// Binary little-endian PLY, float x y z (and nx ny nz when `normals` is not empty; then it must match
-// `positions` in size), written atomically.
+// The bytes of a binary little-endian PLY, float x y z (and nx ny nz when `normals` is not empty;
+// then it must match `positions` in size).
+std::string particles_ply_bytes(const std::vector<Eigen::Vector3f>& positions,
+                                const std::vector<Eigen::Vector3f>& normals);
+
+// particles_ply_bytes written atomically to `path`.
 void write_particles_ply(const std::filesystem::path& path, const std::vector<Eigen::Vector3f>& positions,
                          const std::vector<Eigen::Vector3f>& normals);
 

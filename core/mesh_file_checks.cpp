@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -108,30 +109,94 @@ void check_off_file(const std::filesystem::path& path, std::string_view text) {
 
 namespace {
 
-bool is_vertex_index_list(const ply::Element& element, const ply::Property& property) {
-  return element.name == "face" && property.is_list() &&
-         (property.name == "vertex_indices" || property.name == "vertex_index");
+// The elements assimp gives a meaning to, by name: positions, polygons and triangle strips, whose
+// corner lists are named vertex_indices or vertex_index.
+bool is_vertex_index_name(const std::string& name) {
+  return name == "vertex_indices" || name == "vertex_index";
+}
+bool has_corner_lists(const ply::Element& element) {
+  return element.name == "face" || element.name == "tristrips";
+}
+
+// What assimp makes of the header is what was checked: one vertex element with scalar x, y and z
+// (assimp reads a missing one as 0), one face element, corner lists that are lists.
+void check_ply_layout(const std::filesystem::path& path, const ply::Header& header) {
+  std::vector<std::string> seen;
+  for (const ply::Element& element : header.elements) {
+    if ((element.name == "vertex" || has_corner_lists(element)) &&
+        std::find(seen.begin(), seen.end(), element.name) != seen.end()) {
+      throw InputError(path, fmt::format("the PLY header declares element '{}' twice", element.name));
+    }
+    seen.push_back(element.name);
+    if (element.name == "vertex") {
+      for (const char* axis : {"x", "y", "z"}) {
+        if (!element.scalar_property(axis)) {
+          throw InputError(
+              path,
+              fmt::format("the vertex element has no scalar property {} (a mesh needs x, y and z)", axis));
+        }
+      }
+    }
+    if (!has_corner_lists(element)) continue;
+    const auto corners = std::find_if(element.properties.begin(), element.properties.end(),
+                                      [](const ply::Property& p) { return is_vertex_index_name(p.name); });
+    if (element.count > 0 && (corners == element.properties.end() || !corners->is_list())) {
+      throw InputError(path, fmt::format("element '{}' has no list property vertex_indices", element.name));
+    }
+  }
+}
+
+// One corner of row `row` of a face or tristrips element: a vertex index (a strip may also hold -1,
+// its restart marker).
+void check_corner(const std::filesystem::path& path, const ply::DataReader& reader,
+                  const ply::Element& element, std::uint64_t row, double index, std::int64_t vertex_count) {
+  const bool restart = element.name == "tristrips" && index == -1.0;
+  if (restart || (index >= 0 && index < static_cast<double>(vertex_count) && index == std::floor(index)))
+    return;
+  throw InputError(path, fmt::format("{}{} {} refers to vertex {}, outside 0..{}",
+                                     reader.line() ? fmt::format("line {}: ", reader.line()) : "",
+                                     element.name, row, index, vertex_count - 1));
+}
+
+// A face has three corners or more (assimp's triangulation aborts the process on a face without
+// any); an ascii row is one line, as assimp reads it (a row spread over lines, or two on one line,
+// would be misread).
+void check_row_shape(const std::filesystem::path& path, const ply::DataReader& reader,
+                     const ply::Element& element, std::uint64_t row, double corners, std::size_t& last_line) {
+  if (element.name == "face" && corners < 3) {
+    throw InputError(path,
+                     fmt::format("{}face {} has {} corners; a face needs at least 3",
+                                 reader.line() ? fmt::format("line {}: ", reader.line()) : "", row, corners));
+  }
+  if (reader.row_line() == 0) return;  // binary data
+  if (reader.row_line() <= last_line || reader.line() != reader.row_line()) {
+    throw InputError(path,
+                     fmt::format("line {}: '{}' {} does not stand on a line of its own (one row per line, as "
+                                 "the PLY format and assimp want it)",
+                                 reader.row_line(), element.name, row));
+  }
+  last_line = reader.line();
 }
 
 // Reads every row of every element, as assimp will: truncation, list lengths and (in ascii data)
-// numbers are checked by the reader, face corners here.
+// numbers are checked by the reader, the rows' shapes and the corners here.
 void check_ply_data(const std::filesystem::path& path, std::string_view bytes, const ply::Header& header) {
   std::int64_t vertex_count = 0;
   for (const auto& e : header.elements)
     if (e.name == "vertex") vertex_count = static_cast<std::int64_t>(e.count);
   ply::DataReader reader(path, bytes, header);
+  std::size_t last_line = 0;
   for (const ply::Element& element : header.elements) {
     if (element.properties.empty()) continue;  // its rows hold no data
+    std::optional<std::size_t> corners;
+    for (std::size_t p = 0; p < element.properties.size(); ++p)
+      if (has_corner_lists(element) && is_vertex_index_name(element.properties[p].name)) corners = p;
     std::vector<double> values(element.properties.size());
     for (std::uint64_t i = 0; i < element.count; ++i) {
       reader.read_row(element, i, values, [&](std::size_t p, double index) {
-        if (is_vertex_index_list(element, element.properties[p]) &&
-            !(index >= 0 && index < static_cast<double>(vertex_count))) {
-          throw InputError(path, fmt::format("{}face {} refers to vertex {}, outside 0..{}",
-                                             reader.line() ? fmt::format("line {}: ", reader.line()) : "", i, index,
-                                             vertex_count - 1));
-        }
+        if (p == corners) check_corner(path, reader, element, i, index, vertex_count);
       });
+      check_row_shape(path, reader, element, i, corners ? values[*corners] : 3.0, last_line);
     }
   }
 }
@@ -140,8 +205,11 @@ void check_ply_data(const std::filesystem::path& path, std::string_view bytes, c
 
 void check_ply_file(const std::filesystem::path& path, std::string_view bytes) {
   // Unknown header lines are skipped, as assimp does (exporters wrap long comments onto lines of
-  // their own), and big-endian files are read like the others: ply::HeaderRules' defaults.
-  check_ply_data(path, bytes, ply::parse_header(path, bytes));
+  // their own), but not between an element's properties, where assimp would misread the data; and
+  // big-endian files are read like the others: ply::HeaderRules' defaults.
+  const ply::Header header = ply::parse_header(path, bytes);
+  check_ply_layout(path, header);
+  check_ply_data(path, bytes, header);
 }
 
 }  // namespace ts::detail

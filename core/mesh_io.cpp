@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -55,9 +57,99 @@ struct PositionHash {
     return h;
   }
 };
+// Equal positions, and non-finite ones with the same bits: a NaN vertex that a file's faces share is
+// one vertex (assimp's OBJ reader copies it for every corner), counted once.
 struct PositionEqual {
-  bool operator()(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const { return a == b; }
+  bool operator()(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+    return a == b || std::memcmp(a.data(), b.data(), 3 * sizeof(double)) == 0;
+  }
 };
+
+std::string vertices_phrase(std::size_t count) {
+  return count == 1 ? "1 vertex has" : fmt::format("{} vertices have", count);
+}
+
+// What assimp's post-processing trusts about an imported scene without checking it, checked: an
+// index past a mesh's vertices is read out of bounds, a face without corners trips
+// TriangulateProcess's assertion (the process aborts), and non-finite positions reach its ear
+// clipping. Positions are counted once per distinct value.
+void check_mesh_before_post_processing(
+    const fs::path& path, const aiMesh& mesh, unsigned index,
+    std::unordered_set<Eigen::Vector3d, PositionHash, PositionEqual>& non_finite) {
+  const std::string which =
+      fmt::format("mesh {}{}", index, mesh.mName.length ? fmt::format(" ('{}')", mesh.mName.C_Str()) : "");
+  if ((mesh.mNumVertices > 0 && !mesh.mVertices) || (mesh.mNumFaces > 0 && !mesh.mFaces)) {
+    throw InputError(path, which + " has no vertex or face data");
+  }
+  for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+    const aiVector3D& p = mesh.mVertices[v];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) non_finite.emplace(p.x, p.y, p.z);
+  }
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+    const aiFace& face = mesh.mFaces[f];
+    if (face.mNumIndices == 0 || !face.mIndices)
+      throw InputError(path, fmt::format("{}: face {} has no corners", which, f));
+    for (unsigned c = 0; c < face.mNumIndices; ++c) {
+      if (face.mIndices[c] >= mesh.mNumVertices) {
+        throw InputError(path, fmt::format("{}: face {} refers to vertex {}, outside 0..{}", which, f,
+                                           face.mIndices[c], static_cast<long long>(mesh.mNumVertices) - 1));
+      }
+    }
+  }
+}
+
+// Nodes name meshes that exist, and the graph is a tree of bounded depth (the flattening recurses).
+void check_nodes(const fs::path& path, const aiScene& scene, const aiNode& node, unsigned depth) {
+  constexpr unsigned kMaxDepth = 1000;
+  if (depth > kMaxDepth)
+    throw InputError(path, fmt::format("the node hierarchy is deeper than {} levels", kMaxDepth));
+  for (unsigned k = 0; k < node.mNumMeshes; ++k) {
+    if (!node.mMeshes || node.mMeshes[k] >= scene.mNumMeshes) {
+      throw InputError(path,
+                       fmt::format("node '{}' refers to a mesh that does not exist", node.mName.C_Str()));
+    }
+  }
+  for (unsigned c = 0; c < node.mNumChildren; ++c) {
+    if (!node.mChildren || !node.mChildren[c])
+      throw InputError(path, fmt::format("node '{}' has a missing child", node.mName.C_Str()));
+    check_nodes(path, scene, *node.mChildren[c], depth + 1);
+  }
+}
+
+void check_scene_before_post_processing(const fs::path& path, const aiScene& scene) {
+  if (scene.mNumMeshes > 0 && !scene.mMeshes) throw InputError(path, "the file's meshes are missing");
+  std::unordered_set<Eigen::Vector3d, PositionHash, PositionEqual> non_finite;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    if (!scene.mMeshes[m]) throw InputError(path, fmt::format("mesh {} is missing", m));
+    check_mesh_before_post_processing(path, *scene.mMeshes[m], m, non_finite);
+  }
+  if (!non_finite.empty()) {
+    throw InputError(
+        path, fmt::format("{} non-finite coordinates (NaN or infinity)", vertices_phrase(non_finite.size())));
+  }
+  if (!scene.mRootNode) throw InputError(path, "the file holds no scene graph");
+  check_nodes(path, scene, *scene.mRootNode, 0);
+}
+
+// The primitive types of each mesh as its faces are. Importers set or leave them; TriangulateProcess
+// asserts that a mesh flagged as holding polygons has one, so they are recomputed from the faces
+// (checked above: each has one corner or more).
+void set_primitive_types_from_faces(const aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    // The scene is the importer's own, not a const object: assimp hands it out read-only only
+    // because its post-processing steps are meant to be the ones to change it.
+    aiMesh& mesh = *const_cast<aiMesh*>(scene.mMeshes[m]);
+    unsigned types = 0;
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const unsigned n = mesh.mFaces[f].mNumIndices;
+      types |= n == 1   ? aiPrimitiveType_POINT
+               : n == 2 ? aiPrimitiveType_LINE
+               : n == 3 ? aiPrimitiveType_TRIANGLE
+                        : aiPrimitiveType_POLYGON;
+    }
+    mesh.mPrimitiveTypes = types;
+  }
+}
 
 struct Flattener {
   const aiScene* scene;
@@ -67,7 +159,10 @@ struct Flattener {
 
   std::uint32_t vertex_index(const Eigen::Vector3d& p) {
     auto [it, inserted] = welded.try_emplace(p, static_cast<std::uint32_t>(mesh.vertices.size()));
-    if (inserted) mesh.vertices.push_back(p);
+    if (inserted) {
+      mesh.vertices.push_back(p);
+      if (!p.allFinite()) ++non_finite;  // a finite position beyond double's range after its transform
+    }
     return it->second;
   }
 
@@ -86,9 +181,7 @@ struct Flattener {
     for (unsigned v = 0; v < source.mNumVertices; ++v) {
       const aiVector3D& p = source.mVertices[v];
       const Eigen::Vector4d x = transform * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
-      const Eigen::Vector3d position = x.head<3>() / x.w();
-      if (!position.allFinite()) ++non_finite;
-      remap[v] = vertex_index(position);
+      remap[v] = vertex_index(x.head<3>() / x.w());
     }
     // A mirroring transform (negative determinant) flips the winding; restore outward orientation.
     const bool mirrored = transform.topLeftCorner<3, 3>().determinant() < 0.0;
@@ -105,29 +198,42 @@ struct Flattener {
   }
 };
 
+[[noreturn]] void import_failed(const fs::path& path, const std::string& reason) {
+  if (reason.find("No suitable reader") != std::string::npos) {
+    throw InputError(path, "unknown or unsupported mesh format (assimp: " + reason + ")");
+  }
+  throw InputError(path, "cannot be read as a mesh: " + reason);
+}
+
+// The file as assimp reads it, checked, then with polygons triangulated.
+const aiScene& import_scene(const fs::path& path, Assimp::Importer& importer) {
+  // No post-processing while reading: the scene is checked first (check_scene_before_post_processing).
+  const aiScene* scene = importer.ReadFile(path.string(), 0);
+  if (!scene) import_failed(path, importer.GetErrorString());
+  check_scene_before_post_processing(path, *scene);
+  set_primitive_types_from_faces(*scene);
+  // Triangulate polygons; keep positions as they are (no normal generation, no vertex merging that
+  // depends on normals or texture coordinates: welding by position is done below). No SortByPType:
+  // points and lines are skipped face by face below, and that step turns an STL solid without
+  // facets into the baffling "Mesh with invalid primitive type" instead of an empty mesh.
+  scene = importer.ApplyPostProcessing(aiProcess_Triangulate);
+  if (!scene) import_failed(path, importer.GetErrorString());
+  return *scene;
+}
+
 }  // namespace
 
 TriangleMesh load_mesh(const fs::path& path) {
   check_readable_file(path);
   check_before_assimp(path);
   Assimp::Importer importer;
-  // Triangulate polygons; keep positions as they are (no normal generation, no vertex merging that
-  // depends on normals or texture coordinates: welding by position is done below). No SortByPType:
-  // points and lines are skipped face by face below, and that step turns an STL solid without
-  // facets into the baffling "Mesh with invalid primitive type" instead of an empty mesh.
-  const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate);
-  if (!scene) {
-    const std::string reason = importer.GetErrorString();
-    if (reason.find("No suitable reader") != std::string::npos) {
-      throw InputError(path, "unknown or unsupported mesh format (assimp: " + reason + ")");
-    }
-    throw InputError(path, "cannot be read as a mesh: " + reason);
-  }
-  if (!scene->mRootNode) throw InputError(path, "the file holds no scene graph");
-  Flattener flat{scene, {}, {}, 0, 0};
-  flat.visit(scene->mRootNode, Eigen::Matrix4d::Identity());
+  const aiScene& scene = import_scene(path, importer);
+  Flattener flat{&scene, {}, {}, 0, 0};
+  flat.visit(scene.mRootNode, Eigen::Matrix4d::Identity());
   if (flat.non_finite > 0) {
-    throw InputError(path, fmt::format("{} vertices have non-finite coordinates (NaN or infinity)", flat.non_finite));
+    throw InputError(
+        path, fmt::format("{} non-finite coordinates after the node transforms (beyond double's range)",
+                          vertices_phrase(flat.non_finite)));
   }
   if (flat.mesh.triangles.empty()) {
     throw InputError(path, flat.points_and_lines > 0 || !flat.mesh.vertices.empty()

@@ -166,9 +166,15 @@ MeshReport analyze_mesh(const TriangleMesh& mesh, const ReportOptions& options) 
   }
 
   // A vertex is manifold when its triangles form one fan: link them through shared edges at v.
+  // A triangle that repeats a vertex (degenerate, counted as such) is in that vertex's fan once.
   std::vector<std::vector<std::uint32_t>> around(mesh.vertex_count());
-  for (std::uint32_t f = 0; f < mesh.triangle_count(); ++f)
-    for (auto v : mesh.triangles[f]) around[v].push_back(f);
+  for (std::uint32_t f = 0; f < mesh.triangle_count(); ++f) {
+    const auto& t = mesh.triangles[f];
+    for (int c = 0; c < 3; ++c) {
+      if ((c > 0 && t[c] == t[0]) || (c == 2 && t[2] == t[1])) continue;
+      around[t[c]].push_back(f);
+    }
+  }
   for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
     const auto& faces = around[v];
     if (faces.size() < 2) continue;
@@ -187,7 +193,7 @@ MeshReport analyze_mesh(const TriangleMesh& mesh, const ReportOptions& options) 
   }
 
   // Euler: chi = V - E + F = sum over components of (2 - 2 g). Unused vertices are not part of it.
-  if (r.closed() && r.manifold() && r.components > 0) {
+  if (r.closed() && r.manifold() && r.components > 0 && r.degenerate_triangles < r.triangles) {
     const auto used_vertices = static_cast<long long>(std::count(used.begin(), used.end(), 1));
     const long long chi = used_vertices - static_cast<long long>(edges.size()) + static_cast<long long>(r.triangles);
     r.genus = static_cast<int>((2 * static_cast<long long>(r.components) - chi) / 2);
@@ -200,6 +206,17 @@ MeshReport analyze_mesh(const TriangleMesh& mesh, const ReportOptions& options) 
   return r;
 }
 
+namespace {
+
+std::string no_volume(const MeshReport& r) {
+  if (r.degenerate_triangles == r.triangles) {
+    return fmt::format("encloses no volume: all {} triangles are degenerate (zero area)", r.triangles);
+  }
+  return "encloses no volume (zero volume: flat or folded onto itself)";
+}
+
+}  // namespace
+
 std::string closed_solid_problems(const MeshReport& r) {
   std::vector<std::string> problems;
   if (r.non_finite_vertices) problems.push_back(fmt::format("{} non-finite vertices", r.non_finite_vertices));
@@ -208,7 +225,11 @@ std::string closed_solid_problems(const MeshReport& r) {
   if (r.non_manifold_vertices) problems.push_back(fmt::format("{} non-manifold vertices", r.non_manifold_vertices));
   if (r.inconsistent_edges) problems.push_back(fmt::format("{} inconsistently oriented edges", r.inconsistent_edges));
   if (r.self_intersecting_pairs) problems.push_back(fmt::format("{} self-intersecting triangle pairs", r.self_intersecting_pairs));
-  if (r.closed() && r.signed_volume <= 0) problems.push_back("inside out (negative volume)");
+  if (encloses_no_volume(r)) {
+    problems.push_back(no_volume(r));
+  } else if (is_inside_out(r)) {
+    problems.push_back("inside out (negative volume)");
+  }
   std::string out;
   for (const auto& p : problems) out += (out.empty() ? "" : ", ") + p;
   return out;
@@ -224,7 +245,9 @@ std::string format_report(const MeshReport& r) {
                    r.box.min.y(), r.box.min.z(), r.box.max.x(), r.box.max.y(), r.box.max.z());
   s += fmt::format("area                  {:.9g} m^2\n", r.area);
   s += fmt::format("signed volume         {:.9g} m^3{}\n", r.signed_volume,
-                   r.closed() && r.signed_volume <= 0 ? "  <-- inside out" : "");
+                   encloses_no_volume(r) ? "  <-- encloses no volume"
+                   : is_inside_out(r)    ? "  <-- inside out"
+                                         : "");
   s += fmt::format("non-finite vertices   {}{}\n", r.non_finite_vertices, flag(r.non_finite_vertices));
   s += fmt::format("degenerate triangles  {}{}\n", r.degenerate_triangles, flag(r.degenerate_triangles));
   s += fmt::format("duplicate triangles   {}{}\n", r.duplicate_triangles, flag(r.duplicate_triangles));

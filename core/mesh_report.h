@@ -3,6 +3,7 @@
 // use to refuse or warn. Topology is computed on the welded, indexed mesh.
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <string>
 
 #include "core/mesh.h"
@@ -25,7 +26,7 @@ struct MeshReport {
   double area = 0;                         // m^2
   double signed_volume = 0;                // m^3; negative: inside out
   Aabb box;
-  int genus = -1;                          // closed manifold: summed over components; else -1
+  int genus = -1;  // closed manifold, not all degenerate: summed over components; else -1
 
   bool closed() const { return boundary_edges == 0 && non_manifold_edges == 0; }
   bool manifold() const { return non_manifold_edges == 0 && non_manifold_vertices == 0; }
@@ -49,6 +50,17 @@ inline bool encloses_volume(const MeshReport& r) {
   const double size = r.box.valid() ? r.box.size().maxCoeff() : 0.0;
   return r.closed() && r.inconsistent_edges == 0 && r.non_finite_vertices == 0 &&
          r.signed_volume > 1e-12 * size * size * size;
+}
+
+// Closed, with a volume that is zero up to rounding (encloses_volume's threshold): every triangle
+// degenerate (a point set, or lines), or flat. Such a mesh is neither a solid nor inside out.
+inline bool encloses_no_volume(const MeshReport& r) {
+  const double size = r.box.valid() ? r.box.size().maxCoeff() : 0.0;
+  return r.closed() && !(std::abs(r.signed_volume) > 1e-12 * size * size * size);
+}
+// Closed and of negative volume beyond rounding: the triangles face inward.
+inline bool is_inside_out(const MeshReport& r) {
+  return r.closed() && r.signed_volume < 0 && !encloses_no_volume(r);
 }
 
 MeshReport analyze_mesh(const TriangleMesh& mesh, const ReportOptions& options = {});

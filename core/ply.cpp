@@ -48,7 +48,7 @@ class HeaderParser {
     bool ended = false;
     while (pos_ < bytes_.size() && !ended) {
       words = next_line();
-      if (words.empty() || words[0] == "comment" || words[0] == "obj_info") continue;
+      if (words.empty()) continue;
       ended = words[0] == "end_header";
       if (!ended) keyword_line(words);
     }
@@ -64,6 +64,7 @@ class HeaderParser {
   std::vector<std::string_view> next_line() {
     const std::size_t end = std::min(bytes_.find('\n', pos_), bytes_.size());
     line_ = bytes_.substr(pos_, end - pos_);
+    if (line_.ends_with('\r')) line_.remove_suffix(1);
     pos_ = end + 1;
     ++line_number_;
     std::vector<std::string_view> words;
@@ -73,12 +74,22 @@ class HeaderParser {
   }
 
   void keyword_line(const std::vector<std::string_view>& w) {
+    if (w[0] == "element") {
+      element_line(w);
+      return;
+    }
+    if (w[0] == "property") {
+      property_line(w);
+      return;
+    }
+    // Any other line inside an element ends its property list for assimp (HeaderRules).
+    if (!header_.elements.empty() && other_line_number_ == 0) {
+      other_line_number_ = line_number_;
+      other_line_ = line_;
+    }
+    if (w[0] == "comment" || w[0] == "obj_info") return;
     if (w[0] == "format" && (w.size() >= 2 || !rules_.unknown_lines)) {
       format_line(w);
-    } else if (w[0] == "element") {
-      element_line(w);
-    } else if (w[0] == "property") {
-      property_line(w);
     } else if (!rules_.unknown_lines) {
       fail(fmt::format("unknown PLY header keyword '{}'", w[0]));
     }
@@ -108,11 +119,18 @@ class HeaderParser {
     const auto count = detail::parse_integer(w[2]);
     if (!count || *count < 0) fail(fmt::format("element '{}' has an invalid count '{}'", w[1], w[2]));
     header_.elements.push_back({std::string(w[1]), static_cast<std::uint64_t>(*count), {}});
+    other_line_number_ = 0;
   }
 
   // "property TYPE NAME" or "property list LENGTH_TYPE ITEM_TYPE NAME".
   void property_line(const std::vector<std::string_view>& w) {
     if (header_.elements.empty()) malformed("property before any element");
+    if (other_line_number_ != 0 && !rules_.lines_between_properties) {
+      fail(fmt::format(
+          "'{}' follows line {} ('{}') inside element '{}': assimp ends an element's properties at "
+          "the first other line and would misread the data; move that line above the element line",
+          line_, other_line_number_, other_line_, header_.elements.back().name));
+    }
     const bool list = w.size() == 5 && w[1] == "list";
     if (!list && w.size() != 3) malformed("");
     Property p{std::string(w.back()), Scalar::Float32, std::nullopt};
@@ -140,6 +158,8 @@ class HeaderParser {
   std::size_t pos_ = 0;          // bytes: the start of the next line
   std::size_t line_number_ = 0;  // of line_
   std::string_view line_;
+  std::size_t other_line_number_ = 0;  // the first line since the last element line that is not a property
+  std::string_view other_line_;
   bool has_format_ = false;
   Header header_;
 };
@@ -176,6 +196,7 @@ DataReader::DataReader(const fs::path& file, std::string_view bytes, const Heade
 void DataReader::read_row(const Element& element, std::uint64_t row, std::span<double> values,
                           const ListItems& items) {
   assert(values.size() >= element.properties.size());
+  row_line_ = 0;
   for (std::size_t p = 0; p < element.properties.size(); ++p) {
     const Property& property = element.properties[p];
     if (!property.is_list()) {
@@ -244,6 +265,7 @@ std::optional<double> DataReader::next_binary(Scalar type) {
 std::optional<double> DataReader::next_ascii() {
   const auto token = tokens_.next();
   if (!token) return std::nullopt;
+  if (row_line_ == 0) row_line_ = tokens_.line();
   const auto value = detail::parse_number(*token);
   if (!value)
     throw InputError(file_, fmt::format("line {}: \"{}\" in the PLY data is not a number", line(), *token));

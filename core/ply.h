@@ -54,13 +54,20 @@ struct Header {
 };
 
 // What a header may hold besides the PLY essentials (a first line "ply", a format line, element and
-// property lines, comment and obj_info lines, end_header). The defaults accept what assimp accepts.
+// property lines, comment and obj_info lines, end_header). The defaults accept what assimp reads as
+// this parser does, and nothing it would read differently.
 struct HeaderRules {
   // binary_big_endian data (the reader converts it on any host); false: such a file is an error.
   bool big_endian = true;
   // Lines with another keyword, and format lines other than "format ENCODING 1.0", are skipped, as
   // assimp does (exporters wrap long comments onto lines of their own); false: they are errors.
   bool unknown_lines = true;
+  // Lines other than property lines (comment, obj_info, unknown) between the properties of one
+  // element; false: a property line after such a line is an error. Assimp ends an element's
+  // property list at the first line that is not a property and skips the properties after it, so
+  // it would read the data with fewer columns than it has: y and z as 0 in ascii data, a crash on
+  // binary data. Lines before an element's first property count too; blank lines are harmless.
+  bool lines_between_properties = false;
 };
 
 // Parses the header of the PLY file `bytes` (the whole file; `file` names it in messages).
@@ -88,6 +95,9 @@ class DataReader {
 
   // The line of the value last read in ascii data; 0 in binary data.
   std::size_t line() const;
+  // The line of the first value of the row last read by read_row, in ascii data; 0 in binary data
+  // and for a row without values.
+  std::size_t row_line() const { return row_line_; }
   // Bytes of data after the current position.
   std::size_t remaining_bytes() const;
 
@@ -103,6 +113,7 @@ class DataReader {
   Encoding encoding_;
   std::size_t pos_;        // binary: bytes into the file
   detail::Tokens tokens_;  // ascii
+  std::size_t row_line_ = 0;
 };
 
 }  // namespace ts::ply

@@ -59,8 +59,20 @@ Sizing size_particles(double area, const SampleSettings& s) {
   return out;
 }
 
+// The particles are floats, on the GPU and in the PLY, and the relaxation compares squared steps down
+// to 1e-4 of the radius: (1e-4 r)^2 must stay a normal float, so r >= sqrt(FLT_MIN) / 1e-4, about
+// 1.1e-15 m. A body that small is a mesh in the wrong units, not a particle body.
+const double kSmallestRadius = std::sqrt(static_cast<double>(std::numeric_limits<float>::min())) / 1e-4;
+
 void check_sizes(const Sizing& z, const SampleSettings& s, double area) {
   if (!(s.coverage > 0.0)) throw InputError(fmt::format("--coverage must be positive (got {})", s.coverage));
+  if (!(z.radius >= kSmallestRadius)) {
+    throw InputError(
+        fmt::format("particle radius {:.3g} m is below {:.2g} m, the smallest the sampler's float "
+                    "arithmetic resolves (the mesh is {:.3g} m^2 in area): is the mesh in the wrong "
+                    "units? --scale multiplies its coordinates",
+                    z.radius, kSmallestRadius, area));
+  }
   if (z.count < 8) {
     throw InputError(fmt::format("particle radius {:.4g} m is too large for this mesh (area {:.4g} m^2): it would "
                                  "hold only {} particles; use a radius below {:.4g} m",

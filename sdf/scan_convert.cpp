@@ -192,9 +192,10 @@ struct SlabTarget {
 
 openvdb::FloatGrid::Ptr make_level_set(const GridSpec& spec, float band, bool index_space) {
   if (!index_space && !(spec.voxel_size >= kMinVdbVoxelSize)) {
-    throw InputError("voxel size " + std::to_string(spec.voxel_size) +
-                     " is below the smallest OpenVDB can store (1.3e-5 world units); scale the mesh to smaller "
-                     "units (e.g. --scale 1000 for millimetres)");
+    throw InputError(
+        fmt::format("voxel size {:.3g} is below the smallest OpenVDB can store (1.3e-5 world units); "
+                    "scale the mesh to smaller units (e.g. --scale 1000 for millimetres)",
+                    spec.voxel_size));
   }
   auto grid = openvdb::FloatGrid::create(band * static_cast<float>(spec.voxel_size));
   // An index-space grid (voxel size 1, values still in world units) holds any voxel size: the GPU

@@ -1,11 +1,32 @@
 #include "sdf/vdb_io.h"
 
+#include <fmt/format.h>
+
 #include <mutex>
+#include <new>
+#include <stdexcept>
+#include <string>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 
 namespace ts::sdf {
+namespace {
+
+// OpenVDB's message about a broken file, fit for one line: it quotes what it read (a type name of
+// 64 kB from a fuzzed file), so it is cut at 200 characters and its control bytes escaped.
+std::string openvdb_problem(const std::string& message) {
+  constexpr std::size_t kMost = 200;
+  std::string out;
+  for (const char c : message.substr(0, kMost)) {
+    const auto byte = static_cast<unsigned char>(c);
+    out += byte < 0x20 || byte >= 0x7f ? fmt::format("\\x{:02x}", byte) : std::string(1, c);
+  }
+  if (message.size() > kMost) out += fmt::format("... ({} characters)", message.size());
+  return out;
+}
+
+}  // namespace
 
 void ensure_openvdb_initialized() {
   static std::once_flag once;
@@ -13,16 +34,21 @@ void ensure_openvdb_initialized() {
 }
 
 void write_vdb(const std::filesystem::path& path, const openvdb::FloatGrid::Ptr& grid,
-               const std::map<std::string, std::string>& metadata, const std::vector<std::filesystem::path>& inputs) {
+               const std::map<std::string, std::string>& metadata,
+               const std::vector<std::filesystem::path>& inputs) {
   ensure_openvdb_initialized();
   for (const auto& [key, value] : metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
   write_atomically(
       path,
       [&](const std::filesystem::path& tmp) {
-        openvdb::io::File file(tmp.string());
-        openvdb::GridPtrVec grids{grid};
-        file.write(grids);
-        file.close();
+        try {
+          openvdb::io::File file(tmp.string());
+          openvdb::GridPtrVec grids{grid};
+          file.write(grids);
+          file.close();
+        } catch (const openvdb::IoError& e) {  // the place is not writable (permission, space)
+          throw InputError(path, std::string("cannot write file (") + e.what() + ")");
+        }
       },
       inputs);
 }
@@ -39,7 +65,11 @@ openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path) {
     grids = file.getGrids();
     file.close();
   } catch (const openvdb::Exception& e) {
-    throw InputError(path, std::string("is not a readable OpenVDB file (") + e.what() + ")");
+    throw InputError(path, "is not a readable OpenVDB file (" + openvdb_problem(e.what()) + ")");
+  } catch (const std::bad_alloc&) {  // a size in the file beyond memory
+    throw InputError(path, "is not a readable OpenVDB file (a size in it is beyond this machine's memory)");
+  } catch (const std::length_error&) {
+    throw InputError(path, "is not a readable OpenVDB file (a size in it is beyond any string or array)");
   }
   bool any_float = false;
   for (const auto& base : *grids) {
@@ -47,7 +77,8 @@ openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path) {
     if (!grid) continue;
     any_float = true;
     if (grid->getGridClass() != openvdb::GRID_LEVEL_SET) continue;
-    if (grid->activeVoxelCount() == 0) throw InputError(path, "its level set '" + grid->getName() + "' is empty");
+    if (grid->activeVoxelCount() == 0)
+      throw InputError(path, "its level set '" + grid->getName() + "' is empty");
     return grid;
   }
   throw InputError(path, any_float ? "holds float grids but none is a level set (class fog volume or unknown)"

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/mass_properties.h"
 #include "sampler/surface_points.h"
+#include "tests/body/test_bodies.h"
 #include "tests/input_error.h"
 #include "tests/test_meshes.h"
 #include "tests/test_support.h"
@@ -46,21 +47,7 @@ ParticleBody box_body() {
     body.positions.push_back(points.positions[i].cast<float>());
     body.normals.push_back(points.normals[i].cast<float>());
   }
-  body.particle_radius = 0.05;
-  body.sdf_voxel_size = 0.0125;
-  body.source_path = "meshes/box.obj";
-  body.source_sha256 = std::string(64, 'a');
-  body.quality = {0.81,
-                  0.035,
-                  0.047,
-                  0.94,
-                  0.47 / 1.5,
-                  0.02,
-                  1234,
-                  1.75,
-                  true,
-                  2,
-                  ParticleBody::Quality::Certificate{false, 1.07, 1.02, 12, 3e-4, 0.05 / 64.0}};
+  test::set_sampling_keys(body, 0.05);
   return body;
 }
 

@@ -70,6 +70,27 @@ TEST(MeshReport, CountsComponentsAndDegenerateTriangles) {
   EXPECT_EQ(r.degenerate_triangles, 1u);
 }
 
+TEST(MeshReport, ThreeIdenticalPointsAreDegenerateNotInsideOut) {
+  TriangleMesh points;
+  points.vertices = {{1, 1, 1}};
+  points.triangles = {{0, 0, 0}};
+  const MeshReport r = analyze_mesh(points);
+  EXPECT_EQ(r.degenerate_triangles, 1u);
+  EXPECT_EQ(r.non_manifold_vertices, 0u);  // one degenerate triangle is no fan of two
+  EXPECT_TRUE(encloses_no_volume(r));
+  EXPECT_FALSE(is_inside_out(r));
+  EXPECT_EQ(closed_solid_problems(r), "encloses no volume: all 1 triangles are degenerate (zero area)");
+  const std::string text = format_report(r);
+  EXPECT_EQ(text.find("inside out"), std::string::npos) << text;
+  EXPECT_NE(text.find("0 m^3  <-- encloses no volume"), std::string::npos) << text;
+  // A box turned inside out still is.
+  TriangleMesh flipped = make_box({0, 0, 0}, {1, 1, 1});
+  for (auto& t : flipped.triangles) std::swap(t[1], t[2]);
+  const MeshReport rf = analyze_mesh(flipped);
+  EXPECT_TRUE(is_inside_out(rf));
+  EXPECT_EQ(closed_solid_problems(rf), "inside out (negative volume)");
+}
+
 TEST(MeshReport, FindsASelfIntersectingPair) {
   TriangleMesh m = make_box({0, 0, 0}, {1, 1, 1});
   const TriangleMesh inner = make_box({0.5, 0.5, 0.5}, {1.5, 1.5, 1.5});  // overlapping second box

@@ -238,6 +238,27 @@ TEST(Ply, StrictRulesRejectWhatTheDefaultsSkip) {
             std::string::npos);
 }
 
+TEST(Ply, LinesBetweenAnElementsPropertiesAreErrorsUnlessAllowed) {
+  // Assimp ends the vertex element's properties at the comment and drops y: the default refuses.
+  const std::string text =
+      "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\ncomment c\nproperty float "
+      "y\n\nend_header\n";
+  EXPECT_EQ(
+      input_error([&] { parse_header(kFile, text); }),
+      "test.ply: line 6: 'property float y' follows line 5 ('comment c') inside element 'vertex': assimp "
+      "ends "
+      "an element's properties at the first other line and would misread the data; move that line above the "
+      "element line");
+  const HeaderRules own_reader{.lines_between_properties = true};
+  EXPECT_EQ(parse_header(kFile, text, own_reader).elements[0].properties.size(), 2u);
+  // Blank lines, and any line after the last property or outside elements, are harmless.
+  const std::string fine =
+      "ply\nformat ascii 1.0\ncomment top\nelement vertex 0\nproperty float x\n\nproperty float y\ncomment "
+      "end\n"
+      "element face 0\nproperty list uchar int vertex_indices\nend_header\n";
+  EXPECT_EQ(parse_header(kFile, fine).elements.size(), 2u);
+}
+
 TEST(Ply, HeaderErrorsNameTheFileAndTheLine) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"", "test.ply: line 1: not a PLY file: it must start with the line 'ply'"},

@@ -105,5 +105,21 @@ TEST(VdbIo, BadFilesAreClearErrors) {
   EXPECT_NE(read_error(dir).find("directory"), std::string::npos);
 }
 
+// Found by fuzz_vdb (scripts/fuzz.sh): a transform type name 4 GiB long by its length field. OpenVDB
+// reserves it (libFuzzer's memory limit stopped the run) and quoted what it read, 64 kB of it, in its
+// message: the error is one short line naming the file.
+TEST(VdbIo, AFuzzedFileWithAHugeNameIsAShortError) {
+  const std::filesystem::path file =
+      std::filesystem::path(TETRASAND_SOURCE_DIR) / "tests/sdf/bad_vdb/transform-name-of-4-gib.vdb";
+  std::string message;
+  try {
+    read_level_set(file);
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  EXPECT_EQ(message.rfind(file.string() + ": is not a readable OpenVDB file (", 0), 0u) << message.substr(0, 400);
+  EXPECT_LT(message.size(), 600u) << message.substr(0, 400);
+}
+
 }  // namespace
 }  // namespace ts::sdf

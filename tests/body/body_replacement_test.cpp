@@ -1,0 +1,212 @@
+// A body is replaced only as a whole, also when its writer is killed (SIGKILL) at any moment: a
+// reader afterwards finds the old pair or the new pair, byte for byte, and nothing left behind.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <optional>
+#include <random>
+#include <thread>
+
+#include "body/body_file.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/mass_properties.h"
+#include "tests/body/test_bodies.h"
+#include "tests/input_error.h"
+#include "tests/test_meshes.h"
+#include "tests/test_support.h"
+
+namespace ts::body {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A valid 2 x 1 x 0.5 m box body of `count` particles at random places with random unit normals
+// (the writer checks mass properties and normals, not where the particles are).
+ParticleBody random_body(std::size_t count, std::uint64_t seed) {
+  ParticleBody body;
+  const TriangleMesh box = test::box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d(2.0, 1.0, 0.5));
+  set_mass_properties(body, compute_mass_properties(box, 1500.0));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (std::size_t i = 0; i < count; ++i) {
+    body.positions.emplace_back(u(rng) + 1.0f, 0.5f * u(rng) + 0.5f, 0.25f * u(rng) + 0.25f);
+    body.normals.push_back(Eigen::Vector3f(u(rng), u(rng), u(rng) + 2.0f).normalized());
+  }
+  test::set_sampling_keys(body, 0.01);
+  return body;
+}
+
+struct Pair {
+  std::string json, ply;
+  bool operator==(const Pair&) const = default;
+};
+
+Pair read_pair(const fs::path& dir) {
+  return {read_file(dir / "b.body.json"), read_file(dir / "b.particles.ply")};
+}
+
+void write_bytes(const fs::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+// Runs write_body(dir, "b", body) in a child process, SIGKILLed after `delay` (when still running;
+// none: it runs to its end).
+void write_and_kill(const fs::path& dir, const ParticleBody& body,
+                    std::optional<std::chrono::microseconds> delay) {
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    try {
+      write_body(dir, "b", body);
+    } catch (...) {
+      ::_exit(1);
+    }
+    ::_exit(0);
+  }
+  if (delay) {
+    std::this_thread::sleep_for(*delay);
+    ::kill(child, SIGKILL);
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) == 0));
+}
+
+std::size_t entries(const fs::path& dir) {
+  return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+}
+
+// Microseconds after the fork: the first hidden (temporary) file seen in `dir`, the child's exit.
+struct Window {
+  long first_file = 0;
+  long end = 0;
+};
+
+Window time_write(const fs::path& dir, const ParticleBody& body) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto since = [&] {
+    return static_cast<long>(
+        std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - start)
+            .count());
+  };
+  const pid_t child = ::fork();
+  if (child == 0) {
+    write_body(dir, "b", body);
+    ::_exit(0);
+  }
+  Window window{-1, 0};
+  int status = 0;
+  while (::waitpid(child, &status, WNOHANG) == 0) {
+    if (window.first_file < 0) {
+      for (const auto& entry : fs::directory_iterator(dir)) {
+        if (entry.path().filename().string().starts_with(".")) window.first_file = since();
+      }
+    }
+  }
+  window.end = since();
+  if (window.first_file < 0) window.first_file = 0;
+  return window;
+}
+
+TEST(BodyReplacement, AWriterKilledAtRandomLeavesTheOldPairOrTheNewOneByteForByte) {
+  const ParticleBody old_body = random_body(5000, 1);
+  const ParticleBody new_body = random_body(40000, 2);
+  const fs::path reference = test::temp_dir();
+  write_body(reference / "old", "b", old_body);
+  write_body(reference / "new", "b", new_body);
+  const Pair old_pair = read_pair(reference / "old"), new_pair = read_pair(reference / "new");
+  // When, in a child as in the trials, the first temporary file appears and when the write ends:
+  // the kills are spread over that window and a little around it.
+  const fs::path dir = test::temp_dir();
+  const Window window = time_write(dir, new_body);
+  ASSERT_EQ(read_pair(dir), new_pair);
+  constexpr int kTrials = 200;
+  std::mt19937_64 rng(20);
+  const long margin = (window.end - window.first_file) / 10;
+  std::uniform_int_distribution<long> delay(std::max(0L, window.first_file - margin), window.end + margin);
+  int old_found = 0, new_found = 0, interrupted = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    write_bytes(dir / "b.body.json", old_pair.json);
+    write_bytes(dir / "b.particles.ply", old_pair.ply);
+    write_and_kill(dir, new_body, std::chrono::microseconds(delay(rng)));
+    if (entries(dir) != 2) ++interrupted;  // temporary files or a journal were left behind
+    const ParticleBody read = read_body(dir / "b.body.json");  // completes or removes what was left
+    const Pair found = read_pair(dir);
+    if (found == old_pair) ++old_found;
+    if (found == new_pair) ++new_found;
+    ASSERT_TRUE(found == old_pair || found == new_pair) << "trial " << trial << ": a mixed pair";
+    EXPECT_EQ(read.positions.size(), found == old_pair ? 5000u : 40000u);
+    ASSERT_EQ(entries(dir), 2u) << "trial " << trial << ": leftovers after the next read";
+  }
+  std::printf(
+      "%d trials (first file at %.1f ms, write done at %.1f ms): old pair %d, new pair %d, %d "
+      "interrupted mid-write\n",
+      kTrials, static_cast<double>(window.first_file) / 1000.0, static_cast<double>(window.end) / 1000.0,
+      old_found, new_found, interrupted);
+  EXPECT_EQ(old_found + new_found, kTrials);
+  EXPECT_GT(interrupted, 0);  // the kills did land inside writes
+}
+
+TEST(BodyReplacement, ADeadWritersPublishedJournalIsCompletedByTheNextWrite) {
+  const fs::path dir = test::temp_dir();
+  write_body(dir, "b", random_body(100, 1));
+  // A dead writer that had published its journal: new files under temporary names, renames not done.
+  const pid_t dead = ::fork();
+  if (dead == 0) ::_exit(0);
+  ::waitpid(dead, nullptr, 0);
+  const std::string tmp_ply = fmt::format(".b.particles.ply.tmp.{}.7", dead);
+  const std::string tmp_json = fmt::format(".b.body.json.tmp.{}.8", dead);
+  const fs::path other = test::temp_dir();
+  write_body(other, "b", random_body(300, 2));
+  fs::copy_file(other / "b.particles.ply", dir / tmp_ply);
+  fs::copy_file(other / "b.body.json", dir / tmp_json);
+  write_bytes(dir / ".b.body.json.journal",
+              fmt::format("tetrasand journal 1\npid {}\n{}\tb.particles.ply\n{}\tb.body.json\n", dead,
+                          tmp_ply, tmp_json));
+  EXPECT_EQ(read_body(dir / "b.body.json").positions.size(), 300u);
+  EXPECT_EQ(entries(dir), 2u);
+  EXPECT_EQ(read_pair(dir), read_pair(other));
+}
+
+TEST(BodyReplacement, StaleTemporaryFilesOfADeadProcessAreRemovedByTheNextRun) {
+  const fs::path dir = test::temp_dir();
+  const pid_t dead = ::fork();
+  if (dead == 0) ::_exit(0);
+  ::waitpid(dead, nullptr, 0);
+  write_bytes(dir / fmt::format(".b.particles.ply.tmp.{}.1", dead), "half a file");
+  write_bytes(dir / fmt::format(".b.body.json.tmp.{}.2", dead), "{");
+  // The journal's own temporary file (write_atomically's name for ".b.body.json.journal").
+  write_bytes(dir / fmt::format("..b.body.json.journal.tmp.{}.3", dead), "tetrasand jou");
+  // Another live process's temporary file (this one's parent: alive) stays.
+  const std::string live = fmt::format(".b.body.json.tmp.{}.4", ::getppid());
+  write_bytes(dir / live, "{");
+  write_body(dir, "b", random_body(100, 1));
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{live, "b.body.json", "b.particles.ply"}));
+}
+
+TEST(BodyReplacement, AJournalOfALiveWriterIsRefusedNamingIt) {
+  const fs::path dir = test::temp_dir();
+  write_body(dir, "b", random_body(100, 1));
+  write_bytes(dir / ".b.body.json.journal", fmt::format("tetrasand journal 1\npid {}\n", ::getppid()));
+  const std::string error = test::input_error([&] { read_body(dir / "b.body.json"); });
+  EXPECT_NE(error.find(".b.body.json.journal: process " + std::to_string(::getppid()) +
+                       " is replacing these files right now"),
+            std::string::npos)
+      << error;
+}
+
+}  // namespace
+}  // namespace ts::body
