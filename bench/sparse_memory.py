@@ -111,6 +111,7 @@ def main():
                 r = run(a.binary, mesh, n, work)
                 if r:
                     rows.append(r)
+                    print(json.dumps(r), file=sys.stderr)  # the raw figures, kept in the run's log
     if not rows:
         raise SystemExit("sparse: no run finished")
     plot(rows, a.plot)

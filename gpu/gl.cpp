@@ -216,7 +216,13 @@ void Queue::dispatch(const Program& program, std::uint32_t gx, std::uint32_t gy,
 void Queue::dispatch_items(const Program& program, std::size_t items, GLbitfield barrier) {
   const std::size_t local = static_cast<std::size_t>(program.local_size()[0]);
   const std::size_t groups = (items + local - 1) / local;
-  if (groups > 0xffffffffull) throw GpuError("dispatch of " + program.name() + " is too large");
+  GLint max_groups = 0;
+  glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &max_groups);
+  // Past the limit a dispatch is a GL error that leaves the buffers as they were: stop instead.
+  if (groups > static_cast<std::size_t>(max_groups)) {
+    throw GpuError("dispatch of " + program.name() + " over " + std::to_string(items) + " items needs " +
+                   std::to_string(groups) + " work groups, above this GPU's limit of " + std::to_string(max_groups));
+  }
   dispatch(program, static_cast<std::uint32_t>(groups), 1, 1, barrier);
 }
 

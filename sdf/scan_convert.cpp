@@ -239,9 +239,17 @@ void fill_dense_off_band(DenseSdf& dense, const std::vector<std::uint8_t>& state
     if (state[idx] != kInBand) dense.values[idx] = {0.0f, 0.0f, 0.0f, state[idx] == kOutside ? band_world : -band_world};
 }
 
-int choose_slab_layers(const GridSpec& spec, std::size_t budget) {
+// `max_items`: the most voxels one compute dispatch of the band compaction (and its scan) covers,
+// 256 per work group times the device's work-group count limit along x.
+int choose_slab_layers(const GridSpec& spec, std::size_t budget, std::size_t max_items) {
   const std::size_t per_layer = bytes_per_layer(spec);
-  const int fit = static_cast<int>(std::min<std::size_t>(budget / per_layer, 1u << 20));
+  const std::size_t layer_voxels = static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y());
+  if (layer_voxels > max_items) {
+    throw GpuError(fmt::format("one z-layer of the SDF grid ({} x {} voxels) exceeds the {} voxels one compute dispatch "
+                               "of this GPU covers; use a larger voxel size",
+                               spec.dims.x(), spec.dims.y(), max_items));
+  }
+  const int fit = static_cast<int>(std::min<std::size_t>({budget / per_layer, max_items / layer_voxels, 1u << 20}));
   if (fit < 1) {
     throw GpuError("one z-layer of the SDF grid (" + std::to_string(spec.dims.x()) + " x " +
                    std::to_string(spec.dims.y()) + " voxels, " + std::to_string(per_layer >> 20) +
@@ -261,7 +269,7 @@ struct ScanPlan {
   DrawLists lists;
 };
 
-ScanPlan plan_scan(const TriangleMesh& mesh, const Pseudonormals& normals, const GridSpec& spec,
+ScanPlan plan_scan(std::size_t max_items, const TriangleMesh& mesh, const Pseudonormals& normals, const GridSpec& spec,
                    const ScanConvertOptions& options) {
   ScanPlan plan;
   // Every voxel with |d| < band lies inside the triangle's prism grown by the band; a quarter voxel
@@ -270,7 +278,7 @@ ScanPlan plan_scan(const TriangleMesh& mesh, const Pseudonormals& normals, const
   // lies beyond depth_range.
   plan.margin = options.band + 0.25;
   plan.geometry = build_geometry(mesh, normals, spec, plan.margin);
-  plan.slab_layers = choose_slab_layers(spec, options.max_slab_bytes);
+  plan.slab_layers = choose_slab_layers(spec, options.max_slab_bytes, max_items);
   plan.block = std::min(kLayersPerDraw, plan.slab_layers);
   plan.lists = bucket_by_block(plan.geometry, spec.dims.z(), plan.block);
   return plan;
@@ -557,7 +565,8 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
                                const GridSpec& spec, const ScanConvertOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   check_request(context, spec, options);
-  const ScanPlan plan = plan_scan(mesh, normals, spec, options);
+  const std::size_t max_items = 256u * static_cast<std::size_t>(context.limits().max_compute_work_group_count[0]);
+  const ScanPlan plan = plan_scan(max_items, mesh, normals, spec, options);
   gpu::ShaderLibrary library;
   gpu::Queue queue(options.timings, context.debug());
   SlabScanner scanner(library, queue, spec, plan);

@@ -237,6 +237,25 @@ TEST_F(ScanConvert, SmallSlabsGiveTheSameFieldAsOneSlab) {
   (void)a;
 }
 
+// A grid whose default slab would hold more voxels than one compute dispatch covers (256 x the
+// work-group count limit, 16.7M on llvmpipe): slabs are cut by that limit too, so the band is the
+// same as with small slabs. Before, such slabs came out nearly empty (a GL error, no message).
+TEST_F(ScanConvert, SlabsLargerThanOneDispatchAreCutToIt) {
+  const TriangleMesh sphere = icosphere(1.0, 1);
+  const GridSpec spec = grid_around(sphere, 2.0 / 300.0, 4);
+  const std::size_t max_items = 256u * static_cast<std::size_t>(context.limits().max_compute_work_group_count[0]);
+  ASSERT_GT(spec.voxel_count(), max_items);
+  ScanConvertOptions one_slab;
+  one_slab.max_slab_bytes = bytes_per_layer(spec) * static_cast<std::size_t>(spec.dims.z());
+  const auto whole = run(sphere, spec, one_slab);
+  EXPECT_LE(static_cast<std::size_t>(whole.stats.layers_per_slab) * spec.dims.x() * spec.dims.y(), max_items);
+  ScanConvertOptions small;
+  small.max_slab_bytes = bytes_per_layer(spec) * 16;
+  const auto sliced = run(sphere, spec, small);
+  EXPECT_GT(whole.stats.band_voxels, 6u * 300u * 300u);
+  EXPECT_EQ(whole.stats.band_voxels, sliced.stats.band_voxels);
+}
+
 TEST_F(ScanConvert, ErrorInVoxelsIsTheSameAtTinyAndHugeScaleFarFromOrigin) {
   for (double scale : {1e-4, 1e4}) {
     TriangleMesh sphere = icosphere(scale, 1);
