@@ -126,14 +126,19 @@ if runs agreement; then
   "$py" "$root/bench/validation/report.py" "$work/agreement" "$root/docs" >/dev/null
   echo "bench: wrote the agreement section of docs/validation.md"
 fi
-if runs sparse; then
-  meshes="$build/test-data/cgal/data/meshes"
-  if [ ! -d "$meshes" ]; then
-    tarball=/usr/share/doc/libcgal-dev/data.tar.gz
+# cgal_meshes: the folder of libcgal-demo's meshes, where the tests unpacked them, else unpacked here.
+cgal_meshes() {
+  local dir="$build/test-data/cgal/data/meshes"
+  if [ ! -d "$dir" ]; then
+    local tarball=/usr/share/doc/libcgal-dev/data.tar.gz
     [ -f "$tarball" ] || { echo "bench: $tarball not found (Debian package libcgal-dev)" >&2; exit 1; }
     mkdir -p "$work/cgal" && tar -xzf "$tarball" -C "$work/cgal" data/meshes
-    meshes="$work/cgal/data/meshes"
+    dir="$work/cgal/data/meshes"
   fi
+  echo "$dir"
+}
+if runs sparse; then
+  meshes=$(cgal_meshes)
   sparse_res=64,128,256,512,1024
   [ "$quick" -eq 1 ] && sparse_res=64,128
   "$py" "$root/bench/sparse_memory.py" "$bin/tetrasand" "$root/assets/bunny.obj,$meshes/knot1.off,$meshes/armadillo.off" \
@@ -142,14 +147,7 @@ if runs sparse; then
   echo "bench: wrote section sparse of docs/benchmarks.md and docs/benchmarks/sparse_memory.png"
 fi
 if runs sdf; then
-  # libcgal-demo's meshes: where the tests unpacked them, else unpacked here.
-  meshes="$build/test-data/cgal/data/meshes"
-  if [ ! -d "$meshes" ]; then
-    tarball=/usr/share/doc/libcgal-dev/data.tar.gz
-    [ -f "$tarball" ] || { echo "bench: $tarball not found (Debian package libcgal-dev)" >&2; exit 1; }
-    mkdir -p "$work/cgal" && tar -xzf "$tarball" -C "$work/cgal" data/meshes
-    meshes="$work/cgal/data/meshes"
-  fi
+  meshes=$(cgal_meshes)
   resolved=()
   for c in $sdf_cases; do
     name=${c%@*}
