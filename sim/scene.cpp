@@ -383,7 +383,8 @@ void read_simulation(TableReader& root, const fs::path& file, Scene& scene) {
   s.max_impact_speed = r.non_negative("max_impact_speed", 0.0);
   s.step.normal_damping = static_cast<NormalDamping>(r.choice("normal_damping", {"tsuji", "thesis"}, 0));
   s.step.thesis_reference_speed = r.positive("thesis_reference_speed", s.step.thesis_reference_speed);
-  s.step.integrator = static_cast<Integrator>(r.choice("integrator", {"euler", "symplectic"}, 0));
+  s.step.integrator = static_cast<Integrator>(
+      r.choice("integrator", {"euler", "symplectic"}, static_cast<std::size_t>(s.step.integrator)));
   s.step.tangential = static_cast<TangentialModel>(r.choice("tangential", {"viscous", "spring"}, 0));
   s.step.resort_every = r.integer("resort_every", s.step.resort_every, 0);
   s.step.cfl = r.non_negative("cfl", s.step.cfl);
