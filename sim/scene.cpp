@@ -54,6 +54,22 @@ class TableReader {
     throw InputError(fmt::format("{}:{}: {}: {}", file_.string(), line, name, problem));
   }
 
+  // A required key that is absent. When the table holds a key nobody has read that is one or two edits
+  // from it, that key is the likely typo: name it where it is, so the user fixes the right line. Keys of
+  // under 4 letters are left out: "min" and "max", "nu" and "mu" are two edits apart and both valid.
+  [[noreturn]] void missing(std::string_view key, const std::string& detail = "") const {
+    const std::string name = path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+    for (const auto& [present, value] : table_) {
+      const std::string candidate(present.str());
+      if (key.size() < 4 || candidate.size() < 4 || used_.count(candidate)) continue;
+      if (edit_distance(candidate, key) > 2) continue;
+      const std::string full = path_.empty() ? candidate : path_ + "." + candidate;
+      throw InputError(fmt::format("{}:{}: {}: unknown key (did you mean \"{}\"? {} is required{})", file_.string(),
+                                   line_of(value), full, key, name, detail));
+    }
+    fail(key, "missing (required" + detail + ")");
+  }
+
   bool has(std::string_view key) {
     used_.insert(std::string(key));
     return table_.contains(key);
@@ -78,12 +94,12 @@ class TableReader {
   double number(std::string_view key, double fallback) { return optional_number(key).value_or(fallback); }
   double required_number(std::string_view key) {
     const auto value = optional_number(key);
-    if (!value) fail(key, "missing (required)");
+    if (!value) missing(key);
     return *value;
   }
   double positive(std::string_view key, std::optional<double> fallback = std::nullopt) {
     const auto value = has(key) ? optional_number(key) : fallback;
-    if (!value) fail(key, "missing (required)");
+    if (!value) missing(key);
     if (!(*value > 0)) fail(key, fmt::format("must be > 0 (got {})", *value));
     return *value;
   }
@@ -94,7 +110,7 @@ class TableReader {
   }
   std::int64_t integer(std::string_view key, std::optional<std::int64_t> fallback, std::int64_t min_value) {
     const toml::node* n = node(key);
-    if (!n && !fallback) fail(key, "missing (required)");
+    if (!n && !fallback) missing(key);
     if (!n) return *fallback;
     if (!n->is_integer()) fail(key, "must be an integer");
     const std::int64_t value = *n->value<std::int64_t>();
@@ -115,13 +131,13 @@ class TableReader {
   }
   std::string required_string(std::string_view key) {
     auto s = optional_string(key);
-    if (!s) fail(key, "missing (required)");
+    if (!s) missing(key);
     return *s;
   }
   // One of `choices`; returns its index.
   std::size_t choice(std::string_view key, const std::vector<std::string>& choices, std::optional<std::size_t> fallback) {
     const auto s = optional_string(key);
-    if (!s && !fallback) fail(key, fmt::format("missing (required; one of: {})", fmt::join(choices, ", ")));
+    if (!s && !fallback) missing(key, fmt::format("; one of: {}", fmt::join(choices, ", ")));
     if (!s) return *fallback;
     const auto it = std::find(choices.begin(), choices.end(), *s);
     if (it == choices.end()) fail(key, fmt::format("\"{}\" is not one of: {}", *s, fmt::join(choices, ", ")));
@@ -145,7 +161,7 @@ class TableReader {
   template <int N>
   Eigen::Matrix<double, N, 1> vector(std::string_view key, std::optional<Eigen::Matrix<double, N, 1>> fallback) {
     auto v = optional_vector<N>(key);
-    if (!v && !fallback) fail(key, "missing (required)");
+    if (!v && !fallback) missing(key);
     return v ? *v : *fallback;
   }
   Eigen::Vector3d unit_vector(std::string_view key, const Eigen::Vector3d& fallback) {
@@ -229,7 +245,8 @@ void read_material(const toml::table& t, const fs::path& file, Scene& scene) {
 
 void read_grain(TableReader& root, const fs::path& file, Scene& scene) {
   const toml::node* n = root.node("grain");
-  if (!n || !n->is_table()) root.fail("grain", "missing [grain] table (radius, edge, material)");
+  if (!n) root.missing("grain", "; a [grain] table: radius, edge, material");
+  if (!n->is_table()) root.fail("grain", "must be a [grain] table (radius, edge, material)");
   TableReader r(*n->as_table(), "grain", file);
   scene.grain.radius = r.positive("radius");
   scene.grain.edge = r.positive("edge", 2 * scene.grain.radius);

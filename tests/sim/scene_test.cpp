@@ -54,6 +54,22 @@ TEST(Scene, UnknownKeyIsRejectedWithASuggestion) {
   EXPECT_NE(top.find("simulaton: unknown key (did you mean \"simulation\"?)"), std::string::npos) << top;
 }
 
+// A misspelt required key is the user's typo, not an absent key: the message points at its line.
+TEST(Scene, MisspeltRequiredKeyIsReportedAsTheUnknownKeyWithTheSuggestion) {
+  std::string text = kMinimal;
+  text.replace(text.find("radius = 1.0e-3"), 6, "raduis");
+  EXPECT_EQ(parse_error(text),
+            "scene.toml:11: grain.raduis: unknown key (did you mean \"radius\"? grain.radius is required)");
+  std::string table = kMinimal;
+  table.replace(table.find("[grain]"), 7, "[grian]");
+  const std::string error = parse_error(table);
+  EXPECT_NE(error.find("grian: unknown key (did you mean \"grain\"? grain is required"), std::string::npos) << error;
+  // Far from every required key, it stays "missing".
+  std::string absent = kMinimal;
+  absent.replace(absent.find("radius = 1.0e-3"), 15, "");
+  EXPECT_NE(parse_error(absent).find("grain.radius: missing (required)"), std::string::npos) << parse_error(absent);
+}
+
 TEST(Scene, SyntaxErrorNamesTheLine) {
   const std::string error = parse_error(std::string(kMinimal) + "[simulation\n");
   EXPECT_EQ(error.rfind("scene.toml:13:", 0), 0u) << error;
@@ -71,7 +87,8 @@ TEST(Scene, BadValuesAreRejected) {
                 .find("scene.toml:16: emitter.max: must be an array of 3 numbers"),
             std::string::npos);
   std::string no_grain = base.substr(0, base.find("[grain]"));
-  EXPECT_NE(parse_error(no_grain).find("missing [grain]"), std::string::npos);
+  EXPECT_NE(parse_error(no_grain).find("grain: missing (required; a [grain] table"), std::string::npos)
+      << parse_error(no_grain);
 }
 
 TEST(Scene, FillEmitterPlacesGrainsWithoutOverlap) {
