@@ -47,10 +47,15 @@ class TableReader {
               std::map<std::string, int, std::less<>>* lines = nullptr)
       : table_(table), path_(std::move(path)), file_(file), lines_(lines) {}
 
+  // "path.key" as errors and key lines name it; the root table's keys stand alone.
+  std::string qualified(std::string_view key) const {
+    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  }
+
   [[noreturn]] void fail(std::string_view key, const std::string& problem) const {
     const toml::node* node = key.empty() ? nullptr : table_.get(key);
     const int line = node ? line_of(*node) : line_of(table_);
-    const std::string name = key.empty() ? path_ : (path_.empty() ? std::string(key) : path_ + "." + std::string(key));
+    const std::string name = key.empty() ? path_ : qualified(key);
     throw InputError(fmt::format("{}:{}: {}: {}", file_.string(), line, name, problem));
   }
 
@@ -58,14 +63,13 @@ class TableReader {
   // from it, that key is the likely typo: name it where it is, so the user fixes the right line. Keys of
   // under 4 letters are left out: "min" and "max", "nu" and "mu" are two edits apart and both valid.
   [[noreturn]] void missing(std::string_view key, const std::string& detail = "") const {
-    const std::string name = path_.empty() ? std::string(key) : path_ + "." + std::string(key);
     for (const auto& [present, value] : table_) {
+      if (key.size() < 4) break;  // no candidate can be close enough to name
       const std::string candidate(present.str());
-      if (key.size() < 4 || candidate.size() < 4 || used_.count(candidate)) continue;
-      if (edit_distance(candidate, key) > 2) continue;
-      const std::string full = path_.empty() ? candidate : path_ + "." + candidate;
-      throw InputError(fmt::format("{}:{}: {}: unknown key (did you mean \"{}\"? {} is required{})", file_.string(),
-                                   line_of(value), full, key, name, detail));
+      if (candidate.size() < 4 || used_.count(candidate) || edit_distance(candidate, key) > 2) continue;
+      throw InputError(fmt::format("{}:{}: {}: unknown key (did you mean \"{}\"? {} is required{})",
+                                   file_.string(), line_of(value), qualified(candidate), key, qualified(key),
+                                   detail));
     }
     fail(key, "missing (required" + detail + ")");
   }
@@ -78,8 +82,7 @@ class TableReader {
   const toml::node* node(std::string_view key) {
     used_.insert(std::string(key));
     const toml::node* found = table_.get(key);
-    if (found && lines_)
-      (*lines_)[path_.empty() ? std::string(key) : path_ + "." + std::string(key)] = line_of(*found);
+    if (found && lines_) (*lines_)[qualified(key)] = line_of(*found);
     return found;
   }
 
@@ -185,7 +188,7 @@ class TableReader {
         }
       }
       const int line = line_of(value);
-      const std::string full = path_.empty() ? name : path_ + "." + name;
+      const std::string full = qualified(name);
       throw InputError(fmt::format("{}:{}: {}: unknown key{}; expected one of: {}", file_.string(), line, full, hint,
                                    fmt::join(used_, ", ")));
     }
