@@ -1,9 +1,11 @@
 // `tetrasand sim SCENE.toml`: run a sand scene on the GPU (or the CPU reference with --cpu).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <tuple>
 #include <utility>
 
@@ -68,6 +70,26 @@ void report_progress(double duration, const sim::World& world, const sim::StepSt
   }
 }
 
+// "360 grains; props: 1 dynamic; static bodies: 2 rough walls; smooth walls: 5 planes" (kinds with
+// none left out, so a grain-only scene reads "360 grains").
+std::string describe_bodies(const sim::BodyCounts& c) {
+  const auto plural = [](std::size_t n, std::string_view what) {
+    return fmt::format("{} {}{}", n, what, n == 1 ? "" : "s");
+  };
+  std::vector<std::string> parts{plural(c.grains, "grain")};
+  std::vector<std::string> props;
+  if (c.dynamic_props > 0) props.push_back(fmt::format("{} dynamic", c.dynamic_props));
+  if (c.kinematic_props > 0) props.push_back(fmt::format("{} kinematic", c.kinematic_props));
+  if (c.static_props > 0) props.push_back(fmt::format("{} static", c.static_props));
+  if (!props.empty()) parts.push_back(fmt::format("props: {}", fmt::join(props, ", ")));
+  if (c.rough_walls > 0) parts.push_back(fmt::format("static bodies: {} (rough walls)", c.rough_walls));
+  std::vector<std::string> smooth;
+  if (c.smooth_planes > 0) smooth.push_back(plural(c.smooth_planes, "plane"));
+  if (c.smooth_cylinders > 0) smooth.push_back(plural(c.smooth_cylinders, "cylinder"));
+  if (!smooth.empty()) parts.push_back(fmt::format("smooth walls: {}", fmt::join(smooth, ", ")));
+  return fmt::format("{}", fmt::join(parts, "; "));
+}
+
 const std::string& output_dir(const Options& o) { return o.resume.empty() ? o.output : o.resume; }
 
 void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResult& result, double seconds,
@@ -78,6 +100,7 @@ void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResu
              result.steps, result.dt, result.grains, seconds,
              seconds > 0 ? stepped * static_cast<double>(result.grains) / seconds : 0.0,
              o.cpu ? "CPU reference" : context->summary());
+  fmt::print("bodies: {}\n", describe_bodies(result.bodies));
   fmt::print("clamps: {} velocity, {} angular velocity, {} overlap (each clamp means a less accurate result)\n",
              result.last.velocity_clamps, result.last.angular_velocity_clamps, result.last.overlap_clamps);
   if (scene.simulation.step.tangential == sim::TangentialModel::Spring) {
@@ -87,7 +110,12 @@ void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResu
   if (result.resumed_from >= 0) fmt::print("resumed from the checkpoint at step {}\n", result.resumed_from);
   if (result.checkpoints > 0)
     fmt::print("checkpoints: {} written in {}\n", result.checkpoints, output_dir(o));
-  fmt::print("outputs: {}/metrics.csv ({} rows)\n", output_dir(o), result.outputs);
+  std::vector<std::string> files;
+  for (const sim::OutputRecord& f : result.files)
+    files.push_back(fmt::format("{} ({} {})", (std::filesystem::path(output_dir(o)) / f.pattern).string(),
+                                f.count, f.unit));
+  fmt::print("outputs: {}\n", files.empty() ? std::string("none ([output] writes nothing)")
+                                            : fmt::format("{}", fmt::join(files, ", ")));
 }
 
 int run_sim(const Options& o, const GlobalOptions& global) {

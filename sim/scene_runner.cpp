@@ -96,16 +96,24 @@ void write_contacts_csv(const std::vector<ContactRecord>& contacts, const std::f
 
 namespace {
 
-std::size_t dynamic_bodies(const World& world) {
-  std::size_t n = 0;
-  for (MotionType m : world.bodies.motion) n += m == MotionType::Dynamic ? 1 : 0;
-  return n;
+std::size_t bodies_moving(const World& world, MotionType motion) {
+  return static_cast<std::size_t>(std::count(world.bodies.motion.begin(), world.bodies.motion.end(), motion));
+}
+
+std::size_t props_moving(const Scene& scene, MotionType motion) {
+  return static_cast<std::size_t>(std::count_if(scene.props.begin(), scene.props.end(),
+                                                [motion](const Prop& p) { return p.motion == motion; }));
+}
+
+// Grains are the dynamic bodies that are not props (emitters only add grains).
+std::size_t grains_of(const Scene& scene, const World& world) {
+  return bodies_moving(world, MotionType::Dynamic) - props_moving(scene, MotionType::Dynamic);
 }
 
 class OutputWriter {
  public:
   OutputWriter(const Scene& scene, const std::filesystem::path& dir, const RunHooks& hooks)
-      : settings_(scene.output), dir_(dir), hooks_(hooks) {
+      : scene_(scene), settings_(scene.output), dir_(dir), hooks_(hooks) {
     std::filesystem::create_directories(dir_);
     csv_ = "step,time_s,grains,kinetic_translational_J,kinetic_rotational_J,potential_J,elastic_J,contacts,"
            "wall_contacts,max_overlap_ratio,velocity_clamps,angular_velocity_clamps,overlap_clamps,spring_overflows\n";
@@ -114,11 +122,11 @@ class OutputWriter {
   void write(const World& world, const StepStats& stats, std::int64_t step, Stepper& stepper) {
     const std::string index = fmt::format("{:06d}", frame_);
     if (settings_.csv) {
-      csv_ += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{},{},{}\n", step, world.time,
-                          dynamic_bodies(world), stats.energy.translational, stats.energy.rotational,
-                          stats.energy.potential, stats.elastic_energy, stats.contacts, stats.wall_contacts,
-                          stats.max_overlap_ratio, stats.velocity_clamps, stats.angular_velocity_clamps,
-                          stats.overlap_clamps, stats.spring_overflows);
+      csv_ += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{},{},{}\n", step,
+                          world.time, grains_of(scene_, world), stats.energy.translational,
+                          stats.energy.rotational, stats.energy.potential, stats.elastic_energy,
+                          stats.contacts, stats.wall_contacts, stats.max_overlap_ratio, stats.velocity_clamps,
+                          stats.angular_velocity_clamps, stats.overlap_clamps, stats.spring_overflows);
       write_file_atomically(dir_ / "metrics.csv", csv_);  // whole file each time: valid after any interruption
     }
     if (settings_.ply) write_particles_ply(world, dir_ / ("particles_" + index + ".ply"));
@@ -137,6 +145,17 @@ class OutputWriter {
 
   std::int64_t count() const { return frame_; }
   const std::string& csv() const { return csv_; }
+  // Every kind of output the folder holds, each with as many files as outputs were written (a resumed
+  // run's included: its frame counter goes on from the checkpoint's).
+  std::vector<OutputRecord> files() const {
+    std::vector<OutputRecord> files;
+    if (settings_.csv) files.push_back({"metrics.csv", frame_, "rows"});
+    if (settings_.ply) files.push_back({"particles_NNNNNN.ply", frame_, "files"});
+    if (settings_.vtp) files.push_back({"particles_NNNNNN.vtp", frame_, "files"});
+    if (settings_.contacts) files.push_back({"contacts_NNNNNN.csv", frame_, "files"});
+    if (settings_.frames && hooks_.write_frame) files.push_back({"frame_NNNNNN.png", frame_, "files"});
+    return files;
+  }
   // Goes on after `frames` outputs whose metrics.csv was `csv` (a resumed run).
   void restore(std::string csv, std::int64_t frames) {
     csv_ = std::move(csv);
@@ -144,6 +163,7 @@ class OutputWriter {
   }
 
  private:
+  const Scene& scene_;
   OutputSettings settings_;
   std::filesystem::path dir_;
   const RunHooks& hooks_;
@@ -418,13 +438,27 @@ RunResult SceneRun::run() {
   }
   result_.steps = step_;
   result_.last = stats_;
-  result_.grains = dynamic_bodies(world_);
+  result_.bodies = count_bodies(scene_, world_);
+  result_.grains = result_.bodies.grains;
   result_.outputs = output_->count();
+  result_.files = output_->files();
   if (hooks_.on_finish) hooks_.on_finish(*stepper_);
   return result_;
 }
 
 }  // namespace
+
+BodyCounts count_bodies(const Scene& scene, const World& world) {
+  BodyCounts c;
+  c.grains = grains_of(scene, world);
+  c.dynamic_props = props_moving(scene, MotionType::Dynamic);
+  c.kinematic_props = props_moving(scene, MotionType::Kinematic);
+  c.static_props = props_moving(scene, MotionType::Static);
+  c.rough_walls = bodies_moving(world, MotionType::Static) - c.static_props;
+  c.smooth_planes = world.walls.planes.size();
+  c.smooth_cylinders = world.walls.cylinders.size();
+  return c;
+}
 
 RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir, const RunHooks& hooks,
                     const StepperFactory& make_stepper, const RunControl& control) {

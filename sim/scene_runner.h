@@ -44,13 +44,33 @@ struct RunControl {
 // Makes the engine of a run from the settings with dt resolved; the runner loads the world.
 using StepperFactory = std::function<std::unique_ptr<Stepper>(const StepSettings& settings)>;
 
+// The bodies of a run's world, counted apart: a dynamic prop is not a grain, a rough wall is a static
+// body but not a prop.
+struct BodyCounts {
+  std::size_t grains = 0;  // the emitters' dynamic grains
+  std::size_t dynamic_props = 0, kinematic_props = 0, static_props = 0;
+  std::size_t rough_walls = 0;  // static particle bodies of the rough boundaries
+  std::size_t smooth_planes = 0, smooth_cylinders = 0;
+};
+BodyCounts count_bodies(const Scene& scene, const World& world);
+
+// One kind of file a run wrote into its output folder: `pattern` as a user would list it
+// ("particles_NNNNNN.ply"), `count` files (or rows, for metrics.csv).
+struct OutputRecord {
+  std::string pattern;
+  std::int64_t count = 0;
+  std::string unit;  // "rows" or "files"
+};
+
 struct RunResult {
   std::int64_t steps = 0;
   double dt = 0;                 // s, as used
   std::string time_step_warning; // non-empty when the user's dt exceeds the bound
   StepStats last;
-  std::size_t grains = 0;        // dynamic bodies at the end
+  std::size_t grains = 0;  // grains at the end (dynamic bodies that are not props)
+  BodyCounts bodies;       // at the end
   std::int64_t outputs = 0;
+  std::vector<OutputRecord> files;  // what the output folder holds after the run, checkpoints apart
   // Contacts over the whole run that found no free spring slot (spring tangential model): each ran
   // without static friction for that step.
   std::size_t spring_overflows = 0;

@@ -3,8 +3,11 @@
 // The props are `tetrasand sample` bodies committed under assets/bodies/.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <vector>
 
 #include "sim/scene.h"
@@ -126,6 +129,45 @@ TEST(Props, KinematicBladePushesGrainsAndNoneSlipsThrough) {
   const double travel = front - (-0.15);  // m, blade travel inside the bed
   EXPECT_GT(swept / n_swept, 0.5 * travel);
   EXPECT_LT(std::abs(far / n_far), 0.01);
+}
+
+
+// The run summary (issue 17): prop_drop's cube is a dynamic body but not a grain, in the result, in
+// metrics.csv and in `tetrasand sim`'s report, which also names every output it wrote.
+TEST(Props, RunSummaryCountsThePropApartFromTheGrainsAndListsEveryOutput) {
+  Scene scene = load_scene(test::asset("scenes/prop_drop.toml"));
+  scene.simulation.duration = 0.005;  // s: a few steps
+  scene.output.vtp = true;
+  const auto dir = test::temp_dir();
+  const RunResult r = run_scene(scene, dir);
+  EXPECT_EQ(r.grains, 360u);
+  EXPECT_EQ(r.bodies.grains, 360u);
+  EXPECT_EQ(r.bodies.dynamic_props, 1u);
+  EXPECT_EQ(r.bodies.kinematic_props + r.bodies.static_props + r.bodies.rough_walls, 0u);
+  EXPECT_EQ(r.bodies.smooth_planes, 5u);
+  ASSERT_EQ(r.files.size(), 3u);  // metrics.csv and the ply and vtp particles
+  for (const OutputRecord& f : r.files) EXPECT_EQ(f.count, r.outputs) << f.pattern;
+  EXPECT_EQ(r.files[2].pattern, "particles_NNNNNN.vtp");
+  std::ifstream csv(dir / "metrics.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  EXPECT_EQ(row.substr(row.find(',', row.find(',') + 1) + 1, 4), "360,") << row;
+
+  std::string output;
+  const auto out = test::temp_dir();
+  ASSERT_EQ(test::run_tetrasand(fmt::format("sim '{}' -o '{}' --cpu --duration 0.005",
+                                            test::asset("scenes/prop_drop.toml").string(), out.string()),
+                                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find(", 360 grains, "), std::string::npos) << output;
+  EXPECT_NE(output.find("bodies: 360 grains; props: 1 dynamic; smooth walls: 5 planes\n"), std::string::npos)
+      << output;
+  EXPECT_NE(output.find((out / "metrics.csv").string() + " (2 rows), " +
+                        (out / "particles_NNNNNN.ply").string() + " (2 files)\n"),
+            std::string::npos)
+      << output;
 }
 
 }  // namespace
