@@ -117,9 +117,11 @@ void add_camera_options(CLI::App* cmd, Options& o) {
 
 void add_colour_options(CLI::App* cmd, Options& o) {
   cmd->add_flag("--alpha", o.alpha, "Transparent background; the ground shows only its shadows");
-  cmd->add_option("--color-by", o.color_by,
-                  "Colour the surface by: none, error (distance from the mesh, voxels; MESH input) or "
-                  "particle-distance (distance to the nearest particle centre, in radii)")
+  cmd->add_option(
+         "--color-by", o.color_by,
+         "Colour the surface by: none, error (distance from the mesh, voxels; MESH input) or "
+         "particle-distance (distance to the nearest particle centre, in radii of the body, whatever "
+         "--particle-radius draws)")
       ->check(CLI::IsMember({"none", "error", "particle-distance"}))
       ->capture_default_str();
   cmd->add_option("--color-max", o.color_max,
@@ -220,6 +222,7 @@ void load_particles(const Options& o, preview::Renderer& renderer, Content& cont
   if (o.scale != 1.0) {
     for (auto& c : content.loaded.particles.centers) c *= o.scale;
     if (o.particle_radius <= 0.0) content.loaded.particles.radii[0] *= static_cast<float>(o.scale);
+    content.loaded.sampled_radius *= o.scale;
   }
   renderer.set_particles(content.loaded.particles);
 }
@@ -234,13 +237,16 @@ void set_surface_colouring(const Options& o, Content& content, preview::RenderSe
     settings.surface_scalar.max_value = o.color_max > 0 ? o.color_max : 0.25;
     content.scalar_name = "distance from the rendered surface to the mesh [voxels]";
   } else if (o.color_by == "particle-distance") {
-    const double r = content.loaded.particles.radii[0];
+    // In radii the set was sampled for, not the drawing radius (--particle-radius would saturate it).
+    const double r = content.loaded.sampled_radius > 0.0 ? content.loaded.sampled_radius
+                                                         : content.loaded.particles.radii[0];
     content.particle_grid = std::make_unique<sampler::PointGrid>(content.loaded.particles.centers, 2.0 * r);
     settings.surface_scalar.value = [grid = content.particle_grid.get(), r](const Eigen::Vector3d& p) {
       return grid->nearest(p).distance / r;
     };
     settings.surface_scalar.max_value = o.color_max > 0 ? o.color_max : 1.5;
-    content.scalar_name = "distance from the surface to the nearest particle centre [radii]";
+    content.scalar_name =
+        fmt::format("distance from the surface to the nearest particle centre [radii of {:.4g} m]", r);
   }
 }
 

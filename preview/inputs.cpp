@@ -48,27 +48,31 @@ LoadedParticles load_particles(const std::filesystem::path& file, double radius)
   if (ends_with(name, ".json")) {
     const body::ParticleBody body = body::read_body(file);
     out.particles.centers = to_double(body.positions);
-    out.particles.radii = {static_cast<float>(radius > 0.0 ? radius : body.particle_radius)};
-    out.radius_source = radius > 0.0 ? "--particle-radius" : "body.json";
-    return out;
-  }
-  out.particles.centers = to_double(body::read_particles_ply(file).positions);
-  if (out.particles.centers.empty()) throw InputError(file, "holds no particles");
-  if (radius > 0.0) {
-    out.radius_source = "--particle-radius";
-  } else if (ends_with(name, ".particles.ply") &&
-             std::filesystem::exists(file.parent_path() / (name.substr(0, name.size() - 14) + ".body.json"))) {
-    radius = body::read_body(file.parent_path() / (name.substr(0, name.size() - 14) + ".body.json")).particle_radius;
+    out.sampled_radius = body.particle_radius;
     out.radius_source = "body.json";
   } else {
-    radius = estimate_radius(out.particles.centers);
-    out.radius_source = "estimated from the spacing";
-    if (!(radius > 0.0)) {
-      throw InputError(file, "cannot estimate a particle radius from a single particle or coincident ones: "
-                             "give --particle-radius");
+    out.particles.centers = to_double(body::read_particles_ply(file).positions);
+    if (out.particles.centers.empty()) throw InputError(file, "holds no particles");
+    const bool beside =
+        ends_with(name, ".particles.ply") &&
+        std::filesystem::exists(file.parent_path() / (name.substr(0, name.size() - 14) + ".body.json"));
+    if (beside) {
+      out.sampled_radius =
+          body::read_body(file.parent_path() / (name.substr(0, name.size() - 14) + ".body.json"))
+              .particle_radius;
+      out.radius_source = "body.json";
+    } else {
+      out.sampled_radius = estimate_radius(out.particles.centers);
+      out.radius_source = "estimated from the spacing";
+      if (!(out.sampled_radius > 0.0) && !(radius > 0.0)) {
+        throw InputError(file,
+                         "cannot estimate a particle radius from a single particle or coincident ones: "
+                         "give --particle-radius");
+      }
     }
   }
-  out.particles.radii = {static_cast<float>(radius)};
+  if (radius > 0.0) out.radius_source = "--particle-radius";
+  out.particles.radii = {static_cast<float>(radius > 0.0 ? radius : out.sampled_radius)};
   return out;
 }
 

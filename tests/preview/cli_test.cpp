@@ -1,6 +1,8 @@
 // `tetrasand preview`, `sample --preview` and `sim` frames through the executable: outputs, and
 // clear errors with the documented exit codes for bad inputs.
 #include <gtest/gtest.h>
+
+#include <cstdio>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
@@ -121,6 +123,29 @@ TEST(CliPreview, SampleWritesAPreviewBesideTheBody) {
             0)
       << out;
   EXPECT_NE(out.find("(body.json)"), std::string::npos) << out;
+}
+
+// A smaller drawing radius shows the surface between the impostors; the colours stay in radii of the
+// body's own radius (they saturated at the colour map's top when divided by the drawing radius).
+TEST(CliPreview, ParticleDistanceIsInTheBodysRadiusWhateverTheDrawingRadius) {
+  const auto dir = test::temp_dir();
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("preview " + q(test::asset("cube.obj")) + " --particles " +
+                                    q(test::asset("bodies/cube.body.json")) + " -o " + q(dir / "c.png") +
+                                    " --size 48x48 --resolution 32 --color-by particle-distance --particle-radius 0.001",
+                                &out),
+            0)
+      << out;
+  const std::string unit = "[radii of 0.008358 m]: mean ";
+  const std::size_t at = out.find(unit);
+  ASSERT_NE(at, std::string::npos) << out;
+  double mean = 0, max = 0;
+  ASSERT_EQ(std::sscanf(out.c_str() + at + unit.size(), "%lf, max %lf", &mean, &max), 2) << out;
+  // The committed cube body covers its surface (c <= r): every visible point lies within about one
+  // body radius of a centre (the rendered surface is the SDF's, a fraction of a voxel off the mesh).
+  EXPECT_GT(mean, 0.1) << out;
+  EXPECT_LT(mean, 1.0) << out;
+  EXPECT_LT(max, 1.2) << out;
 }
 
 TEST(CliPreview, SimulationFramesArePngs) {
