@@ -9,6 +9,7 @@
 #include "core/mass_properties.h"
 #include "core/mesh_io.h"
 #include "core/mesh_report.h"
+#include "core/up_axis.h"
 
 namespace ts::app {
 
@@ -72,13 +73,22 @@ int run_info(const Options& o) {
   } else {
     text = "mass properties       none: the mesh does not enclose a volume (" + closed_solid_problems(report) + ")\n";
   }
+  const UpAxisHint up = up_axis_hint(report.box);
+  const std::string advice = up_axis_advice(up, o.mesh);
   if (o.json) {
     nlohmann::json out = to_json(report);
     out["file"] = o.mesh;
     out["mass_properties"] = mass;
+    out["up_axis"] = {{"tallest", std::string(1, axis_name(up.tallest))},
+                      {"runner_up", std::string(1, axis_name(up.runner_up))},
+                      {"extent", vec_json(up.extent)},
+                      {"ambiguous", up.ambiguous},
+                      {"advice", advice}};
     fmt::print("{}\n", out.dump(2));
   } else {
     fmt::print("{}\n{}{}", o.mesh, format_report(report), text);
+    fmt::print("up axis               tallest along {} ({:.6g} m; {} {:.6g} m): {}\n", axis_name(up.tallest),
+               up.extent[up.tallest], axis_name(up.runner_up), up.extent[up.runner_up], advice);
   }
   return 0;
 }

@@ -26,7 +26,7 @@ namespace {
 
 struct Options {
   std::string input, output, particles, size = "800x800", view = "iso", color_by = "none";
-  std::vector<double> eye, target, up{0.0, 1.0, 0.0}, light;
+  std::vector<double> eye, target, up{0.0, 0.0, 1.0}, light;
   double fov = 30.0, particle_radius = 0.0, color_max = 0.0, voxel = 0.0, band = 3.0, scale = 1.0;
   int resolution = 192, turntable = 1;
   bool ortho = false, contact_sheet = false, alpha = false, no_ground = false, no_shadows = false, timings = false;
@@ -101,8 +101,10 @@ void add_camera_options(CLI::App* cmd, Options& o) {
       ->expected(3)
       ->check(finite())
       ->needs(eye);
-  cmd->add_option("--up", o.up,
-                  "World up X,Y,Z: the ground's normal and the image's up (meshes: y up by default)")
+  cmd->add_option(
+         "--up", o.up,
+         "World up X,Y,Z: the ground's normal and the image's up (+z, as in the simulator; `info` tells a "
+         "mesh's tallest axis)")
       ->delimiter(',')
       ->expected(3)
       ->check(finite())

@@ -39,6 +39,7 @@ struct Options {
   std::size_t sdf_budget_mib = 1024;
   std::string sign = "pseudonormal";
   bool json = false, allow_open = false, preview = false;
+  std::vector<double> up{0.0, 0.0, 1.0};  // --preview's world up
 };
 
 struct BatchRow {
@@ -204,6 +205,12 @@ void add_solid_and_output_options(CLI::App* cmd, Options& o) {
   cmd->add_flag("--json", o.json, "Print the body.json summary on stdout");
   cmd->add_flag("--timings", o.sampling.timings, "Per-kernel GPU times");
   cmd->add_flag("--preview", o.preview, "Also write NAME.preview.png: the mesh's SDF ray-cast with the particles over it");
+  cmd->add_option("--up", o.up,
+                  "With --preview: the mesh's up X,Y,Z (+z by convention; `info` tells its tallest axis)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(finite())
+      ->capture_default_str();
 }
 
 // The mesh, scaled, and the sign and mass methods it allows: an open or inconsistent mesh is refused
@@ -331,7 +338,9 @@ int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
   }
   if (o.preview) {
     const std::filesystem::path png = std::filesystem::path(o.output) / (name + ".preview.png");
-    preview::write_body_preview(context, mesh, body, png, {o.mesh});
+    preview::BodyPreviewSettings look;
+    look.up = Eigen::Vector3d(o.up[0], o.up[1], o.up[2]);
+    preview::write_body_preview(context, mesh, body, png, {o.mesh}, look);
     log::info("preview: {}", png.string());
   }
   return 0;
@@ -369,6 +378,8 @@ int run_batch(const Options& o, const std::vector<std::string>& meshes, gpu::Con
 
 int run_sample(Options& o, const GlobalOptions& global) {
   if (o.inputs.empty() && o.list.empty()) throw Error(ExitCode::Usage, "sample: give at least one MESH or --list FILE");
+  if (!(Eigen::Vector3d(o.up[0], o.up[1], o.up[2]).norm() > 0.0))
+    throw Error(ExitCode::Usage, "sample: --up must not be the zero vector");
   const std::vector<std::string> meshes = expand_inputs(o);
   o.batch = meshes.size() > 1 || !o.list.empty() || !o.shard.empty() || !o.summary.empty() ||
             (!o.inputs.empty() && o.inputs[0].rfind('@', 0) == 0);

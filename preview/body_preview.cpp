@@ -19,7 +19,7 @@ void write_body_preview(gpu::Context& context, const TriangleMesh& mesh, const b
   RenderSettings s;
   s.width = settings.width;
   s.height = settings.height;
-  s.up = Eigen::Vector3d::UnitY();
+  s.up = settings.up.normalized();
   s.camera = frame_box(renderer.content_box(), view_direction(View::Iso, s.up), view_image_up(View::Iso, s.up),
                        static_cast<double>(s.width) / s.height, false, 30.0);
   write_png(png, renderer.render(s).image, inputs);

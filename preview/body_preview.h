@@ -1,6 +1,6 @@
 #pragma once
 // `tetrasand sample --preview`: NAME.preview.png beside the body, the mesh's SDF ray-cast with the
-// particles over it (the thesis's figure 6.13), from the iso view, y up.
+// particles over it (the thesis's figure 6.13), from the iso view, +z up unless told otherwise.
 #include <filesystem>
 #include <vector>
 
@@ -13,6 +13,7 @@ namespace ts::preview {
 struct BodyPreviewSettings {
   int width = 800, height = 800;  // pixels
   int resolution = 192;           // SDF voxels along the mesh's longest side
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // the mesh's up (sample --up), +z by convention
 };
 
 // Scan-converts `mesh` and renders it with `body`'s particles; writes `png` atomically, never over

@@ -45,7 +45,7 @@ void validate(const Camera& camera);
 // turntable_frames > 1 the distance fits all the orbits about `orbit_axis` that orbit() makes.
 Camera frame_box(const Aabb& box, const Eigen::Vector3d& from, const Eigen::Vector3d& up, double aspect,
                  bool ortho, double fov_y, int turntable_frames = 1,
-                 const Eigen::Vector3d& orbit_axis = Eigen::Vector3d::UnitY(), double margin = 1.08);
+                 const Eigen::Vector3d& orbit_axis = Eigen::Vector3d::UnitZ(), double margin = 1.08);
 
 // The camera rotated about the axis through its target (right-handed, radians): turntables.
 Camera orbit(const Camera& camera, const Eigen::Vector3d& axis, double angle);

@@ -41,7 +41,8 @@ struct SurfaceScalar {
 struct RenderSettings {
   int width = 512, height = 512;           // pixels
   Camera camera;
-  Eigen::Vector3d up = Eigen::Vector3d::UnitY();  // world up: the ground plane's normal, the light's frame
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // world up (+z, the tool's convention): the ground plane's
+                                                  // normal, the light's frame
   std::optional<Eigen::Vector3d> light;    // towards the key light, world; default: upper left, behind the camera
   bool shadows = true;
   bool ground = true;                      // a ground plane at the lowest point of the scene

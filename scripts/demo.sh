@@ -15,6 +15,6 @@ if "$bin" sdf --help >/dev/null 2>&1; then
   echo "outputs: $out/bunny.vdb"
 fi
 if "$bin" sample --help >/dev/null 2>&1; then
-  "$bin" sample "$root/assets/bunny.obj" -o "$out" --preview
+  "$bin" sample "$root/assets/bunny.obj" -o "$out" --preview --up 0,1,0  # the Stanford bunny stands on +y
   echo "outputs: $out/bunny.particles.ply $out/bunny.body.json $out/bunny.preview.png"
 fi

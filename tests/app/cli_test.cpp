@@ -3,6 +3,8 @@
 
 #include <filesystem>
 
+#include "core/mesh_io.h"
+#include "core/primitives.h"
 #include "tests/test_support.h"
 
 namespace ts {
@@ -78,6 +80,24 @@ TEST(CliInfo, ReportsHolesAndMassPropertiesAsJson) {
   ASSERT_EQ(test::run_tetrasand("info '" + test::assimp_model("STL/sphereWithHole.stl").string() + "'", &out), 0) << out;
   EXPECT_NE(out.find("boundary edges"), std::string::npos) << out;
   EXPECT_NE(out.find("none: the mesh does not enclose a volume"), std::string::npos) << out;
+}
+
+// One up convention (+z, issue 17): info names the tallest axis and, for a mesh tallest along y, the
+// --up option and the scene orientation that stand it on +z.
+TEST(CliInfo, ReportsTheTallestAxisAndHowToStandTheMeshOnZ) {
+  const auto dir = test::temp_dir();
+  write_obj(dir / "post.obj", make_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.02, 0.1, 0.03)));
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("info '" + (dir / "post.obj").string() + "'", &out), 0) << out;
+  EXPECT_NE(
+      out.find("up axis               tallest along y (0.1 m; z 0.03 m): tetrasand takes +z as up; if this "
+               "mesh stands along +y"),
+      std::string::npos)
+      << out;
+  EXPECT_NE(out.find("pass --up 0,1,0 to preview and sample"), std::string::npos) << out;
+  ASSERT_EQ(test::run_tetrasand("info --json '" + (dir / "post.obj").string() + "'", &out), 0) << out;
+  EXPECT_NE(out.find("\"tallest\": \"y\""), std::string::npos) << out;
+  EXPECT_NE(out.find("\"ambiguous\": false"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -2,11 +2,15 @@
 // clear errors with the documented exit codes for bad inputs.
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
+#include <algorithm>
+#include <cstdio>
+#include <utility>
 
 #include "core/atomic_file.h"
+#include "core/mesh_io.h"
+#include "core/primitives.h"
 #include "preview/image.h"
 #include "sdf/vdb_io.h"
 #include "tests/test_support.h"
@@ -146,6 +150,39 @@ TEST(CliPreview, ParticleDistanceIsInTheBodysRadiusWhateverTheDrawingRadius) {
   EXPECT_GT(mean, 0.1) << out;
   EXPECT_LT(mean, 1.0) << out;
   EXPECT_LT(max, 1.2) << out;
+}
+
+// Width and height [pixels] of what covers the transparent background.
+std::pair<int, int> silhouette(const preview::Image& image) {
+  int x0 = image.width, x1 = -1, y0 = image.height, y1 = -1;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      if (image.pixel(x, y)[3] > 0) {
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+  return {x1 - x0 + 1, y1 - y0 + 1};
+}
+
+// One up convention (+z, as in the simulator; issue 17): a post standing along z is upright in the
+// default side view (from +x), and lies on its side once --up says y.
+TEST(CliPreview, MeshesStandOnZUnlessUpSaysOtherwise) {
+  const auto dir = test::temp_dir();
+  write_obj(dir / "post.obj", make_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.02, 0.02, 0.1)));
+  std::string out;
+  for (const std::string up : {"", " --up 0,1,0"}) {
+    ASSERT_EQ(
+        test::run_tetrasand("preview " + q(dir / "post.obj") + " -o " + q(dir / "p.png") +
+                                " --size 64x64 --resolution 24 --view side --ortho --alpha --no-ground" + up,
+                            &out),
+        0)
+        << out;
+    const auto [w, h] = silhouette(preview::read_png(dir / "p.png"));
+    if (up.empty()) {
+      EXPECT_GT(h, 3 * w) << "upright by default: " << w << " x " << h;
+    } else {
+      EXPECT_GT(w, 3 * h) << "lying with --up y: " << w << " x " << h;
+    }
+  }
 }
 
 TEST(CliPreview, SimulationFramesArePngs) {
