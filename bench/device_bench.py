@@ -51,7 +51,7 @@ SIZES = {
 # Time caps (s). Full: 460 s of parts in a call of at most 8 minutes (unpacking and `devices` take the
 # rest); time a part leaves unused goes to the parts after it. Quick: loose, for 2 loaded cores.
 CAPS = {"full": {"sdf": 200, "sampler": 80, "sim": 130, "preview": 50},
-        "quick": {"sdf": 90, "sampler": 90, "sim": 150, "preview": 60}}
+        "quick": {"sdf": 90, "sampler": 90, "sim": 150, "preview": 120}}
 BINARIES = {"sdf": "tetrasand_bench_sdf", "sampler": "tetrasand", "sim": "tetrasand_bench_sim",
             "preview": "tetrasand_bench_preview"}
 
@@ -216,7 +216,7 @@ def run_part(r, part, cap):
     try:
         rc, secs, err, data = getattr(r, part)(cap)
         status, error = outcome(rc, err)
-        return dict(record, **data, status=status, seconds=round(secs, 2), error=error)
+        return dict(record, **data, status=status, seconds=round(secs, 2), error=error, stderr_tail=tail(err, 30))
     except (OSError, KeyError, tarfile.TarError) as e:  # a missing executable or mesh, a broken tarball: this part's error
         return dict(record, status="error", seconds=0.0, error=str(e))
 
@@ -228,7 +228,7 @@ def run(args):
     if unknown:
         raise SystemExit(f"--only: unknown part(s) {', '.join(unknown)} (parts: {', '.join(PARTS)})")
     caps = dict(CAPS[r.kind], **parse_caps(args.caps))
-    args.budget = args.budget or (400.0 if args.quick else 470.0)
+    args.budget = args.budget or (450.0 if args.quick else 470.0)
     os.makedirs(args.out, exist_ok=True)
     system_env = dict(os.environ)
     if args.libs:  # the children's, not this interpreter's: the loader read its path at start-up
@@ -388,7 +388,7 @@ def main():
     r.add_argument("--quick", action="store_true", help="tiny sizes: the whole chain in a few minutes on llvmpipe")
     r.add_argument("--only", help="comma-separated parts to run (others are recorded as skipped)")
     r.add_argument("--caps", help="part=seconds,... overriding the time caps")
-    r.add_argument("--budget", type=float, help="seconds for all parts together (default 470; --quick 400)")
+    r.add_argument("--budget", type=float, help="seconds for all parts together (default 470; --quick 450)")
     p = sub.add_parser("report", help="write the NVIDIA sections of docs/benchmarks.md from a results file")
     p.add_argument("results")
     p.add_argument("--markdown", default=os.path.join(ROOT, "docs", "benchmarks.md"))

@@ -52,6 +52,17 @@ fetch_gl_debs() {
     { echo "device-bench: apt-get download ${gl_packages[*]} failed; put the .debs in $root/.gl/" >&2; exit 1; }
 }
 
+# check_libraries STAGE: with STAGE/lib first on the path, every library each executable needs is found
+# there or is one of the system ones left out; else the bundle would fail on the device, not here.
+check_libraries() {
+  local bad
+  bad=$(for b in "$1"/bin/*; do LD_LIBRARY_PATH="$1/lib" ldd "$b"; done | awk '$2 == "=>" {print $1, $3}' |
+    while read -r name path; do
+      echo "$name" | grep -Eq "$system_libs" || [ "${path#"$1"/lib/}" != "$path" ] || echo "$name ($path)"
+    done | sort -u)
+  [ -z "$bad" ] || { echo "device-bench: not in the bundle: $bad" >&2; exit 1; }
+}
+
 prepare() {
   local build="$root/build-release" bundle="$root/.devbundle" do_build=1
   while [ $# -gt 0 ]; do
@@ -78,16 +89,17 @@ prepare() {
     while read -r lib; do
       basename "$lib" | grep -Eq "$system_libs" || cp -L "$lib" "$stage/lib/"
     done
+  check_libraries "$stage"
   cgal_mesh knot1 "$stage/meshes"
   cgal_mesh armadillo "$stage/meshes"
   rm -rf "$bundle" && mkdir -p "$bundle"
   tar -c -C "$stage" bin lib share meshes | xz -T0 >"$bundle/payload.tar.xz"
   rm -rf "$stage"
   fetch_gl_debs "$bundle/gl"
-  local size tree
+  local size tree debs=("$bundle"/gl/*.deb)
   size=$(du -sb "$bundle" | cut -f1)
   tree=$(cd "$root" && git ls-files -z --cached --others --exclude-standard | du -cb --files0-from=- 2>/dev/null | tail -n 1 | cut -f1)
-  echo "device-bench: $bundle is $((size / 1024)) KiB ($(ls "$bundle/gl" | wc -l) .debs, payload" \
+  echo "device-bench: $bundle is $((size / 1024)) KiB (${#debs[@]} .debs, payload" \
     "$(($(stat -c %s "$bundle/payload.tar.xz") / 1024)) KiB); with the working tree ($((tree / 1024)) KiB)" \
     "$(((size + tree) / 1024)) KiB of the $((carry_limit / 1024)) KiB a call carries"
   [ $((size + tree)) -le "$carry_limit" ] || { echo "device-bench: over the carry limit" >&2; exit 1; }
@@ -104,7 +116,8 @@ unpack_bundle() {
     ldconfig
   fi
   local nvidia=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
-  if [ -f "$nvidia" ] && ! compgen -G '/usr/share/glvnd/egl_vendor.d/*nvidia*' >/dev/null; then
+  if [ -f "$nvidia" ] && ! compgen -G '/usr/share/glvnd/egl_vendor.d/*nvidia*' >/dev/null &&
+    ! compgen -G '/etc/glvnd/egl_vendor.d/*nvidia*' >/dev/null; then
     export __EGL_VENDOR_LIBRARY_FILENAMES=$nvidia
   fi
 }
@@ -123,7 +136,10 @@ run() {
   done
   local bin="$build/bin"
   if [ -n "$bundle" ]; then
-    local dest="${TMPDIR:-/tmp}/tetrasand-device"
+    local dest
+    dest=$(mktemp -d "${TMPDIR:-/tmp}/tetrasand-device.XXXXXX")
+    # shellcheck disable=SC2064  # expanded now on purpose: dest is local to this function
+    trap "rm -rf '$dest'" EXIT
     unpack_bundle "$bundle" "$dest"
     bin="$dest/bin"
     pass+=(--meshes "$dest/meshes" --libs "$dest/lib")

@@ -82,6 +82,10 @@ def report(build):
     check("| knot1 | 6400 |" in doc and "| 1000 | double |" in doc, "the SDF and sim rows are in their sections")
     outside = lambda text: text.split("<!-- section: nvidia-sdf -->")[0]
     check(outside(doc) == outside(original), "the text before the NVIDIA sections is unchanged")
+    device_bench("report", results, "--markdown", copy, "--baseline", results)
+    sampler = open(copy).read().split("<!-- section: nvidia-sampler -->")[1].split("<!-- end: nvidia-sampler -->")[0]
+    check("| baseline s | speed-up |" in sampler and "| 1.0 |" in sampler,
+          "--baseline adds the baseline's time and the speed-up (1.0 against itself)")
     shutil.rmtree(tmp)
 
 
