@@ -63,6 +63,28 @@ check_libraries() {
   [ -z "$bad" ] || { echo "device-bench: not in the bundle: $bad" >&2; exit 1; }
 }
 
+# newest_version PREFIX STAGE: the highest symbol version PREFIX.* that STAGE's executables and libraries ask for.
+newest_version() {
+  for f in "$2"/bin/* "$2"/lib/*; do objdump -T "$f"; done | grep -o "$1\.[0-9.]*" | sort -uV | tail -n 1
+}
+
+# stage_payload BUILD STAGE: STAGE/bin (stripped executables), lib, share/tetrasand/shaders, meshes.
+stage_payload() {
+  mkdir -p "$2/bin" "$2/lib" "$2/share/tetrasand" "$2/meshes"
+  for b in "${binaries[@]}"; do
+    [ -x "$1/bin/$b" ] || { echo "device-bench: $1/bin/$b not built" >&2; exit 1; }
+    strip --strip-unneeded -o "$2/bin/$b" "$1/bin/$b"
+  done
+  cp -r "$1/share/tetrasand/shaders" "$2/share/tetrasand/"
+  for b in "${binaries[@]}"; do ldd "$1/bin/$b"; done | awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u |
+    while read -r lib; do
+      basename "$lib" | grep -Eq "$system_libs" || cp -L "$lib" "$2/lib/"
+    done
+  check_libraries "$2"
+  cgal_mesh knot1 "$2/meshes"
+  cgal_mesh armadillo "$2/meshes"
+}
+
 prepare() {
   local build="$root/build-release" bundle="$root/.devbundle" do_build=1
   while [ $# -gt 0 ]; do
@@ -77,23 +99,18 @@ prepare() {
     cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
     cmake --build "$build" -j "$(nproc)" --target "${binaries[@]}" tetrasand_shaders >/dev/null
   fi
+  if [ -e "$bundle" ] && [ ! -f "$bundle/payload.tar.xz" ] && [ -n "$(ls -A "$bundle")" ]; then
+    echo "device-bench: $bundle is not empty and holds no payload.tar.xz: not overwriting it" >&2
+    exit 1
+  fi
   local stage
   stage=$(mktemp -d "${TMPDIR:-/tmp}/device-bench-stage.XXXXXX")
-  mkdir -p "$stage/bin" "$stage/lib" "$stage/share/tetrasand" "$stage/meshes"
-  for b in "${binaries[@]}"; do
-    [ -x "$build/bin/$b" ] || { echo "device-bench: $build/bin/$b not built" >&2; exit 1; }
-    strip --strip-unneeded -o "$stage/bin/$b" "$build/bin/$b"
-  done
-  cp -r "$build/share/tetrasand/shaders" "$stage/share/tetrasand/"
-  for b in "${binaries[@]}"; do ldd "$build/bin/$b"; done | awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u |
-    while read -r lib; do
-      basename "$lib" | grep -Eq "$system_libs" || cp -L "$lib" "$stage/lib/"
-    done
-  check_libraries "$stage"
-  cgal_mesh knot1 "$stage/meshes"
-  cgal_mesh armadillo "$stage/meshes"
+  stage_payload "$build" "$stage"
   rm -rf "$bundle" && mkdir -p "$bundle"
   tar -c -C "$stage" bin lib share meshes | xz -T0 >"$bundle/payload.tar.xz"
+  # What the left-out system libraries must give there (the device image's glibc and libstdc++).
+  local needs
+  needs="glibc $(newest_version GLIBC_2 "$stage") and libstdc++ $(newest_version GLIBCXX_3 "$stage") or newer"
   rm -rf "$stage"
   fetch_gl_debs "$bundle/gl"
   local size tree debs=("$bundle"/gl/*.deb)
@@ -102,6 +119,7 @@ prepare() {
   echo "device-bench: $bundle is $((size / 1024)) KiB (${#debs[@]} .debs, payload" \
     "$(($(stat -c %s "$bundle/payload.tar.xz") / 1024)) KiB); with the working tree ($((tree / 1024)) KiB)" \
     "$(((size + tree) / 1024)) KiB of the $((carry_limit / 1024)) KiB a call carries"
+  echo "device-bench: the device machine needs $needs"
   [ $((size + tree)) -le "$carry_limit" ] || { echo "device-bench: over the carry limit" >&2; exit 1; }
 }
 
