@@ -191,10 +191,13 @@ def machine(bin_dir, system_env):
     except (OSError, subprocess.TimeoutExpired, AttributeError) as e:
         info["devices"] = f"tetrasand devices failed: {e}"
     smi = shutil.which("nvidia-smi")
-    if smi:
-        res = subprocess.run([smi, "--query-gpu=name,driver_version,memory.total", "--format=csv,noheader"],
-                             capture_output=True, text=True, env=system_env)
-        info["nvidia_smi"] = res.stdout.strip()
+    try:
+        if smi:
+            res = subprocess.run([smi, "--query-gpu=name,driver_version,memory.total", "--format=csv,noheader"],
+                                 capture_output=True, text=True, env=system_env, timeout=30)
+            info["nvidia_smi"] = res.stdout.strip()
+    except (OSError, subprocess.TimeoutExpired) as e:
+        info["nvidia_smi_error"] = str(e)
     return info
 
 
