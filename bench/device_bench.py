@@ -372,6 +372,10 @@ def load_results(path):
 
 def report(args):
     res = load_results(args.results)
+    renderer = res["machine"]["gl_renderer"]
+    if not args.allow_test and (res["kind"] != "full" or "NVIDIA" not in renderer):
+        raise SystemExit(f"{args.results}: a {res['kind']} run on {renderer or 'no GL device'}, not a full run on an "
+                         "NVIDIA GPU; the NVIDIA sections are for those (--allow-test writes it anyway)")
     baseline = load_results(args.baseline) if args.baseline else None
     for part, text in sections(res, baseline).items():
         if res["parts"][part]["status"] == "skipped":
@@ -396,6 +400,7 @@ def main():
     p.add_argument("results")
     p.add_argument("--markdown", default=os.path.join(ROOT, "docs", "benchmarks.md"))
     p.add_argument("--baseline", help="a results file of the same sizes run here (llvmpipe), for speed-ups")
+    p.add_argument("--allow-test", action="store_true", help="also write a --quick or non-NVIDIA run (tests)")
     args = ap.parse_args()
     run(args) if args.verb == "run" else report(args)
 

@@ -12,8 +12,9 @@
 #       installed), then runs SDF, sampler, sim and preview, each under its own time cap (bench/device_bench.py),
 #       into DIR/device-bench.json and DIR/device-bench.md (DIR: --out, else $OUT, else ./device-bench-out).
 #       Without a bundle it runs the build tree's binaries (default build-release).
-#   scripts/device-bench.sh report RESULTS.json [--markdown FILE] [--baseline HERE.json]
-#       here: rewrites the NVIDIA sections (nvidia-sdf, -sampler, -sim, -preview) of docs/benchmarks.md.
+#   scripts/device-bench.sh report RESULTS.json [--markdown FILE] [--baseline HERE.json] [--allow-test]
+#       here: rewrites the NVIDIA sections (nvidia-sdf, -sampler, -sim, -preview) of docs/benchmarks.md;
+#       a --quick or non-NVIDIA run only with --allow-test (the ctest writes into a copy).
 # One device call (README.md, "Benchmarks"): carry .devbundle, timeout_s 540, command
 #   scripts/device-bench.sh run --bundle .devbundle --out $OUT
 set -euo pipefail
@@ -169,5 +170,5 @@ case "$verb" in
   prepare) prepare "$@" ;;
   run) run "$@" ;;
   report) "$py" "$root/bench/device_bench.py" report "$@" ;;
-  *) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2 ;;
+  *) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2 ;;
 esac

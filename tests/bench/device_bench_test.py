@@ -70,7 +70,10 @@ def report(build):
     tmp = tempfile.mkdtemp(prefix="device-bench-report.")
     copy = os.path.join(tmp, "benchmarks.md")
     shutil.copy(DOCS, copy)
-    device_bench("report", results, "--markdown", copy)
+    refused = subprocess.run([SCRIPT, "report", results, "--markdown", copy], capture_output=True, text=True)
+    check(refused.returncode != 0 and "--allow-test" in refused.stderr and open(copy).read() == open(DOCS).read(),
+          "a quick llvmpipe run is refused without --allow-test, the file left as it was")
+    device_bench("report", results, "--markdown", copy, "--allow-test")
     doc, original = open(copy).read(), open(DOCS).read()
     check(hashlib.sha256(open(DOCS, "rb").read()).hexdigest() == before, "docs/benchmarks.md itself is untouched")
     for part in PARTS:
@@ -82,7 +85,7 @@ def report(build):
     check("| knot1 | 6400 |" in doc and "| 1000 | double |" in doc, "the SDF and sim rows are in their sections")
     outside = lambda text: text.split("<!-- section: nvidia-sdf -->")[0]
     check(outside(doc) == outside(original), "the text before the NVIDIA sections is unchanged")
-    device_bench("report", results, "--markdown", copy, "--baseline", results)
+    device_bench("report", results, "--markdown", copy, "--allow-test", "--baseline", results)
     sampler = open(copy).read().split("<!-- section: nvidia-sampler -->")[1].split("<!-- end: nvidia-sampler -->")[0]
     check("| baseline s | speed-up |" in sampler and "| 1.0 |" in sampler,
           "--baseline adds the baseline's time and the speed-up (1.0 against itself)")
