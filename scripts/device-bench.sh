@@ -170,5 +170,5 @@ case "$verb" in
   prepare) prepare "$@" ;;
   run) run "$@" ;;
   report) "$py" "$root/bench/device_bench.py" report "$@" ;;
-  *) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2 ;;
+  *) awk 'NR > 1 && !/^#/ {exit} NR > 1 {sub(/^# ?/, ""); print}' "$0" >&2; exit 2 ;;
 esac
