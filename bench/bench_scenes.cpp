@@ -4,8 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
+#include <cstdlib>
 #include <random>
+#include <utility>
 
 #include "sim/grain.h"
 #include "sim/scene_runner.h"
@@ -14,7 +15,10 @@
 namespace ts::bench {
 
 std::filesystem::path reference_scene(const std::string& name) {
-  return std::filesystem::path(TETRASAND_SOURCE_DIR) / "assets" / "scenes" / "reference" / name;
+  // A binary carried to another machine (scripts/device-bench.sh) finds the tree there by the variable.
+  const char* moved = std::getenv("TETRASAND_SOURCE_DIR");
+  const std::filesystem::path root = moved && *moved ? moved : TETRASAND_SOURCE_DIR;
+  return root / "assets" / "scenes" / "reference" / name;
 }
 
 sim::World settling_box(std::uint32_t grains, std::uint64_t seed) {

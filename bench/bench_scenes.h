@@ -11,7 +11,8 @@
 
 namespace ts::bench {
 
-// <repo>/assets/scenes/reference/<name>.
+// <repo>/assets/scenes/reference/<name>; <repo> is $TETRASAND_SOURCE_DIR where set, else the build's source
+// tree.
 std::filesystem::path reference_scene(const std::string& name);
 
 // `grains` tetrahedral grains (r = 1 mm, edge 2 mm, E = 10 MPa), randomly oriented on a lattice spaced

@@ -43,9 +43,7 @@ Timing time_renders(ts::preview::Renderer& renderer, const ts::preview::RenderSe
   return t;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   std::string mesh_path = TETRASAND_SOURCE_DIR "/assets/bunny.obj";
   int size = 1024, resolution = 512, repeat = 3;
   std::size_t particle_count = 1'000'000;
@@ -116,4 +114,16 @@ int main(int argc, char** argv) {
   fmt::print("per-pass GPU time, all renders of the SDF and the hybrid:\n{}\n", renderer.timing_report());
   fmt::print("per-pass GPU time, all renders of the impostors:\n{}", particles_only.timing_report());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    // A clear line and exit 1 (scripts/device-bench.sh records it as the part's error), not an abort.
+    fmt::print(stderr, "error: {}\n", e.what());
+    return 1;
+  }
 }

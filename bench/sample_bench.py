@@ -83,14 +83,21 @@ def quality(points, mesh, probes, radius):
             "c_over_dhex": c / d_hex, "phi_over_r": phi / radius}
 
 
-def run_tetrasand(exe, mesh_path, count, out, extra=()):
+def run_sample(exe, mesh_path, count, out, extra=(), timeout=None):
+    """`tetrasand sample --json`: (body.json summary, wall seconds, what it printed after the JSON, e.g.
+    --timings' table). Raises RuntimeError on failure, subprocess.TimeoutExpired past `timeout` s."""
     cmd = [exe, "-q", "sample", mesh_path, "-o", out, "--count", str(count), "--json", *extra]
     t = time.perf_counter()
-    res = subprocess.run(cmd, capture_output=True, text=True)
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     seconds = time.perf_counter() - t
     if res.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed: {res.stdout}{res.stderr}")
-    body = json.loads(res.stdout[res.stdout.index("{"):])
+    body, end = json.JSONDecoder().raw_decode(res.stdout, res.stdout.index("{"))
+    return body, seconds, res.stdout[end:].strip()
+
+
+def run_tetrasand(exe, mesh_path, count, out, extra=()):
+    body, seconds, _ = run_sample(exe, mesh_path, count, out, extra)
     stem = os.path.splitext(os.path.basename(mesh_path))[0]
     return body, read_ply_points(os.path.join(out, stem + ".particles.ply")), seconds
 

@@ -1,9 +1,11 @@
 // Cundall number (grain time steps per second) of the GPU pipeline and of the CPU reference on the
 // same scenes, in one run, as ratios, from 1k to 1M grains; memory per grain of both. Usage:
 //   tetrasand_bench_sim [--grains 1000,8000,64000,512000,1000000] [--seconds 2] [--min-steps 2]
-//                       [--precision float|double] [--csv FILE]
+//                       [--precision float|double|float,double] [--csv FILE]
 // The scene of every size is the settled bed of bench/bench_scenes.h (reference/bed_tile.toml copied
 // side by side), so each size sees the same contacts per grain. scripts/bench.sh sim plots the CSV.
+// With two precisions the CPU reference is measured once per size and each GPU precision gets a row.
+// The CSV is rewritten (atomically) after every size, so a run stopped at its time cap keeps its rows.
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -29,7 +31,7 @@ struct Options {
   std::vector<std::uint32_t> grains{1000, 8000, 64000, 512000, 1000000};
   double seconds = 2.0;  // wall time per measurement (at least min_steps steps)
   int min_steps = 2;
-  ts::sim::Precision precision = ts::sim::Precision::Float;
+  std::vector<ts::sim::Precision> precisions{ts::sim::Precision::Float};
   std::string csv;
 };
 
@@ -50,9 +52,13 @@ Options parse(int argc, char** argv) {
     } else if (arg == "--min-steps") {
       o.min_steps = std::max(1, std::stoi(next()));
     } else if (arg == "--precision") {
-      const std::string p = next();
-      if (p != "float" && p != "double") throw std::runtime_error("--precision: expected float or double, got " + p);
-      o.precision = p == "double" ? ts::sim::Precision::Double : ts::sim::Precision::Float;
+      o.precisions.clear();
+      std::stringstream list(next());
+      for (std::string p; std::getline(list, p, ',');) {
+        if (p != "float" && p != "double")
+          throw std::runtime_error("--precision: expected float or double, got " + p);
+        o.precisions.push_back(p == "double" ? ts::sim::Precision::Double : ts::sim::Precision::Float);
+      }
     } else if (arg == "--csv") {
       o.csv = next();
     } else {
@@ -94,12 +100,15 @@ Rate measure(StepFn step, SyncFn sync, double seconds, int min_steps, int batch)
   return r;
 }
 
+// One size: the CPU reference once, then one GPU measurement per precision asked for.
 struct Row {
   std::size_t grains = 0, particles = 0;
   double contacts_per_grain = 0;
   double dt = 0;  // s
-  Rate gpu, cpu;
-  double gpu_bytes_per_grain = 0, cpu_bytes_per_grain = 0;
+  Rate cpu;
+  double cpu_bytes_per_grain = 0;
+  std::vector<Rate> gpu;                    // one per Options::precisions
+  std::vector<double> gpu_bytes_per_grain;  // likewise
 };
 
 Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Options& options) {
@@ -123,11 +132,33 @@ Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Optio
     row.cpu_bytes_per_grain = (resident_bytes() - before) / static_cast<double>(row.grains);
     row.contacts_per_grain = static_cast<double>(stats.contacts + stats.wall_contacts) / static_cast<double>(row.grains);
   }
-  ts::sim::GpuStepper gpu(context, bed.world, bed.settings, options.precision);
-  row.gpu = measure([&](int n) { gpu.step(n); }, [&] { context.finish(); }, options.seconds,
-                    options.min_steps, batch);
-  row.gpu_bytes_per_grain = static_cast<double>(gpu.gpu_bytes()) / static_cast<double>(row.grains);
+  for (const ts::sim::Precision precision : options.precisions) {
+    ts::sim::GpuStepper gpu(context, bed.world, bed.settings, precision);
+    row.gpu.push_back(measure([&](int n) { gpu.step(n); }, [&] { context.finish(); }, options.seconds,
+                              options.min_steps, batch));
+    row.gpu_bytes_per_grain.push_back(static_cast<double>(gpu.gpu_bytes()) / static_cast<double>(row.grains));
+  }
   return row;
+}
+
+const char* precision_name(ts::sim::Precision p) {
+  return p == ts::sim::Precision::Double ? "double" : "float";
+}
+
+// The printed line and the CSV row of one size and precision k.
+std::string report_row(const Row& r, std::size_t k, ts::sim::Precision precision,
+                       const std::string& renderer) {
+  const double g = r.gpu[k].steps_per_second * static_cast<double>(r.grains);
+  const double c = r.cpu.steps_per_second * static_cast<double>(r.grains);
+  fmt::print(
+      "grains {:>8}: {:.1f} contacts/grain; GPU {} {:.3g} grain-steps/s ({} steps), CPU reference {:.3g} "
+      "grain-steps/s ({} steps), ratio {:.2f}; memory per grain GPU {:.0f} B, CPU {:.0f} B\n",
+      r.grains, r.contacts_per_grain, precision_name(precision), g, r.gpu[k].steps, c, r.cpu.steps, g / c,
+      r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain);
+  std::fflush(stdout);
+  return fmt::format("{},{},{:.3f},{:.4g},{},{:.5g},{},{:.5g},{:.4f},{:.1f},{:.1f},{},\"{}\"\n", r.grains,
+                     r.particles, r.contacts_per_grain, r.dt, r.gpu[k].steps, g, r.cpu.steps, c, g / c,
+                     r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain, precision_name(precision), renderer);
 }
 
 }  // namespace
@@ -142,20 +173,10 @@ int main(int argc, char** argv) {
         "gpu_over_cpu,gpu_bytes_per_grain,cpu_bytes_per_grain,precision,renderer\n";
     for (std::uint32_t requested : options.grains) {
       const Row r = measure_size(context, requested, options);
-      const double g = r.gpu.steps_per_second * static_cast<double>(r.grains);
-      const double c = r.cpu.steps_per_second * static_cast<double>(r.grains);
-      fmt::print(
-          "grains {:>8}: {:.1f} contacts/grain; GPU {:.3g} grain-steps/s ({} steps), CPU reference {:.3g} "
-          "grain-steps/s ({} steps), ratio {:.2f}; memory per grain GPU {:.0f} B, CPU {:.0f} B\n",
-          r.grains, r.contacts_per_grain, g, r.gpu.steps, c, r.cpu.steps, g / c, r.gpu_bytes_per_grain,
-          r.cpu_bytes_per_grain);
-      std::fflush(stdout);
-      csv += fmt::format("{},{},{:.3f},{:.4g},{},{:.5g},{},{:.5g},{:.4f},{:.1f},{:.1f},{},\"{}\"\n", r.grains,
-                         r.particles, r.contacts_per_grain, r.dt, r.gpu.steps, g,
-                         r.cpu.steps, c, g / c, r.gpu_bytes_per_grain, r.cpu_bytes_per_grain,
-                         options.precision == ts::sim::Precision::Double ? "double" : "float", context.summary());
+      for (std::size_t k = 0; k < options.precisions.size(); ++k)
+        csv += report_row(r, k, options.precisions[k], context.summary());
+      if (!options.csv.empty()) ts::write_file_atomically(options.csv, csv);
     }
-    if (!options.csv.empty()) ts::write_file_atomically(options.csv, csv);
     return 0;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());

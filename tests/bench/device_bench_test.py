@@ -1,0 +1,121 @@
+#!/usr/bin/python3
+"""CTest checks of scripts/device-bench.sh on llvmpipe, at the --quick sizes (label device-bench):
+  device_bench_test.py quick BUILD_DIR    the whole chain: every part recorded, each ok with rows
+  device_bench_test.py report BUILD_DIR   `report` on quick's results, into a copy of docs/benchmarks.md
+  device_bench_test.py caps BUILD_DIR     a part past its cap is stopped and recorded, the next still runs,
+                                          a missing executable is that part's error, not the run's
+Exit status 0 when every check holds; each failed check is printed."""
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SCRIPT = os.path.join(ROOT, "scripts", "device-bench.sh")
+DOCS = os.path.join(ROOT, "docs", "benchmarks.md")
+PARTS = ["sdf", "sampler", "sim", "preview"]
+failures = []
+
+
+def check(ok, what):
+    print(("ok:   " if ok else "FAIL: ") + what)
+    if not ok:
+        failures.append(what)
+
+
+def device_bench(*args):
+    res = subprocess.run([SCRIPT, *args], capture_output=True, text=True)
+    print(res.stdout + res.stderr)
+    check(res.returncode == 0, f"device-bench.sh {' '.join(args)} exits 0 (got {res.returncode})")
+
+
+def quick_dir(build):
+    return os.path.join(build, "device-bench-quick")
+
+
+def quick(build):
+    out = quick_dir(build)
+    shutil.rmtree(out, ignore_errors=True)
+    device_bench("run", "--quick", "--build-dir", build, "--out", out)
+    res = json.load(open(os.path.join(out, "device-bench.json")))
+    m = res["machine"]
+    check(res["kind"] == "quick", "the results say they are of the --quick sizes")
+    check(bool(m["gl_renderer"]) and bool(m["gl_version"]), f"GL_RENDERER and GL_VERSION recorded: {m['gl_device']}")
+    check(len(m["date"]) == 20 and m["cores"] == os.cpu_count(), f"date and cores recorded: {m['date']}")
+    for part in PARTS:
+        p = res["parts"].get(part, {})
+        check(p.get("status") == "ok", f"{part}: status ok (got {p.get('status')}: {p.get('error')})")
+        check(len(p.get("rows", [])) > 0, f"{part}: has rows")
+        check(0 < p.get("seconds", 0) <= p.get("cap_s", 0), f"{part}: took {p.get('seconds')} s within its cap")
+    sdf = res["parts"]["sdf"]["rows"]
+    check(len(sdf) == 4 and all(int(r["gpu_wrong_signs"]) == 0 for r in sdf), "sdf: 2 meshes x 2 grids, no wrong sign")
+    sim = res["parts"]["sim"]["rows"]
+    check(sorted(r["precision"] for r in sim) == ["double", "float"], "sim: a float and a double row")
+    sampler = res["parts"]["sampler"]["rows"]
+    check(all(r["status"] == "ok" and "sampler/relax.comp" in r["timings"] for r in sampler),
+          "sampler: every count ok, with its per-kernel times")
+    check(len(res["parts"]["preview"]["rows"]) == 3, "preview: SDF, impostor and hybrid rows")
+    md = open(os.path.join(out, "device-bench.md")).read()
+    check(all(f"### {t} on an NVIDIA GPU" in md for t in ("SDF", "Sampling", "Simulation", "Preview")),
+          "device-bench.md has the four sections")
+
+
+def report(build):
+    results = os.path.join(quick_dir(build), "device-bench.json")
+    res = json.load(open(results))
+    before = hashlib.sha256(open(DOCS, "rb").read()).hexdigest()
+    tmp = tempfile.mkdtemp(prefix="device-bench-report.")
+    copy = os.path.join(tmp, "benchmarks.md")
+    shutil.copy(DOCS, copy)
+    refused = subprocess.run([SCRIPT, "report", results, "--markdown", copy], capture_output=True, text=True)
+    check(refused.returncode != 0 and "--allow-test" in refused.stderr and open(copy).read() == open(DOCS).read(),
+          "a quick llvmpipe run is refused without --allow-test, the file left as it was")
+    device_bench("report", results, "--markdown", copy, "--allow-test")
+    doc, original = open(copy).read(), open(DOCS).read()
+    check(hashlib.sha256(open(DOCS, "rb").read()).hexdigest() == before, "docs/benchmarks.md itself is untouched")
+    for part in PARTS:
+        start, end = f"<!-- section: nvidia-{part} -->\n", f"<!-- end: nvidia-{part} -->"
+        body = doc[doc.index(start) + len(start):doc.index(end)]
+        check(res["machine"]["gl_renderer"] in body and res["machine"]["date"][:10] in body,
+              f"nvidia-{part}: names the GL renderer and the date")
+        check("Not an NVIDIA GPU" in body, f"nvidia-{part}: an llvmpipe run is labelled as not NVIDIA")
+    check("| knot1 | 6400 |" in doc and "| 1000 | double |" in doc, "the SDF and sim rows are in their sections")
+    outside = lambda text: text.split("<!-- section: nvidia-sdf -->")[0]
+    check(outside(doc) == outside(original), "the text before the NVIDIA sections is unchanged")
+    device_bench("report", results, "--markdown", copy, "--allow-test", "--baseline", results)
+    sampler = open(copy).read().split("<!-- section: nvidia-sampler -->")[1].split("<!-- end: nvidia-sampler -->")[0]
+    check("| baseline s | speed-up |" in sampler and "| 1.0 |" in sampler,
+          "--baseline adds the baseline's time and the speed-up (1.0 against itself)")
+    shutil.rmtree(tmp)
+
+
+def caps(build):
+    """sdf stopped at a 0.5 s cap, sampler still run, sim without its executable: an error record."""
+    tmp = tempfile.mkdtemp(prefix="device-bench-caps.")
+    fake = os.path.join(tmp, "bin")
+    os.makedirs(fake)
+    for exe in ("tetrasand", "tetrasand_bench_sdf"):
+        os.symlink(os.path.join(build, "bin", exe), os.path.join(fake, exe))
+    out = os.path.join(tmp, "out")
+    res = subprocess.run([sys.executable, os.path.join(ROOT, "bench", "device_bench.py"), "run", "--quick", "--bin",
+                          fake, "--out", out, "--only", "sdf,sampler,sim", "--caps", "sdf=0.5"],
+                         capture_output=True, text=True)
+    print(res.stdout + res.stderr)
+    parts = json.load(open(os.path.join(out, "device-bench.json")))["parts"]
+    check(parts["sdf"]["status"] == "timeout" and parts["sdf"]["seconds"] < 5,
+          f"sdf: recorded as timeout after {parts['sdf'].get('seconds')} s")
+    check(parts["sampler"]["status"] == "ok", f"sampler: still ran after the timeout ({parts['sampler']['status']})")
+    check(parts["sim"]["status"] == "error" and "tetrasand_bench_sim" in parts["sim"]["error"],
+          f"sim: error naming the missing executable ({parts['sim']['error']})")
+    check(parts["preview"]["status"] == "skipped", "preview: skipped (not in --only)")
+    shutil.rmtree(tmp)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3 or sys.argv[1] not in ("quick", "report", "caps"):
+        sys.exit(__doc__)
+    {"quick": quick, "report": report, "caps": caps}[sys.argv[1]](os.path.abspath(sys.argv[2]))
+    sys.exit(1 if failures else 0)
