@@ -98,7 +98,7 @@ void judge_thin_features(const ThinFeatures& thin, double radius, const VerdictT
                         largest.resolving_radius, radius, 100.0 * largest.area_share)
           : std::string("no smaller radius resolves the largest (a knife edge or a sliver)");
   if (thin.area_share <= t.max_thin_share) {
-    out.push_back({Verdict::Ok, fmt::format("{} only ({})", share, remedy)});
+    out.push_back({Verdict::Ok, fmt::format("{} only: {}", share, remedy)});
   } else {
     out.push_back(
         {Verdict::Caveats, fmt::format("{}: particles of both sides overlap there; {}", share, remedy)});

@@ -52,6 +52,14 @@ std::string all_reasons(const BodyVerdict& v) {
   return out;
 }
 
+// Judges `b` and checks the verdict and that one reason contains `text`.
+void expect_judged(const body::ParticleBody& b, Verdict expected, const std::string& text,
+                   const ThinFeatures& thin = {}) {
+  const BodyVerdict v = judge_body(b, thin);
+  EXPECT_EQ(v.verdict, expected) << all_reasons(v);
+  EXPECT_TRUE(mentions(v, text)) << "'" << text << "' not in: " << all_reasons(v);
+}
+
 TEST(BodyVerdict, ACertifiedConvergedEvenBodyIsOkAndListsTheChecksItPassed) {
   const BodyVerdict v = judge_body(good_body(), ThinFeatures{});
   EXPECT_EQ(v.verdict, Verdict::Ok) << all_reasons(v);
@@ -64,11 +72,9 @@ TEST(BodyVerdict, ACertifiedConvergedEvenBodyIsOkAndListsTheChecksItPassed) {
 TEST(BodyVerdict, AnUncertifiedBoundSlightlyAboveOneIsACaveatNamingTheGrainsThatLeak) {
   body::ParticleBody b = good_body();
   uncertify(b, 1.1);
-  const BodyVerdict v = judge_body(b, ThinFeatures{});
-  EXPECT_EQ(v.verdict, Verdict::Caveats) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "coverage NOT certified: covering radius <= 1.100 r")) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "grains smaller than 0.10 r")) << all_reasons(v);
-  EXPECT_STREQ(verdict_name(v.verdict), "usable with caveats");
+  expect_judged(b, Verdict::Caveats, "coverage NOT certified: covering radius <= 1.100 r");
+  expect_judged(b, Verdict::Caveats, "grains smaller than 0.10 r");
+  EXPECT_STREQ(verdict_name(Verdict::Caveats), "usable with caveats");
 }
 
 TEST(BodyVerdict, AnUncertifiedBoundWellAboveOneIsNotUsable) {
@@ -76,85 +82,65 @@ TEST(BodyVerdict, AnUncertifiedBoundWellAboveOneIsNotUsable) {
   uncertify(b, 1.5);  // at the threshold: still a caveat
   EXPECT_EQ(judge_body(b, ThinFeatures{}).verdict, Verdict::Caveats);
   uncertify(b, 1.6);
-  const BodyVerdict v = judge_body(b, ThinFeatures{});
-  EXPECT_EQ(v.verdict, Verdict::NotUsable) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "above 1.5 r")) << all_reasons(v);
-  EXPECT_STREQ(verdict_name(v.verdict), "not usable");
+  expect_judged(b, Verdict::NotUsable, "above 1.5 r");
+  EXPECT_STREQ(verdict_name(Verdict::NotUsable), "not usable");
 }
 
 TEST(BodyVerdict, ABodyWithoutACertificateIsJudgedByItsProbesAndNeverOk) {
   body::ParticleBody b = good_body();
   b.quality.certificate.reset();
-  BodyVerdict v = judge_body(b, ThinFeatures{});
-  EXPECT_EQ(v.verdict, Verdict::Caveats) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "no coverage certificate: probes found covering radius 0.950 r")) << all_reasons(v);
+  expect_judged(b, Verdict::Caveats, "no coverage certificate: probes found covering radius 0.950 r");
   b.quality.covering_over_r = 1.7;
-  v = judge_body(b, ThinFeatures{});
-  EXPECT_EQ(v.verdict, Verdict::NotUsable) << all_reasons(v);
+  expect_judged(b, Verdict::NotUsable, "no coverage certificate: probes found covering radius 1.700 r");
 }
 
 TEST(BodyVerdict, AnUnconvergedRelaxationIsACaveat) {
   body::ParticleBody b = good_body();
   b.quality.converged = false;
   b.quality.iterations = 50;
-  const BodyVerdict v = judge_body(b, ThinFeatures{});
-  EXPECT_EQ(v.verdict, Verdict::Caveats) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "relaxation NOT converged after 50 iterations")) << all_reasons(v);
+  expect_judged(b, Verdict::Caveats, "relaxation NOT converged after 50 iterations");
 }
 
 TEST(BodyVerdict, UnevenSpacingIsACaveatByRhoOrByCv) {
   body::ParticleBody b = good_body();
   b.quality.relative_radius = 0.45;
-  BodyVerdict v = judge_body(b, ThinFeatures{});
-  EXPECT_EQ(v.verdict, Verdict::Caveats) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "uneven spacing: rho 0.450")) << all_reasons(v);
+  expect_judged(b, Verdict::Caveats, "uneven spacing: rho 0.450");
   b = good_body();
   b.quality.cv = 0.12;
-  v = judge_body(b, ThinFeatures{});
-  EXPECT_EQ(v.verdict, Verdict::Caveats) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "CV 0.120")) << all_reasons(v);
+  expect_judged(b, Verdict::Caveats, "CV 0.120");
   b.quality.relative_radius = 0.5, b.quality.cv = 0.1;  // at both thresholds: even
   EXPECT_EQ(judge_body(b, ThinFeatures{}).verdict, Verdict::Ok);
 }
 
 TEST(BodyVerdict, ThinFeaturesOnMoreThanOnePercentOfTheAreaAreACaveatWithTheRadiusThatResolvesThem) {
   const body::ParticleBody b = good_body();
-  BodyVerdict v = judge_body(b, thin_on(0.3));
-  EXPECT_EQ(v.verdict, Verdict::Caveats) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "thin features on 30.00 % of the area in 1 region")) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "--radius 0.0068 (now 0.01) resolves the largest")) << all_reasons(v);
-  v = judge_body(b, thin_on(0.0045));  // the bunny's ear tips at 4,000 particles
-  EXPECT_EQ(v.verdict, Verdict::Ok) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "thin features on 0.45 % of the area in 1 region only")) << all_reasons(v);
+  expect_judged(b, Verdict::Caveats, "thin features on 30.00 % of the area in 1 region", thin_on(0.3));
+  expect_judged(b, Verdict::Caveats, "--radius 0.0068 (now 0.01) resolves the largest", thin_on(0.3));
+  // The bunny's ear tips at 4,000 particles: named, not a caveat.
+  expect_judged(b, Verdict::Ok, "thin features on 0.45 % of the area in 1 region only", thin_on(0.0045));
 }
 
 TEST(BodyVerdict, ParticlesOffTheMeshAreACaveatThenNotUsable) {
   body::ParticleBody b = good_body();
   b.quality.max_abs_phi_over_r = 0.01;
-  EXPECT_EQ(judge_body(b, ThinFeatures{}).verdict, Verdict::Caveats);
+  expect_judged(b, Verdict::Caveats, "some particles are off the mesh");
   b.quality.max_abs_phi_over_r = 0.2;
-  const BodyVerdict v = judge_body(b, ThinFeatures{});
-  EXPECT_EQ(v.verdict, Verdict::NotUsable) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "the particles are off the mesh")) << all_reasons(v);
+  expect_judged(b, Verdict::NotUsable, "the particles are off the mesh");
 }
 
 TEST(BodyVerdict, InvalidMassPropertiesAreNotUsable) {
   body::ParticleBody b = good_body();
   b.mass = 0.0;
-  EXPECT_EQ(judge_body(b, ThinFeatures{}).verdict, Verdict::NotUsable);
+  expect_judged(b, Verdict::NotUsable, "mass properties invalid");
   b = good_body();
   b.principal_moments = Eigen::Vector3d(1e-4, 1e-4, 3e-4);  // no mass distribution has these
-  const BodyVerdict v = judge_body(b, ThinFeatures{});
-  EXPECT_EQ(v.verdict, Verdict::NotUsable) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "mass properties invalid")) << all_reasons(v);
+  expect_judged(b, Verdict::NotUsable, "mass properties invalid");
 }
 
 TEST(BodyVerdict, AnOpenMeshSampledByWindingNumberIsACaveat) {
   body::ParticleBody b = good_body();
   b.mass_method = body::MassMethod::WindingCells;
-  const BodyVerdict v = judge_body(b, ThinFeatures{});
-  EXPECT_EQ(v.verdict, Verdict::Caveats) << all_reasons(v);
-  EXPECT_TRUE(mentions(v, "holes are not covered")) << all_reasons(v);
+  expect_judged(b, Verdict::Caveats, "holes are not covered");
 }
 
 TEST(BodyVerdict, ReasonsListEveryShortcomingWorstFirstAndNoPassedCheck) {
