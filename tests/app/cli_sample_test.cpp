@@ -404,6 +404,32 @@ TEST(CliSample, BatchWritesASummaryAndAFailureDoesNotStopIt) {
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "cube.body.json"));
 }
 
+// --strict in a batch: every mesh is still converted and written; a body short of OK is its row's
+// exit code 1 and the batch's.
+TEST(CliSample, StrictBatchConvertsEveryMeshAndExitsOneForABodyShortOfOk) {
+  const auto dir = test::temp_dir();
+  const auto list = dir / "meshes.txt";
+  std::ofstream(list) << test::asset("sphere.obj").string() << "\n"
+                      << test::asset("plate.obj").string() << "\n";
+  const std::string out =
+      sample_fast("sample @" + quoted(list) + " -o " + quoted(dir / "out") + " --strict", 1);
+  EXPECT_NE(out.find("2 of 2 meshes converted, 1 of them short of 'body OK' (exit 1: --strict)"),
+            std::string::npos)
+      << out;
+  const auto rows = read_csv(dir / "out" / "summary.csv");
+  ASSERT_EQ(rows.size(), 3u) << out;
+  const auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(rows[0].begin(), rows[0].end(), name) - rows[0].begin());
+  };
+  EXPECT_EQ(rows[1][column("verdict")], "body OK");
+  EXPECT_EQ(rows[1][column("exit_code")], "0");
+  EXPECT_EQ(rows[2][column("verdict")], "usable with caveats");
+  EXPECT_NE(rows[2][column("verdict_reasons")].find("thin features"), std::string::npos);
+  EXPECT_EQ(rows[2][column("status")], "ok");
+  EXPECT_EQ(rows[2][column("exit_code")], "1");
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "plate.body.json"));
+}
+
 TEST(CliSample, ShardsSplitTheListDeterministicallyAndCoverItOnce) {
   const auto dir = test::temp_dir();
   const auto list = dir / "meshes.txt";
