@@ -299,12 +299,10 @@ void print_thin_features(const sampler::ThinFeatures& thin, double r) {
       rest += g.area_share;
       continue;
     }
-    const std::string remedy = g.resolving_radius > 0.0
-                                   ? fmt::format("--radius {:.3g} resolves it", g.resolving_radius)
-                                   : std::string("a knife edge or a sliver: no radius resolves it");
     fmt::print(
         "                   {:.2f} % of the area, {} triangle{}, {}, {:.3g} m thick at the thinnest: {}\n",
-        100.0 * g.area_share, g.triangles, g.triangles == 1 ? "" : "s", box_text(g.box), g.thinnest, remedy);
+        100.0 * g.area_share, g.triangles, g.triangles == 1 ? "" : "s", box_text(g.box), g.thinnest,
+        sampler::resolving_radii_text(g));
   }
   if (listed < thin.regions.size()) {
     fmt::print("                   and {} more regions ({:.2f} % of the area)\n",
@@ -321,7 +319,8 @@ nlohmann::json thin_features_json(const sampler::ThinFeatures& thin) {
                        {"triangles", g.triangles},
                        {"area_share", g.area_share},
                        {"thinnest", g.thinnest},
-                       {"resolving_radius", g.resolving_radius}});
+                       {"resolving_radius", g.resolving_radius},
+                       {"mostly_resolving_radius", g.mostly_resolving_radius}});
   }
   return {{"threshold", thin.threshold},
           {"triangles", thin.triangles},

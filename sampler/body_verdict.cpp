@@ -92,11 +92,8 @@ void judge_thin_features(const ThinFeatures& thin, double radius, const VerdictT
       fmt::format("thin features on {:.2f} % of the area in {} region{}", 100.0 * thin.area_share,
                   thin.regions.size(), thin.regions.size() == 1 ? "" : "s");
   const ThinRegion& largest = thin.regions.front();
-  const std::string remedy =
-      largest.resolving_radius > 0.0
-          ? fmt::format("--radius {:.3g} (now {:.3g}) resolves the largest ({:.2f} % of the area)",
-                        largest.resolving_radius, radius, 100.0 * largest.area_share)
-          : std::string("no smaller radius resolves the largest (a knife edge or a sliver)");
+  const std::string remedy = fmt::format("the largest ({:.2f} % of the area): {} (now {:.3g})",
+                                         100.0 * largest.area_share, resolving_radii_text(largest), radius);
   if (thin.area_share <= t.max_thin_share) {
     out.push_back({Verdict::Ok, fmt::format("{} only: {}", share, remedy)});
   } else {

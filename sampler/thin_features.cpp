@@ -1,10 +1,11 @@
 #include "sampler/thin_features.h"
 
+#include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <limits>
 #include <unordered_map>
+#include <utility>
 
 #include "core/union_find.h"
 
@@ -73,6 +74,19 @@ std::vector<std::uint32_t> connected_regions(const TriangleMesh& mesh, const std
   return region;
 }
 
+// The thickness [m] at which the thinner triangles of a region (thickness, area pairs) first hold
+// `share` of its area: every triangle at least that thick holds the other 1 - share or more.
+double thickness_at_area_share(std::vector<std::pair<double, double>> pieces, double share) {
+  std::sort(pieces.begin(), pieces.end());
+  double total = 0.0, below = 0.0;
+  for (const auto& p : pieces) total += p.second;
+  for (const auto& [thickness, area] : pieces) {
+    below += area;
+    if (below >= share * total) return thickness;
+  }
+  return pieces.back().first;
+}
+
 // The regions of the thin triangles `thin` (local thicknesses `thickness` [m]), largest area first.
 ThinFeatures summarise_regions(const TriangleMesh& mesh, const std::vector<std::uint32_t>& thin,
                                const std::vector<double>& thickness, double spacing, double radius) {
@@ -82,19 +96,24 @@ ThinFeatures summarise_regions(const TriangleMesh& mesh, const std::vector<std::
   std::size_t count = 0;
   const std::vector<std::uint32_t> region = connected_regions(mesh, thin, count);
   out.regions.assign(count, ThinRegion{});
-  for (auto& r : out.regions) r.thinnest = std::numeric_limits<double>::infinity();
+  std::vector<std::vector<std::pair<double, double>>> pieces(count);  // (thickness, area) per region
   for (std::size_t k = 0; k < thin.size(); ++k) {
     ThinRegion& r = out.regions[region[k]];
     for (const std::uint32_t v : mesh.triangles[thin[k]]) r.box.extend(mesh.vertices[v]);
     ++r.triangles;
-    r.area += triangle_area(mesh, thin[k]);
-    r.thinnest = std::min(r.thinnest, thickness[k]);
+    pieces[region[k]].emplace_back(thickness[k], triangle_area(mesh, thin[k]));
+    r.area += pieces[region[k]].back().second;
     out.where.extend(centroid_of(mesh, thin[k]));
   }
   const double total_area = surface_area(mesh);
-  for (auto& r : out.regions) {
+  const double radius_per_thickness = kResolvingMargin * radius / (kThinOverSpacing * spacing);
+  for (std::size_t g = 0; g < count; ++g) {
+    ThinRegion& r = out.regions[g];
     r.area_share = r.area / total_area;
-    r.resolving_radius = kResolvingMargin * r.thinnest * radius / (kThinOverSpacing * spacing);
+    r.thinnest = thickness_at_area_share(pieces[g], 0.0);
+    r.resolving_radius = radius_per_thickness * r.thinnest;
+    r.mostly_resolving_radius =
+        radius_per_thickness * thickness_at_area_share(pieces[g], 1.0 - kMostlyResolved);
     out.area_share += r.area_share;
   }
   std::stable_sort(out.regions.begin(), out.regions.end(),
@@ -103,6 +122,19 @@ ThinFeatures summarise_regions(const TriangleMesh& mesh, const std::vector<std::
 }
 
 }  // namespace
+
+std::string resolving_radii_text(const ThinRegion& region) {
+  const auto radius = [](double r) {
+    return r > 0.0 ? fmt::format("--radius {:.3g}", r) : std::string("no radius");
+  };
+  if (region.mostly_resolving_radius == region.resolving_radius) {
+    return region.resolving_radius > 0.0 ? radius(region.resolving_radius) + " resolves all of it"
+                                         : "no radius resolves it (a knife edge or a sliver)";
+  }
+  return fmt::format("{} resolves {:.0f} % of it, {} all of it{}", radius(region.mostly_resolving_radius),
+                     100.0 * kMostlyResolved, radius(region.resolving_radius),
+                     region.resolving_radius > 0.0 ? "" : " (a knife edge or a sliver)");
+}
 
 ThinFeatures find_thin_features(const TriangleMesh& mesh, const sdf::ExactDistance& exact, double spacing,
                                 double radius) {

@@ -5,6 +5,7 @@
 // surface and the particle radius that would resolve it. docs/body-format.md ("Verdict") says how
 // `tetrasand sample` judges them.
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "core/mesh.h"
@@ -19,6 +20,10 @@ inline constexpr double kThinOverSpacing = 0.75;
 // A suggested radius is this much below the one at which the detector would just pass the thinnest
 // triangle, so that the search's rounding and a printed value's cannot leave it flagged.
 inline constexpr double kResolvingMargin = 0.98;
+// A region's tip often tapers to nothing (a claw, a fin's edge), so a radius that resolves all of it
+// can be far smaller than one that resolves most of it: both are reported, "most" being this share
+// of its area.
+inline constexpr double kMostlyResolved = 0.9;
 
 // One connected region of thin triangles (sharing a vertex counts as connected).
 struct ThinRegion {
@@ -29,7 +34,8 @@ struct ThinRegion {
   // m, its smallest local thickness: kThinOverSpacing x the largest spacing at which the detector
   // passes a triangle (exactly the thickness of a slab or a rod, rims included); 0 for a knife edge
   double thinnest = 0.0;
-  double resolving_radius = 0.0;  // m, a particle radius whose spacing flags none of it (0: none does)
+  double resolving_radius = 0.0;         // m, a particle radius whose spacing flags none of it (0: none does)
+  double mostly_resolving_radius = 0.0;  // m, one whose spacing passes kMostlyResolved of its area or more
 };
 
 struct ThinFeatures {
@@ -43,6 +49,10 @@ struct ThinFeatures {
 // Thin triangles of `mesh` at particle spacing `spacing` [m] for particles of radius `radius` [m]
 // (the radius only scales ThinRegion::resolving_radius: spacing / radius is the sampler's fixed ratio).
 // TBB-parallel over triangles; the same mesh and spacing give the same result.
+// What the report and the verdict suggest for a region: "--radius A resolves 90 % of it, --radius B all
+// of it", or that no radius does where its thinnest triangle passes at no spacing (a knife edge).
+std::string resolving_radii_text(const ThinRegion& region);
+
 ThinFeatures find_thin_features(const TriangleMesh& mesh, const sdf::ExactDistance& exact, double spacing,
                                 double radius);
 

@@ -35,7 +35,8 @@ ThinFeatures thin_on(double share) {
   t.triangles = 20;
   t.area_share = share;
   ThinRegion region;
-  region.triangles = 20, region.area_share = share, region.thinnest = 0.007, region.resolving_radius = 0.0068;
+  region.triangles = 20, region.area_share = share, region.thinnest = 0.007;
+  region.resolving_radius = 0.0068, region.mostly_resolving_radius = 0.009;
   t.regions.push_back(region);
   return t;
 }
@@ -115,7 +116,11 @@ TEST(BodyVerdict, UnevenSpacingIsACaveatByRhoOrByCv) {
 TEST(BodyVerdict, ThinFeaturesOnMoreThanOnePercentOfTheAreaAreACaveatWithTheRadiusThatResolvesThem) {
   const body::ParticleBody b = good_body();
   expect_judged(b, Verdict::Caveats, "thin features on 30.00 % of the area in 1 region", thin_on(0.3));
-  expect_judged(b, Verdict::Caveats, "--radius 0.0068 (now 0.01) resolves the largest", thin_on(0.3));
+  expect_judged(
+      b, Verdict::Caveats,
+      "the largest (30.00 % of the area): --radius 0.009 resolves 90 % of it, --radius 0.0068 all of it "
+      "(now 0.01)",
+      thin_on(0.3));
   // The bunny's ear tips at 4,000 particles: named, not a caveat.
   expect_judged(b, Verdict::Ok, "thin features on 0.45 % of the area in 1 region only", thin_on(0.0045));
 }

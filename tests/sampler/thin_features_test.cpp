@@ -45,6 +45,7 @@ void expect_region_is_plate(const ThinRegion& region, const TriangleMesh& plate,
   // (less the margin).
   EXPECT_NEAR(kThinOverSpacing * kSpacing * region.resolving_radius / kRadius,
               kResolvingMargin * region.thinnest, 1e-12);
+  EXPECT_NEAR(region.mostly_resolving_radius, region.resolving_radius, 1e-6);  // one thickness throughout
 }
 
 TEST(ThinFeatures, EachThinPlateIsOneRegionWithItsBoxShareAndResolvingRadius) {
@@ -68,6 +69,20 @@ TEST(ThinFeatures, ASpacingTheThicknessResolvesFindsNone) {
   EXPECT_EQ(thin.triangles, 0u);
   EXPECT_TRUE(thin.regions.empty());
   EXPECT_EQ(thin.area_share, 0.0);
+}
+
+// A region whose tip tapers (a claw) gets two radii; one no radius resolves says so.
+TEST(ThinFeatures, TheSuggestionNamesTheRadiusForMostOfARegionAndForAllOfIt) {
+  ThinRegion region;
+  region.resolving_radius = region.mostly_resolving_radius = 0.002;
+  EXPECT_EQ(resolving_radii_text(region), "--radius 0.002 resolves all of it");
+  region.mostly_resolving_radius = 0.02;
+  EXPECT_EQ(resolving_radii_text(region), "--radius 0.02 resolves 90 % of it, --radius 0.002 all of it");
+  region.resolving_radius = 0.0;
+  EXPECT_EQ(resolving_radii_text(region),
+            "--radius 0.02 resolves 90 % of it, no radius all of it (a knife edge or a sliver)");
+  region.mostly_resolving_radius = 0.0;
+  EXPECT_EQ(resolving_radii_text(region), "no radius resolves it (a knife edge or a sliver)");
 }
 
 }  // namespace
