@@ -457,8 +457,7 @@ void warn_about_quality(const CoverageFigures& f, int rounds, const SamplingPlan
     result.warnings.push_back(fmt::format(
         "{} triangles ({:.1f} % of the area, {} region{}) belong to features thinner than {} x the particle "
         "spacing {:.4g} m (within [{:.4g}, {:.4g}, {:.4g}] .. [{:.4g}, {:.4g}, {:.4g}] m): particles of both "
-        "sides "
-        "overlap there",
+        "sides overlap there",
         thin.triangles, 100.0 * thin.area_share, thin.regions.size(), thin.regions.size() == 1 ? "" : "s",
         kThinOverSpacing, plan.z.spacing, thin.where.min.x(), thin.where.min.y(), thin.where.min.z(),
         thin.where.max.x(), thin.where.max.y(), thin.where.max.z()));

@@ -47,13 +47,13 @@ struct ThinFeatures {
 };
 
 // Thin triangles of `mesh` at particle spacing `spacing` [m] for particles of radius `radius` [m]
-// (the radius only scales ThinRegion::resolving_radius: spacing / radius is the sampler's fixed ratio).
+// (the radius only scales the resolving radii: spacing / radius is the sampler's fixed ratio).
 // TBB-parallel over triangles; the same mesh and spacing give the same result.
+ThinFeatures find_thin_features(const TriangleMesh& mesh, const sdf::ExactDistance& exact, double spacing,
+                                double radius);
+
 // What the report and the verdict suggest for a region: "--radius A resolves 90 % of it, --radius B all
 // of it", or that no radius does where its thinnest triangle passes at no spacing (a knife edge).
 std::string resolving_radii_text(const ThinRegion& region);
-
-ThinFeatures find_thin_features(const TriangleMesh& mesh, const sdf::ExactDistance& exact, double spacing,
-                                double radius);
 
 }  // namespace ts::sampler
