@@ -1,14 +1,16 @@
 // `tetrasand sample MESH...`: the main job. A closed mesh becomes a particle rigid body; many meshes
 // (or list files) make a batch with one GPU context, a summary CSV and --shard I/N.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <vector>
-#include <nlohmann/json.hpp>
 
 #include "app/commands.h"
 #include "app/numeric_options.h"
@@ -19,6 +21,7 @@
 #include "core/mesh_io.h"
 #include "core/mesh_report.h"
 #include "preview/body_preview.h"
+#include "sampler/body_verdict.h"
 #include "sampler/sample_mesh.h"
 
 namespace ts::app {
@@ -40,10 +43,13 @@ struct Options {
   std::string sign = "pseudonormal";
   bool json = false, allow_open = false, preview = false;
   std::vector<double> up{0.0, 0.0, 1.0};  // --preview's world up
+  bool strict = false;                     // a body short of OK exits 1 (it is still written)
 };
 
 struct BatchRow {
   std::string mesh, status = "ok", error, body_json;
+  std::string verdict;  // verdict_name(); empty for a failed mesh
+  std::vector<std::string> verdict_reasons;
   int exit_code = 0;
   std::size_t particles = 0;
   body::ParticleBody::Quality quality;
@@ -114,17 +120,19 @@ void write_summary(const std::filesystem::path& path, const std::vector<BatchRow
   std::string csv =
       "mesh,status,exit_code,particles,particle_radius_m,relative_radius,cv,covering_over_r,"
       "coverage_certified,covering_bound_over_r,uncovered_subtriangles,max_abs_phi_over_r,iterations,"
-      "injection_rounds,converged,seconds,body_json,error\n";
+      "injection_rounds,converged,seconds,verdict,verdict_reasons,body_json,error\n";
   for (const BatchRow& r : rows) {
     const auto& q = r.quality;
     // A failed mesh has no certificate: its certificate columns are empty.
     const auto& c = q.certificate;
     csv += fmt::format(
-        "{},{},{},{},{:.9g},{:.6f},{:.6f},{:.6f},{},{},{},{:.3e},{},{},{},{:.3f},{},{}\n", csv_field(r.mesh),
-        r.status, r.exit_code, r.particles, r.radius, q.relative_radius, q.cv, q.covering_over_r,
-        c ? (c->certified ? "1" : "0") : "", c ? fmt::format("{:.6f}", c->bound_over_r) : "",
-        c ? std::to_string(c->uncovered_subtriangles) : "", q.max_abs_phi_over_r, q.iterations,
-        q.injection_rounds, q.converged ? 1 : 0, q.seconds, csv_field(r.body_json), csv_field(r.error));
+        "{},{},{},{},{:.9g},{:.6f},{:.6f},{:.6f},{},{},{},{:.3e},{},{},{},{:.3f},{},{},{},{}\n",
+        csv_field(r.mesh), r.status, r.exit_code, r.particles, r.radius, q.relative_radius, q.cv,
+        q.covering_over_r, c ? (c->certified ? "1" : "0") : "",
+        c ? fmt::format("{:.6f}", c->bound_over_r) : "", c ? std::to_string(c->uncovered_subtriangles) : "",
+        q.max_abs_phi_over_r, q.iterations, q.injection_rounds, q.converged ? 1 : 0, q.seconds,
+        csv_field(r.verdict), csv_field(fmt::format("{}", fmt::join(r.verdict_reasons, "; "))),
+        csv_field(r.body_json), csv_field(r.error));
   }
   std::filesystem::create_directories(path.parent_path().empty() ? "." : path.parent_path());
   write_file_atomically(path, csv);
@@ -202,7 +210,10 @@ void add_solid_and_output_options(CLI::App* cmd, Options& o) {
   cmd->add_flag("--fill", o.sampling.fill,
                 "Also fill the inside: particles on a face-centred cubic lattice of spacing 2r wherever phi <= -r "
                 "(after the surface ones in the PLY, with normal 0 0 0)");
-  cmd->add_flag("--json", o.json, "Print the body.json summary on stdout");
+  cmd->add_flag("--json", o.json, "Print the body.json summary, the verdict and the thin features on stdout");
+  cmd->add_flag(
+      "--strict", o.strict,
+      "Exit 1 unless the verdict is 'body OK' (the body is still written; a batch converts every mesh)");
   cmd->add_flag("--timings", o.sampling.timings, "Per-kernel GPU times");
   cmd->add_flag("--preview", o.preview, "Also write NAME.preview.png: the mesh's SDF ray-cast with the particles over it");
   cmd->add_option("--up", o.up,
@@ -271,6 +282,72 @@ void print_certificate_line(const sampler::SampleResult& result) {
   }
 }
 
+// Thin regions the report and --json list (largest area first); the rest are counted.
+constexpr std::size_t kListedThinRegions = 5;
+
+std::string box_text(const Aabb& b) {
+  return fmt::format("[{:.4g}, {:.4g}, {:.4g}] .. [{:.4g}, {:.4g}, {:.4g}] m", b.min.x(), b.min.y(),
+                     b.min.z(), b.max.x(), b.max.y(), b.max.z());
+}
+
+// Where the solid is thinner than the spacing, region by region, and the radius that resolves each.
+void print_thin_features(const sampler::ThinFeatures& thin, double r) {
+  if (thin.triangles == 0) return;
+  fmt::print(
+      "  thin features    {} triangles ({:.2f} % of the area) in {} region{} thinner than {:.4g} m ({:.3f} "
+      "r):\n",
+      thin.triangles, 100.0 * thin.area_share, thin.regions.size(), thin.regions.size() == 1 ? "" : "s",
+      thin.threshold, thin.threshold / r);
+  const std::size_t listed = std::min(thin.regions.size(), kListedThinRegions);
+  double rest = 0.0;
+  for (std::size_t k = 0; k < thin.regions.size(); ++k) {
+    const sampler::ThinRegion& g = thin.regions[k];
+    if (k >= listed) {
+      rest += g.area_share;
+      continue;
+    }
+    fmt::print(
+        "                   {:.2f} % of the area, {} triangle{}, {}, {:.3g} m thick at the thinnest: {}\n",
+        100.0 * g.area_share, g.triangles, g.triangles == 1 ? "" : "s", box_text(g.box), g.thinnest,
+        sampler::resolving_radii_text(g));
+  }
+  if (listed < thin.regions.size()) {
+    fmt::print("                   and {} more regions ({:.2f} % of the area)\n",
+               thin.regions.size() - listed, 100.0 * rest);
+  }
+}
+
+nlohmann::json thin_features_json(const sampler::ThinFeatures& thin) {
+  nlohmann::json regions = nlohmann::json::array();
+  for (std::size_t k = 0; k < std::min(thin.regions.size(), kListedThinRegions); ++k) {
+    const sampler::ThinRegion& g = thin.regions[k];
+    regions.push_back({{"box_min", {g.box.min.x(), g.box.min.y(), g.box.min.z()}},
+                       {"box_max", {g.box.max.x(), g.box.max.y(), g.box.max.z()}},
+                       {"triangles", g.triangles},
+                       {"area_share", g.area_share},
+                       {"thinnest", g.thinnest},
+                       {"resolving_radius", g.resolving_radius},
+                       {"mostly_resolving_radius", g.mostly_resolving_radius}});
+  }
+  return {{"threshold", thin.threshold},
+          {"triangles", thin.triangles},
+          {"area_share", thin.area_share},
+          {"region_count", thin.regions.size()},
+          {"regions", regions},
+          {"regions_not_listed", thin.regions.size() - regions.size()}};
+}
+
+// The written body.json, and beside it what only this run knows: the verdict and the thin features.
+void print_json(const std::filesystem::path& json, const sampler::BodyVerdict& verdict,
+                const sampler::ThinFeatures& thin, bool one_line) {
+  std::ifstream in(json);
+  nlohmann::json out = nlohmann::json::parse(in);
+  out["verdict"] = sampler::verdict_name(verdict.verdict);
+  out["verdict_reasons"] = verdict.reasons;
+  out["thin_features"] = thin_features_json(thin);
+  fmt::print("{}\n", out.dump(one_line ? -1 : 2));  // a batch prints JSON Lines
+}
+
 void print_body_report(const Options& o, const sampler::SampleResult& result, const std::filesystem::path& json,
                        const gpu::Context& context) {
   const body::ParticleBody& body = result.body;
@@ -294,6 +371,7 @@ void print_body_report(const Options& o, const sampler::SampleResult& result, co
       q.covering_over_r_plus_grain ? fmt::format(" = {:.3f} (r + r_grain)", *q.covering_over_r_plus_grain)
                                    : "");
   fmt::print("  on the surface   largest |phi| = {:.2e} r\n", q.max_abs_phi_over_r);
+  print_thin_features(result.thin, body.particle_radius);
   fmt::print(
       "  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {} (certificate {:.2f} s "
       "in {} passes, probes {:.2f} s)\n",
@@ -306,7 +384,8 @@ void print_body_report(const Options& o, const sampler::SampleResult& result, co
                  : std::string("from the closed mesh"));
 }
 
-// One mesh: sample, write the body (and its preview), report; `row` gets the batch summary's figures.
+// One mesh: sample, write the body (and its preview), report and judge it; `row` gets the batch
+// summary's figures. Returns the mesh's exit code: 1 under --strict when the verdict is short of OK.
 int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
   sampler::SampleSettings settings = o.sampling;
   settings.max_sdf_bytes = o.sdf_budget_mib << 20;
@@ -320,9 +399,10 @@ int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
   const std::filesystem::path json = body::write_body(o.output, name, body);
   row.status = "ok", row.body_json = json.string(), row.particles = body.positions.size();
   row.quality = body.quality, row.radius = body.particle_radius;
+  const sampler::BodyVerdict verdict = sampler::judge_body(body, result.thin);
+  row.verdict = sampler::verdict_name(verdict.verdict), row.verdict_reasons = verdict.reasons;
   if (o.json) {
-    std::ifstream in(json);
-    fmt::print("{}\n", nlohmann::json::parse(in).dump(o.batch ? -1 : 2));  // a batch prints JSON Lines
+    print_json(json, verdict, result.thin, o.batch);
   } else {
     print_body_report(o, result, json, context);
   }
@@ -343,14 +423,15 @@ int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
     preview::write_body_preview(context, mesh, body, png, {o.mesh}, look);
     log::info("preview: {}", png.string());
   }
-  return 0;
+  if (!o.json) fmt::print("verdict: {}: {}\n", row.verdict, fmt::join(verdict.reasons, "; "));
+  return o.strict && verdict.verdict != sampler::Verdict::Ok ? 1 : 0;
 }
 
 // Every mesh of a batch, a failure a row of the summary; returns the first failure's exit code.
 int run_batch(const Options& o, const std::vector<std::string>& meshes, gpu::Context& context) {
   std::vector<BatchRow> rows;
   std::set<std::string> names;
-  int failed = 0, first_code = 0;
+  int first_code = 0, short_of_ok = 0;
   for (const std::string& path : meshes) {
     Options one = o;
     one.mesh = path;
@@ -360,19 +441,26 @@ int run_batch(const Options& o, const std::vector<std::string>& meshes, gpu::Con
       if (!names.insert(std::filesystem::path(path).stem().string()).second) {
         throw InputError(path, "another mesh of the batch has the same name; its outputs would overwrite");
       }
-      convert_one(one, context, r);
+      r.exit_code = convert_one(one, context, r);
     } catch (const GpuError&) {
       throw;  // the context is gone: no later mesh can run
     } catch (const Error& e) {
       r.status = "failed", r.error = e.what(), r.exit_code = static_cast<int>(e.code());
       log::error("{}", e.what());
     }
-    if (r.exit_code != 0 && failed++ == 0) first_code = r.exit_code;
+    if (r.exit_code != 0 && first_code == 0) first_code = r.exit_code;
+    if (r.status == "ok" && r.verdict != sampler::verdict_name(sampler::Verdict::Ok)) ++short_of_ok;
     rows.push_back(r);
   }
   const std::filesystem::path csv = summary_path(o);
   write_summary(csv, rows);
-  if (!o.json) fmt::print("{} of {} meshes converted; summary: {}\n", rows.size() - failed, rows.size(), csv.string());
+  if (!o.json) {
+    const auto converted =
+        std::count_if(rows.begin(), rows.end(), [](const BatchRow& r) { return r.status == "ok"; });
+    fmt::print("{} of {} meshes converted, {} of them short of 'body OK'{}; summary: {}\n", converted,
+               rows.size(), short_of_ok, o.strict && short_of_ok > 0 ? " (exit 1: --strict)" : "",
+               csv.string());
+  }
   return first_code;
 }
 

@@ -195,23 +195,6 @@ void orient_normals_by_winding(const sdf::ExactDistance& exact, const std::vecto
   });
 }
 
-ThinFeatures find_thin_features(const TriangleMesh& mesh, const sdf::ExactDistance& exact, double spacing) {
-  const sdf::Pseudonormals& pn = exact.pseudonormals();
-  // A triangle whose solid is thinner than the spacing: half a spacing inward from its centroid,
-  // the point is already outside again or barely inside.
-  ThinFeatures thin;
-  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-    const auto& tri = mesh.triangles[t];
-    const Eigen::Vector3d centroid = (mesh.vertices[tri[0]] + mesh.vertices[tri[1]] + mesh.vertices[tri[2]]) / 3.0;
-    const Eigen::Vector3d probe = centroid - 0.5 * spacing * pn.face[t];
-    if (exact.signed_distance(probe, sdf::SignMethod::Pseudonormal) > -0.25 * spacing) {
-      ++thin.triangles;
-      thin.where.extend(centroid);
-    }
-  }
-  return thin;
-}
-
 // What is decided before any GPU work: the particle size, and the mass properties of the solid.
 struct SamplingPlan {
   double area = 0.0;  // m^2
@@ -471,11 +454,13 @@ void warn_about_quality(const CoverageFigures& f, int rounds, const SamplingPlan
   }
   const ThinFeatures& thin = result.thin;
   if (thin.triangles > 0) {
-    result.warnings.push_back(fmt::format("{} triangles belong to features thinner than the particle spacing {:.4g} m "
-                                          "(within [{:.4g}, {:.4g}, {:.4g}] .. [{:.4g}, {:.4g}, {:.4g}] m): particles of "
-                                          "both sides overlap there",
-                                          thin.triangles, plan.z.spacing, thin.where.min.x(), thin.where.min.y(),
-                                          thin.where.min.z(), thin.where.max.x(), thin.where.max.y(), thin.where.max.z()));
+    result.warnings.push_back(fmt::format(
+        "{} triangles ({:.1f} % of the area, {} region{}) belong to features thinner than {} x the particle "
+        "spacing {:.4g} m (within [{:.4g}, {:.4g}, {:.4g}] .. [{:.4g}, {:.4g}, {:.4g}] m): particles of both "
+        "sides overlap there",
+        thin.triangles, 100.0 * thin.area_share, thin.regions.size(), thin.regions.size() == 1 ? "" : "s",
+        kThinOverSpacing, plan.z.spacing, thin.where.min.x(), thin.where.min.y(), thin.where.min.z(),
+        thin.where.max.x(), thin.where.max.y(), thin.where.max.z()));
   }
 }
 
@@ -552,7 +537,7 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   CoverageFigures coverage = measure_coverage_figures(certifier, mesh, a, plan, settings);
   body::ParticleBody& body = result.body;
   body.quality = measure_quality(a, coverage, mesh, plan, settings);
-  result.thin = find_thin_features(mesh, exact, plan.z.spacing);
+  result.thin = find_thin_features(mesh, exact, plan.z.spacing, plan.z.radius);
   result.holes = deepest_holes(coverage.certificate, as_stored(a.particles), kReportedHoles);
   warn_about_quality(coverage, a.rounds, plan, settings, result);
   result.certificate = std::move(coverage.certificate);

@@ -20,6 +20,7 @@
 #include "gpu/context.h"
 #include "sampler/coverage_certificate.h"
 #include "sampler/gpu_relaxer.h"
+#include "sampler/thin_features.h"
 #include "sdf/settings.h"
 
 namespace ts::sampler {
@@ -60,11 +61,6 @@ struct SampleProgress {
   double residual = 0.0;       // mean displacement per step / spacing
 };
 
-struct ThinFeatures {
-  std::size_t triangles = 0;   // triangles whose solid is thinner than the particle spacing there
-  Aabb where;                  // their bounding box
-};
-
 // Most holes a SampleResult lists (the deepest; a certificate may prove more).
 inline constexpr std::size_t kReportedHoles = 20;
 
@@ -79,7 +75,7 @@ struct FieldStats {
 
 struct SampleResult {
   body::ParticleBody body;
-  ThinFeatures thin;
+  ThinFeatures thin;                // features thinner than the spacing, by region (sampler/thin_features.h)
   std::size_t estimated_count = 0;  // surface particles, from the area and the coverage target
   double estimated_interior = 0.0;  // with `fill`: lattice points in V(phi <= -r) ~ V - A r, / (4 sqrt(2) r^3)
   CoverageCertificate certificate;  // of the surface particles at radius r (body.quality has its figures)

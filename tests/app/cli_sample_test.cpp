@@ -1,7 +1,8 @@
 // `tetrasand sample` from the outside: refusal of open meshes with the info report, --json, outputs
-// written whole (no temporary files left), and batch conversion (list files, summary CSV, --shard,
-// failures that do not stop the batch). Small counts and probe sets: the quality figures themselves
-// are checked in tests/sampler/sample_mesh_test.cpp.
+// written whole (no temporary files left), the verdict (last line, --json, summary.csv, --strict), and
+// batch conversion (list files, summary CSV, --shard, failures that do not stop the batch). Small counts and
+// probe sets: the quality figures themselves are checked in tests/sampler/sample_mesh_test.cpp.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <pty.h>
 #include <signal.h>
@@ -219,7 +220,80 @@ TEST(CliSample, JsonPrintsTheBodyAndOnlyFinishedFilesRemain) {
   EXPECT_LE(q.at("covering_lower_over_r").get<double>(), q.at("covering_bound_over_r").get<double>());
   EXPECT_EQ(q.at("uncovered_subtriangles").get<int>() == 0, q.at("coverage_certified").get<bool>());
   EXPECT_GT(q.at("certificate_floor").get<double>(), 0.0);
+  // The verdict and the thin features, which only the run knows (not in the body.json file).
+  EXPECT_EQ(json.at("verdict").get<std::string>(), "body OK") << out;
+  EXPECT_FALSE(json.at("verdict_reasons").empty());
+  EXPECT_EQ(json.at("thin_features").at("triangles").get<int>(), 0);
+  EXPECT_FALSE(nlohmann::json::parse(read_text(dir / "sphere.body.json")).contains("verdict"));
   EXPECT_EQ(files_in(dir), (std::set<std::string>{"sphere.body.json", "sphere.particles.ply"}));
+}
+
+std::string last_line(const std::string& text) {
+  const std::size_t end = text.find_last_not_of('\n');
+  if (end == std::string::npos) return "";
+  const std::size_t start = text.rfind('\n', end);
+  return text.substr(start == std::string::npos ? 0 : start + 1,
+                     end - (start == std::string::npos ? 0 : start + 1) + 1);
+}
+
+// `tetrasand ARGS` with the fast sampling options; checks its exit code, returns what it printed.
+std::string sample_fast(const std::string& args, int expected_code) {
+  std::string out;
+  EXPECT_EQ(test::run_tetrasand(args + kFast, &out), expected_code) << out;
+  return out;
+}
+
+// The issue's case: a body with holes (an open mesh, sampled by winding number: grains can get in
+// through its holes) is short of OK, and --strict makes that exit 1, after writing the body.
+TEST(CliSample, StrictExitsOneOnABodyWithHolesAndZeroOnAnOkBody) {
+  const std::string sphere = sample_fast(
+      "sample " + quoted(test::asset("sphere.obj")) + " -o " + quoted(test::temp_dir()) + " --strict", 0);
+  EXPECT_EQ(last_line(sphere).rfind("verdict: body OK: coverage certified", 0), 0u) << sphere;
+
+  const std::string open =
+      "sample " + quoted(test::assimp_model("STL/sphereWithHole.stl")) + " --sign winding -o ";
+  const std::string lenient = sample_fast(open + quoted(test::temp_dir()), 0);
+  EXPECT_EQ(last_line(lenient).rfind("verdict: usable with caveats: ", 0), 0u) << lenient;
+  EXPECT_NE(last_line(lenient).find("holes are not covered"), std::string::npos) << lenient;
+  const auto dir = test::temp_dir();
+  const std::string strict = sample_fast(open + quoted(dir) + " --strict --json", 1);
+  const auto json = nlohmann::json::parse(strict.substr(strict.find("{\n")));
+  EXPECT_EQ(json.at("verdict").get<std::string>(), "usable with caveats");
+  EXPECT_EQ(files_in(dir),
+            (std::set<std::string>{"sphereWithHole.body.json", "sphereWithHole.particles.ply"}));
+}
+
+// The bundled 2 mm plate at 150 particles (r about 7 mm): all of it is thinner than the spacing, one
+// region, named in --json with its box and the radius that resolves it; at that radius (about 2,100
+// particles) nothing is thin any more.
+TEST(CliSample, JsonNamesTheThinRegionsAndTheRadiusThatResolvesThem) {
+  const auto dir = test::temp_dir();
+  const std::string out =
+      sample_fast("-q sample " + quoted(test::asset("plate.obj")) + " -o " + quoted(dir) + " --json", 0);
+  const auto json = nlohmann::json::parse(out.substr(out.find('{')));
+  EXPECT_EQ(json.at("verdict").get<std::string>(), "usable with caveats");
+  const auto& thin = json.at("thin_features");
+  EXPECT_GT(thin.at("area_share").get<double>(), 0.9) << thin;
+  ASSERT_GE(thin.at("region_count").get<int>(), 1) << thin;
+  const auto& largest = thin.at("regions").at(0);
+  EXPECT_LT(largest.at("thinnest").get<double>(), 0.0021) << thin;
+  const double radius = json.at("particle_radius").get<double>();
+  EXPECT_LT(largest.at("resolving_radius").get<double>(), radius) << thin;
+  EXPECT_EQ(largest.at("box_min").size(), 3u);
+  bool named = false;
+  for (const auto& reason : json.at("verdict_reasons"))
+    named = named || reason.get<std::string>().find("thin features") != std::string::npos;
+  EXPECT_TRUE(named) << json.at("verdict_reasons");
+
+  const std::string resolving = fmt::format("{:.3g}", largest.at("resolving_radius").get<double>());
+  std::string again;
+  ASSERT_EQ(test::run_tetrasand("-q sample " + quoted(test::asset("plate.obj")) + " -o " + quoted(dir) +
+                                    " --probes 20000 --json --radius " + resolving,
+                                &again),
+            0)
+      << again;
+  const auto resolved = nlohmann::json::parse(again.substr(again.find('{')));
+  EXPECT_EQ(resolved.at("thin_features").at("triangles").get<int>(), 0) << resolved.at("thin_features");
 }
 
 TEST(CliSample, ReportPrintsTheCertificateAndTheHolesItLeaves) {
@@ -320,9 +394,40 @@ TEST(CliSample, BatchWritesASummaryAndAFailureDoesNotStopIt) {
   }
   EXPECT_GE(std::stod(rows[1][column("covering_bound_over_r")]),
             std::stod(rows[1][column("covering_over_r")]));
+  // The verdict and its reasons: for a converted mesh, not for a failed one.
+  ASSERT_LT(column("verdict_reasons"), rows[0].size());
+  EXPECT_EQ(rows[1][column("verdict")], "body OK") << rows[1][column("verdict_reasons")];
+  EXPECT_FALSE(rows[1][column("verdict_reasons")].empty());
+  EXPECT_TRUE(rows[2][column("verdict")].empty());
   EXPECT_NE(rows[2].back().find("no-such-mesh.obj"), std::string::npos);
   EXPECT_EQ(rows[3][1], "ok");  // after the failure
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "cube.body.json"));
+}
+
+// --strict in a batch: every mesh is still converted and written; a body short of OK is its row's
+// exit code 1 and the batch's.
+TEST(CliSample, StrictBatchConvertsEveryMeshAndExitsOneForABodyShortOfOk) {
+  const auto dir = test::temp_dir();
+  const auto list = dir / "meshes.txt";
+  std::ofstream(list) << test::asset("sphere.obj").string() << "\n"
+                      << test::asset("plate.obj").string() << "\n";
+  const std::string out =
+      sample_fast("sample @" + quoted(list) + " -o " + quoted(dir / "out") + " --strict", 1);
+  EXPECT_NE(out.find("2 of 2 meshes converted, 1 of them short of 'body OK' (exit 1: --strict)"),
+            std::string::npos)
+      << out;
+  const auto rows = read_csv(dir / "out" / "summary.csv");
+  ASSERT_EQ(rows.size(), 3u) << out;
+  const auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(rows[0].begin(), rows[0].end(), name) - rows[0].begin());
+  };
+  EXPECT_EQ(rows[1][column("verdict")], "body OK");
+  EXPECT_EQ(rows[1][column("exit_code")], "0");
+  EXPECT_EQ(rows[2][column("verdict")], "usable with caveats");
+  EXPECT_NE(rows[2][column("verdict_reasons")].find("thin features"), std::string::npos);
+  EXPECT_EQ(rows[2][column("status")], "ok");
+  EXPECT_EQ(rows[2][column("exit_code")], "1");
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "plate.body.json"));
 }
 
 TEST(CliSample, ShardsSplitTheListDeterministicallyAndCoverItOnce) {
