@@ -250,6 +250,7 @@ bool SceneRun::pouring() const {
 
 void SceneRun::start_fresh() {
   world_ = make_world(scene_, &sources_);
+  if (hooks_.edit_initial_world) hooks_.edit_initial_world(world_);
   prepare(world_);
   duration_ = control_.duration > 0 ? control_.duration : scene_.simulation.duration;
   emit();
@@ -261,7 +262,8 @@ void SceneRun::start_fresh() {
 }
 
 void SceneRun::resume() {
-  const World initial = make_world(scene_, &sources_);
+  World initial = make_world(scene_, &sources_);
+  if (hooks_.edit_initial_world) hooks_.edit_initial_world(initial);
   prepare(initial);
   std::filesystem::path file;
   const RunState state = read_latest_checkpoint(dir_, &file);

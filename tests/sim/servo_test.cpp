@@ -18,6 +18,7 @@
 #include "sim/scene_runner.h"
 #include "tests/input_error.h"
 #include "tests/scene_texts.h"
+#include "tests/sim/servo_csv.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {
@@ -129,24 +130,6 @@ every = 500
   return parse_scene(text, "bed.toml");
 }
 
-// servo.csv's rows (time, target, measured, position, velocity).
-std::vector<ServoSample> servo_samples(const std::filesystem::path& dir) {
-  std::istringstream in(read_file(dir / "servo.csv"));
-  std::string line;
-  std::getline(in, line);
-  std::vector<ServoSample> rows;
-  while (std::getline(in, line)) {
-    ServoSample s;
-    int servo = 0;
-    EXPECT_EQ(std::sscanf(line.c_str(), "%d,%lf,%lf,%lf,%lf,%lf", &servo, &s.time, &s.target, &s.measured,
-                          &s.position, &s.speed),
-              6)
-        << line;
-    rows.push_back(s);
-  }
-  return rows;
-}
-
 // Mean measured stress (Pa) of the samples in [from, to) s.
 double mean_stress(const std::vector<ServoSample>& rows, double from, double to) {
   double sum = 0;
@@ -163,7 +146,7 @@ double mean_stress(const std::vector<ServoSample>& rows, double from, double to)
 std::vector<ServoSample> run_bed(const Scene& scene, const StepperFactory& factory = {}) {
   const auto dir = test::temp_dir();
   run_scene(scene, dir, {}, factory);
-  return servo_samples(dir);
+  return test::servo_samples(dir);
 }
 
 constexpr double kHoldFrom = 0.9, kHoldTo = 1.1;  // s: the plate has reached the bed and settled
