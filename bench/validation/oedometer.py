@@ -32,7 +32,9 @@ def scene():
         s = tomllib.load(f)
     prop = s["prop"][0]
     keys = prop["servo"]["schedule"]
-    peak = max(range(len(keys)), key=lambda k: keys[k][1])
+    # The test's peak: the highest key after the approach (whose high target ends at the first drop).
+    drop = next(k for k in range(1, len(keys)) if keys[k][1] < keys[k - 1][1])
+    peak = max(range(drop, len(keys)), key=lambda k: keys[k][1])
     with open(os.path.join(os.path.dirname(SCENE), prop["body"])) as f:
         piston_radius = json.load(f)["particle_radius"]
     return dict(seat=keys[peak - 1][0], peak=keys[peak][0], end=keys[peak + 1][0], seat_stress=keys[peak - 1][1],
@@ -52,15 +54,15 @@ def analyse(path, sc):
     seat = np.argmin(np.abs(t - sc["seat"]))
     height = -pos[seat] - sc["face"]  # m: the piston's face above the floor (z = 0) at the start of loading
     eps = (pos - pos[seat]) / height
-    s_sigma, s_eps = smooth(t, sigma), smooth(t, eps)
+    s_sigma = smooth(t, sigma)  # the piston's position is smooth; its force is not
     load = (t >= sc["seat"]) & (t <= sc["peak"])
     unload = (t >= sc["peak"]) & (t <= sc["end"])
-    i_peak, i_end = np.argmin(np.abs(t - sc["peak"])), np.argmin(np.abs(t - sc["end"]))
-    eps_peak, eps_end = s_eps[i_peak], s_eps[i_end]
+    i_end = np.argmin(np.abs(t - sc["end"]))
+    eps_peak, eps_end = eps[load | unload].max(), eps[i_end]
     # The branches at the same stresses: each interpolated in its smoothed stress.
     levels = LEVELS * sc["peak_stress"]
-    lo_s, lo_e = s_sigma[load], s_eps[load]
-    un_s, un_e = s_sigma[unload], s_eps[unload]
+    lo_s, lo_e = s_sigma[load], eps[load]
+    un_s, un_e = s_sigma[unload], eps[unload]
     e_load = np.interp(levels, np.sort(lo_s), lo_e[np.argsort(lo_s)])
     e_unload = np.interp(levels, np.sort(un_s), un_e[np.argsort(un_s)])
     w_load = np.trapz(sigma[load], eps[load])      # J/m^3, work done on the sample loading
@@ -76,7 +78,7 @@ def analyse(path, sc):
         rate = abs(eps[w][-1] - eps[w][0]) / (t[w][-1] - t[w][0])
         inertial.append(rate * d_eq / np.sqrt(max(sigma[w].mean(), 1e-9) / sc["density"]))
     before = (t > 0.05) & (t < sc["seat"])
-    return dict(t=t, sigma=sigma, eps=eps, load=load, unload=unload, height=height, eps_peak=eps_peak,
+    return dict(t=t, sigma=sigma, s_sigma=s_sigma, eps=eps, load=load, unload=unload, height=height, eps_peak=eps_peak,
                 eps_end=eps_end, recovered=(eps_peak - eps_end) / eps_peak if eps_peak > 0 else float("nan"),
                 e_load=e_load, e_unload=e_unload, hysteresis=bool(np.all(e_unload > e_load)),
                 loop=w_load - w_unload, w_load=w_load, inertial_max=max(inertial),
@@ -92,12 +94,12 @@ def runs_row(run, shape):
 def plot(results, docs, sc):
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     for shape, r, colour in (("tetrahedra", results["tetrahedra"], "C0"), ("spheres", results["spheres"], "C1")):
-        ax.plot(100 * r["eps"][r["load"]], r["sigma"][r["load"]] / 1e3, "-", color=colour, lw=1,
+        ax.plot(100 * r["eps"][r["load"]], r["s_sigma"][r["load"]] / 1e3, "-", color=colour, lw=1,
                 label=f"{shape}: loading")
-        ax.plot(100 * r["eps"][r["unload"]], r["sigma"][r["unload"]] / 1e3, "--", color=colour, lw=1,
+        ax.plot(100 * r["eps"][r["unload"]], r["s_sigma"][r["unload"]] / 1e3, "--", color=colour, lw=1,
                 label=f"{shape}: unloading")
     ax.set_xlabel("axial strain (%)")
-    ax.set_ylabel("stress on the piston (kPa)")
+    ax.set_ylabel(f"stress on the piston (kPa, mean over {WINDOW:g} s)")
     ax.set_title(f"Oedometer: {sc['seat_stress']:.0f} Pa -> {sc['peak_stress'] / 1e3:.0f} kPa -> "
                  f"{sc['seat_stress']:.0f} Pa")
     ax.legend(fontsize=8)
@@ -151,6 +153,9 @@ def section(run, docs):
                  f"{tet['recovered']:.2f}, {verdict(sph['recovered'] < tet['recovered'])}; sphere loop area "
                  f"{sph['loop']:.1f} J/m^3 ({100 * sph['loop'] / sph['w_load']:.0f} % of its loading work), "
                  f"hysteresis {'present' if sph['hysteresis'] else 'not present at every level'}.")
+    note = os.path.join(run, "oedometer_note.md")  # how this run differs from the plan, when it does
+    if os.path.exists(note):
+        lines += ["", open(note).read().strip()]
     return "\n".join(lines) + "\n"
 
 
