@@ -92,7 +92,8 @@ every = {}
 ply = true
 checkpoint_every = {}
 )",
-                     kCoarseSand, box_emitter("fill", "[-0.045, -0.045, 0.006]", "[0.045, 0.045, 0.06]", 12, "seed = 5\n"),
+                     kCoarseSand,
+                     box_emitter("fill", "[-0.045, -0.045, 0.006]", "[0.045, 0.045, 0.06]", 12, "seed = 5\n"),
                      box_emitter("pour", "[-0.03, -0.03, 0.08]", "[0.03, 0.03, 0.11]", p.pour_count,
                                  fmt::format("rate = {}\n{}seed = 9\n", p.pour_rate, p.pour_extra)),
                      asset("bodies/plate.body.json").string(), p.plate_time, p.plate_x, p.boundaries,

@@ -125,7 +125,8 @@ tangential = "spring"
 [output]
 every = 500
 )",
-      test::kCoarseSand, test::box_emitter("fill", "[-0.04, -0.025, 0.002]", "[0.04, 0.025, 0.1]", 24, "seed = 3\n"),
+      test::kCoarseSand,
+      test::box_emitter("fill", "[-0.04, -0.025, 0.002]", "[0.04, 0.025, 0.1]", 24, "seed = 3\n"),
       plate_prop(0.105, ""), servo_keys, walls, duration);
   return parse_scene(text, "bed.toml");
 }
