@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
-# Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|peers-sim|sim|sim-accuracy|validation|agreement|all]
+# Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|peers-sim|sim|sim-accuracy|validation|oedometer|agreement|all]
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
 #               its section of docs/benchmarks.md (--quick: knot1 and armadillo at 64^3 and 128^3, 1,000
@@ -25,6 +25,10 @@
 #               discharge (80,000 grains) with a Beverloo fit, contact-force distribution (the silo's fill
 #               and 3 more 30,000-grain piles), on the CPU reference
 #               -> docs/validation.md and docs/validation/*.png                        (~2 h, 2 cores)
+#   oedometer   the thesis's stress-strain test: 1,000 tetrahedral grains in a cylinder loaded to 5 kPa and
+#               unloaded by a servo piston, and the same with sphere grains, against the criteria of
+#               bench/validation/oedometer_criteria.md -> its section of docs/validation.md and
+#               docs/validation/oedometer.png                           (~30 min, CPU reference, 2 cores)
 #   agreement   GPU pipeline against the CPU reference on the heap, the small silo and the bed
 #               -> its section of docs/validation.md                    (~30 min on llvmpipe, 2 cores)
 #   sdf         SDF construction three ways per mesh and grid in one run: GPU scan conversion, CPU exact
@@ -59,7 +63,7 @@ while [ $# -gt 0 ]; do
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in peers|sdf|sparse|sample|certificate|peers-sim|sim|sim-accuracy|validation|agreement|all) ;;
+case "$what" in peers|sdf|sparse|sample|certificate|peers-sim|sim|sim-accuracy|validation|oedometer|agreement|all) ;;
   *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;;
 esac
 [ "$quick" -eq 1 ] && sdf_cases="knot1@64,128 armadillo@64,128"
@@ -120,6 +124,15 @@ if runs validation; then
   "$bin/tetrasand_validation_runs" "$work/validation" all
   "$py" "$root/bench/validation/report.py" "$work/validation" "$root/docs" >/dev/null
   echo "bench: wrote docs/validation.md"
+fi
+if runs oedometer; then
+  # The two shapes at once, one core each.
+  "$bin/tetrasand_validation_runs" "$work/oedometer" oedometer-tetrahedra &
+  tetrahedra=$!
+  "$bin/tetrasand_validation_runs" "$work/oedometer" oedometer-spheres
+  wait "$tetrahedra"
+  "$py" "$root/bench/validation/oedometer.py" "$work/oedometer" "$root/docs" >/dev/null
+  echo "bench: wrote the oedometer section of docs/validation.md and docs/validation/oedometer.png"
 fi
 if runs agreement; then
   "$bin/tetrasand_validation_runs" "$work/agreement" agreement

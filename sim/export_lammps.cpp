@@ -194,6 +194,11 @@ void check_exportable(const Scene& scene, const World& w) {
   if (!w.tracks.empty()) {
     refuse(scene, "a keyframed kinematic prop (this export writes LAMMPS fix move linear/rotate, not a path)");
   }
+  if (std::any_of(scene.props.begin(), scene.props.end(),
+                  [](const Prop& p) { return p.servo.has_value(); })) {
+    refuse(scene,
+           "a prop with [prop.servo] (LAMMPS would need fix wall/servo or a fix rigid with a force target)");
+  }
   for (std::size_t b = 0; b < w.bodies.size(); ++b) {
     if (w.bodies.motion[b] != MotionType::Kinematic) continue;
     if (w.bodies.linear_velocity[b].norm() > 0 && w.bodies.angular_velocity[b].norm() > 0) {

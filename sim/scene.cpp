@@ -318,6 +318,55 @@ void read_keyframes(TableReader& prop, const fs::path& file, Prop& p) {
   p.orientation = p.keyframes.front().orientation;
 }
 
+// servo.schedule = [[t, stress], ...]: times strictly increasing, stresses >= 0.
+std::vector<ServoKey> read_servo_schedule(TableReader& r) {
+  const toml::array* rows = r.node("schedule")->as_array();
+  const char* form = "must be an array of [time (s), stress (Pa)] pairs";
+  if (!rows || rows->empty()) r.fail("schedule", form);
+  std::vector<ServoKey> keys;
+  for (const toml::node& row : *rows) {
+    const toml::array* pair = row.as_array();
+    if (!pair || pair->size() != 2 || !pair->get(0)->is_number() || !pair->get(1)->is_number())
+      r.fail("schedule", form);
+    const ServoKey k{*pair->get(0)->value<double>(), *pair->get(1)->value<double>()};
+    if (!std::isfinite(k.time) || !std::isfinite(k.stress)) r.fail("schedule", "must be finite");
+    if (k.stress < 0)
+      r.fail("schedule",
+             fmt::format("stress {} Pa at t = {} s: must be >= 0 (compressive)", k.stress, k.time));
+    if (!keys.empty() && !(k.time > keys.back().time)) {
+      r.fail("schedule", fmt::format("time {} s is not after the previous {} s: keys must be sorted by time",
+                                     k.time, keys.back().time));
+    }
+    keys.push_back(k);
+  }
+  return keys;
+}
+
+// [prop.servo]: a stress-controlled piston (sim/servo.h) on a kinematic prop without keyframes.
+void read_servo(TableReader& prop, const fs::path& file, Prop& p) {
+  const toml::node* n = prop.node("servo");
+  if (!n) return;
+  if (!n->is_table()) prop.fail("servo", "must be a [prop.servo] table");
+  if (p.motion != MotionType::Kinematic)
+    prop.fail("servo", "only a kinematic prop has a servo (motion = \"kinematic\")");
+  if (!p.keyframes.empty()) prop.fail("servo", "a prop follows either keyframes or its servo, not both");
+  if (prop.table().contains("velocity"))
+    prop.fail("servo", "the servo sets the prop's velocity: remove velocity");
+  TableReader r(*n->as_table(), "prop.servo", file);
+  Servo s;
+  const bool constant = r.has("stress"), scheduled = r.has("schedule");
+  if (constant == scheduled) r.fail("", "needs exactly one of stress (Pa) or schedule = [[t, stress], ...]");
+  if (constant) s.schedule = {{0.0, r.non_negative("stress", 0.0)}};
+  if (scheduled) s.schedule = read_servo_schedule(r);
+  s.area = r.positive("area");
+  s.gain = r.positive("gain");
+  s.max_speed = r.positive("max_speed");
+  s.direction = r.unit_vector("direction", s.direction);
+  s.every = r.integer("every", s.every, 1);
+  r.reject_unknown_keys();
+  p.servo = s;
+}
+
 void read_prop(const toml::table& t, const fs::path& file, Scene& scene) {
   TableReader r(t, "prop", file);
   Prop p;
@@ -337,6 +386,7 @@ void read_prop(const toml::table& t, const fs::path& file, Scene& scene) {
   }
   p.material = material_index(r, scene, "material");
   read_keyframes(r, file, p);
+  read_servo(r, file, p);
   r.reject_unknown_keys();
   scene.props.push_back(p);
 }
@@ -434,6 +484,20 @@ void read_output(TableReader& root, const fs::path& file, Scene& scene) {
   r.reject_unknown_keys();
 }
 
+// The servo's samples (servo.csv) are not part of a checkpoint, so a resumed run would lose them.
+void reject_servo_checkpoints(const Scene& scene) {
+  const OutputSettings& o = scene.output;
+  if (o.checkpoint_every == 0 && o.checkpoint_seconds == 0) return;
+  for (const Prop& p : scene.props) {
+    if (!p.servo) continue;
+    const char* key = o.checkpoint_every > 0 ? "output.checkpoint_every" : "output.checkpoint_seconds";
+    throw InputError(
+        fmt::format("{}: checkpoints cannot be written yet in a run with a servo ([prop.servo] of "
+                    "the [[prop]] at line {}: servo.csv is not kept in them)",
+                    scene_location(scene, key), p.line));
+  }
+}
+
 Scene read_scene(const toml::table& root_table, const fs::path& file) {
   Scene scene;
   scene.file = file;
@@ -448,6 +512,7 @@ Scene read_scene(const toml::table& root_table, const fs::path& file) {
   read_simulation(root, file, scene);
   read_output(root, file, scene);
   root.reject_unknown_keys();
+  reject_servo_checkpoints(scene);
   return scene;
 }
 

@@ -11,12 +11,14 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <random>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "sim/contact_model.h"
+#include "sim/servo.h"
 #include "sim/stepper.h"
 #include "sim/time_step.h"
 #include "sim/world.h"
@@ -60,6 +62,9 @@ struct Prop {
   // Kinematic props only: poses of the mesh frame over time (instead of velocity); empty = none.
   // Between keys the centre of mass moves on a straight line and the orientation slerps.
   std::vector<Keyframe> keyframes;
+  // Kinematic props without keyframes only: a stress-controlled piston ([prop.servo], sim/servo.h)
+  // that sets `velocity` as the run goes.
+  std::optional<Servo> servo;
   int line = 0;
 };
 

@@ -17,6 +17,7 @@
 #include "sim/cpu_reference.h"
 #include "sim/scene_checks.h"
 #include "sim/scene_world.h"
+#include "sim/servo.h"
 
 namespace ts::sim {
 
@@ -218,6 +219,7 @@ class SceneRun {
   std::unique_ptr<Stepper> stepper_;
   std::vector<PourEmitter> pours_;
   std::int64_t emit_every_ = 0;  // steps between pour checks: about twice per release
+  std::optional<ServoControl> servos_;  // of the props with [prop.servo]; none: empty
   std::optional<OutputWriter> output_;
   std::string hash_;     // of the scene, for checkpoints
   double duration_ = 0;  // s
@@ -246,6 +248,14 @@ void SceneRun::prepare(const World& initial) {
     emit_every_ = std::min(emit_every_, std::max<std::int64_t>(1, std::llround(0.5 / (e.rate * result_.dt))));
   }
   if (checkpointing()) hash_ = scene_hash(scene_, initial);
+  std::vector<Servo> servos;
+  std::vector<std::uint32_t> bodies;
+  for (std::size_t k = 0; k < scene_.props.size(); ++k) {
+    if (!scene_.props[k].servo) continue;
+    servos.push_back(*scene_.props[k].servo);
+    bodies.push_back(sources_.prop_bodies[k]);
+  }
+  servos_.emplace(std::move(servos), std::move(bodies));
 }
 
 std::size_t SceneRun::emit() {
@@ -260,6 +270,7 @@ bool SceneRun::pouring() const {
 
 void SceneRun::start_fresh() {
   world_ = make_world(scene_, &sources_);
+  if (hooks_.edit_initial_world) hooks_.edit_initial_world(world_);
   prepare(world_);
   duration_ = control_.duration > 0 ? control_.duration : scene_.simulation.duration;
   emit();
@@ -271,7 +282,8 @@ void SceneRun::start_fresh() {
 }
 
 void SceneRun::resume() {
-  const World initial = make_world(scene_, &sources_);
+  World initial = make_world(scene_, &sources_);
+  if (hooks_.edit_initial_world) hooks_.edit_initial_world(initial);
   prepare(initial);
   std::filesystem::path file;
   const RunState state = read_latest_checkpoint(dir_, &file);
@@ -322,14 +334,18 @@ void SceneRun::restore(const RunState& s, const std::filesystem::path& file) {
   result_.resumed_from = s.step;
 }
 
-// Releases due grains (after the first step), then sets where the stretch ends: at the next output,
-// or sooner while pouring.
+// Releases due grains (after the first step) and updates the servos due, then sets where the stretch
+// ends: at the next output, or sooner while pouring or at the next servo update.
 void SceneRun::begin_stretch() {
-  if (step_ > 0 && pouring() && emit() > 0) stepper_->load(world_);
+  bool changed = step_ > 0 && pouring() && emit() > 0;
+  // The contacts are the CPU reference's on the state the last stretch brought back; on the GPU the
+  // servo's new velocity goes up with the whole state again (load), at servo steps only.
+  if (servos_->update(world_, *stepper_, step_)) changed = true;
+  if (changed) stepper_->load(world_);
   const std::int64_t every = scene_.output.every;
   stretch_output_ = std::min(total_, (step_ / every + 1) * every);
-  const std::int64_t chunk =
-      std::min(stretch_output_ - step_, pouring() ? emit_every_ : stretch_output_ - step_);
+  std::int64_t chunk = std::min(stretch_output_ - step_, pouring() ? emit_every_ : stretch_output_ - step_);
+  if (!servos_->empty()) chunk = std::min(chunk, servos_->steps_to_next(step_));
   stretch_end_ = step_ + chunk;
 }
 
@@ -375,6 +391,7 @@ void SceneRun::end_stretch() {
   stats_.angular_velocity_clamps = std::exchange(angular_clamps_, 0);
   stats_.overlap_clamps = std::exchange(overlap_clamps_, 0);
   output_->write(world_, stats_, step_, *stepper_);
+  if (!servos_->empty()) write_file_atomically(dir_ / "servo.csv", servos_->csv());  // whole, as metrics.csv
   try {
     watch_.interval(stats_.velocity_clamps + stats_.angular_velocity_clamps, step_ - last_output_step_,
                     world_.time);

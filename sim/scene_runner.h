@@ -26,6 +26,10 @@
 namespace ts::sim {
 
 struct RunHooks {
+  // Changes the initial world from the scene before anything else sees it (fresh and resumed runs
+  // alike): for benches that need what a scene file cannot say, such as the oedometer's sphere grains.
+  // The bodies of the scene's props must keep their indices.
+  std::function<void(World& world)> edit_initial_world;
   // Called for each output when [output] frames = true; `frame` counts outputs from 0.
   std::function<void(const World& world, std::int64_t frame, const std::filesystem::path& dir)> write_frame;
   // Called after every output (progress reports, tests).

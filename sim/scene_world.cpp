@@ -254,7 +254,9 @@ World make_world(const Scene& scene, WorldSources* sources) {
   world.gravity = scene.gravity;
   BoundaryNames names;
   for (const Boundary& b : scene.boundaries) add_boundary(world, b, names);
+  std::vector<std::uint32_t> prop_bodies;
   for (const Prop& p : scene.props) {
+    prop_bodies.push_back(static_cast<std::uint32_t>(world.bodies.size()));
     add_prop(world, p);
     names.bodies.push_back(
         fmt::format("the prop of [[prop]] at line {} ({})", p.line, p.body_file.filename().string()));
@@ -264,6 +266,7 @@ World make_world(const Scene& scene, WorldSources* sources) {
     sources->smooth_walls = names.planes;
     sources->smooth_walls.insert(sources->smooth_walls.end(), names.cylinders.begin(), names.cylinders.end());
     sources->bodies = names.bodies;
+    sources->prop_bodies = prop_bodies;
   }
   const GrainShape grain = make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
                                                   scene.materials[scene.grain.material].density);
@@ -407,6 +410,7 @@ DesignSpeed scene_design_speed(const Scene& scene, const World& world) {
   }
   for (const Prop& p : scene.props) {
     faster(p.velocity.norm(), "prop.velocity", p.line);
+    if (p.servo) faster(p.servo->max_speed, "prop.servo.max_speed", p.line);
     for (std::size_t k = 1; k < p.keyframes.size(); ++k) {  // keyframed: its fastest segment
       const double span = p.keyframes[k].time - p.keyframes[k - 1].time;
       faster((p.keyframes[k].position - p.keyframes[k - 1].position).norm() / span, "prop.keyframes", p.line);

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
 #include <random>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@ namespace ts::sim {
 struct WorldSources {
   std::vector<std::string> smooth_walls;  // planes, then cylinders: "the plane of [[boundary]] at line 12"
   std::vector<std::string> bodies;        // the first bodies (rough walls, props), in world order
+  std::vector<std::uint32_t> prop_bodies;  // the body of each [[prop]], in scene order
 };
 
 // The initial world of a scene: materials, smooth walls, rough walls as static particle bodies,

@@ -24,6 +24,20 @@ radius = 1.0e-3
 material = "sand"
 )";
 
+// A soft material and coarse 5 mm grains of it (the scenes that run in the tests), 11 lines.
+inline constexpr const char* kCoarseSand = R"([[material]]
+name = "sand"
+E = 1.0e6
+nu = 0.3
+restitution = 0.5
+mu = 0.5
+gamma_s = 2.0
+density = 2600.0
+[grain]
+radius = 5.0e-3
+material = "sand"
+)";
+
 // An [[emitter]] table of `type` ("fill" or "pour") over the box min..max (TOML arrays), `extra`
 // keys after the count.
 inline std::string box_emitter(const std::string& type, const std::string& min, const std::string& max,
@@ -56,18 +70,7 @@ struct PouredScene {
 // tangential springs: every part of the state a checkpoint keeps changes as the run goes.
 inline std::string poured_scene(const PouredScene& p) {
   return fmt::format(R"(gravity = [0.0, 0.0, -9.81]
-[[material]]
-name = "sand"
-E = 1.0e6
-nu = 0.3
-restitution = 0.5
-mu = 0.5
-gamma_s = 2.0
-density = 2600.0
-[grain]
-radius = 5.0e-3
-material = "sand"
-{}{}[[prop]]
+{}{}{}[[prop]]
 body = "{}"
 motion = "kinematic"
 material = "sand"
@@ -89,6 +92,7 @@ every = {}
 ply = true
 checkpoint_every = {}
 )",
+                     kCoarseSand,
                      box_emitter("fill", "[-0.045, -0.045, 0.006]", "[0.045, 0.045, 0.06]", 12, "seed = 5\n"),
                      box_emitter("pour", "[-0.03, -0.03, 0.08]", "[0.03, 0.03, 0.11]", p.pour_count,
                                  fmt::format("rate = {}\n{}seed = 9\n", p.pour_rate, p.pour_extra)),

@@ -624,6 +624,7 @@ discharge rate 10 % (since 2026-12-02 on the mean of four fill seeds, before on 
 
 
 AGREEMENT_START, AGREEMENT_END = "<!-- section: agreement -->\n", "<!-- end: agreement -->\n"
+OEDOMETER_START, OEDOMETER_END = "<!-- section: oedometer -->\n", "<!-- end: oedometer -->\n"  # bench/validation/oedometer.py
 
 
 def main():
@@ -637,8 +638,11 @@ def main():
         print(open(path).read())
         return
     old = open(path).read() if os.path.exists(path) else ""
-    kept = (old[old.index(AGREEMENT_START) + len(AGREEMENT_START):old.index(AGREEMENT_END)]
-            if AGREEMENT_START in old and AGREEMENT_END in old else "(not run yet: `scripts/bench.sh agreement`)\n")
+
+    def kept(start, end, command):
+        # The sections of other commands stay as they last ran.
+        return (start + (old[old.index(start) + len(start):old.index(end)] if start in old and end in old
+                         else f"(not run yet: `{command}`)\n") + end)
     def section(make, needs, title):
         # A part that did not finish (a stopped run) leaves its section saying so, not a stale one.
         if all(os.path.exists(os.path.join(run, f)) for f in needs):
@@ -659,7 +663,7 @@ def main():
     piles = f" and {extra_piles} more pil{'es' if extra_piles > 1 else 'e'}" if extra_piles else ""
     note = os.path.join(run, "NOTE.md")  # how this run was made, when it was not one plain command
     made = (": see the note below for which parts ran when" if os.path.exists(note)
-            else " in one run:\nevery section below except the last comes from it")
+            else " in one run:\nevery section below except the last two (oedometer, agreement) comes from it")
     header = f"""# Physical validation
 
 Produced by `scripts/bench.sh validation` ({time.strftime('%Y-%m-%d')}, {os.cpu_count()} CPU cores){made}. All of them ran on the CPU reference (double
@@ -676,7 +680,8 @@ produced by `scripts/bench.sh peers-sim`.
 """
     if os.path.exists(note):
         header += "\n" + open(note).read()
-    text = header + "\n" + "\n".join(parts) + "\n" + AGREEMENT_START + kept + AGREEMENT_END
+    text = (header + "\n" + "\n".join(parts) + "\n" + kept(OEDOMETER_START, OEDOMETER_END, "scripts/bench.sh oedometer")
+            + kept(AGREEMENT_START, AGREEMENT_END, "scripts/bench.sh agreement"))
     open(path + ".tmp", "w").write(text)
     os.replace(path + ".tmp", path)
     print(text)

@@ -1,7 +1,9 @@
 // The runs behind docs/validation.md, through the library (CPU reference; the agreement run also on
 // the GPU pipeline), written as CSV files that bench/validation/report.py plots and compares with
 // the literature. Usage:
-//   tetrasand_validation_runs OUT_DIR [restitution|repose|silo [SCENE]|column|all|agreement[-heap|-silo|-bed]]
+//   tetrasand_validation_runs OUT_DIR [restitution|repose|silo
+//   [SCENE]|column|all|agreement[-heap|-silo|-bed]|
+//                                      oedometer[-tetrahedra|-spheres]]
 // `all` is the physical report: restitution and repose take minutes, the column collapse (4 x 20,000
 // grains) and the Mankoc-sized silo (80,000 grains) tens of minutes each on two cores. `agreement`
 // (GPU pipeline against the CPU reference) is separate: on llvmpipe it is the slow part.
@@ -93,12 +95,15 @@ struct Run {
 using MakeStepper = StepperFactory;
 
 // Runs `scene` (on the CPU reference unless `make` says otherwise) with no files but the runner's own.
-Run run(Scene scene, const fs::path& dir, const std::string& name, bool record_heights, const MakeStepper& make = {}) {
+// `edit`, when given, changes the initial world (RunHooks::edit_initial_world).
+Run run(Scene scene, const fs::path& dir, const std::string& name, bool record_heights,
+        const MakeStepper& make = {}, const std::function<void(World&)>& edit = {}) {
   fs::create_directories(dir);
   scene.output.csv = false;
   scene.output.ply = false;
   Run r;
   RunHooks hooks;
+  hooks.edit_initial_world = edit;
   hooks.on_output = [&](const World& world, const StepStats&, std::int64_t) {
     r.last = world;
     if (!record_heights) return;
@@ -479,6 +484,49 @@ void column(const fs::path& out) {
   }
 }
 
+// Each tetrahedral grain (a dynamic body of four particles) becomes one solid sphere of the same
+// volume and mass (radius 4^(1/3) r: the grain counts four whole spheres) at its centre of mass; the
+// other bodies (the piston) keep their particles and indices.
+void grains_to_spheres(World& world) {
+  World spheres = world;
+  spheres.bodies = {};
+  spheres.particles = {};
+  spheres.springs = {};
+  const Bodies& b = world.bodies;
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    const std::uint32_t first = b.first_particle[k];
+    BodyDesc d{b.position[k],     b.orientation[k],     b.linear_velocity[k], b.angular_velocity[k],
+               b.inverse_mass[k], b.inverse_inertia[k], b.motion[k]};
+    std::vector<Eigen::Vector3d> offsets(world.particles.offset.begin() + first,
+                                         world.particles.offset.begin() + first + b.particle_count[k]);
+    std::vector<double> radii(world.particles.radius.begin() + first,
+                              world.particles.radius.begin() + first + b.particle_count[k]);
+    if (b.motion[k] == MotionType::Dynamic && b.particle_count[k] == 4) {
+      const double radius = std::cbrt(4.0) * radii[0];  // m
+      offsets = {Eigen::Vector3d::Zero()};
+      radii = {radius};
+      d.inverse_inertia = Eigen::Matrix3d::Identity() * b.inverse_mass[k] / (0.4 * radius * radius);
+    }
+    add_body(spheres, d, offsets, radii, world.particles.material[first]);
+  }
+  world = std::move(spheres);
+}
+
+// The oedometer of assets/scenes/validation/oedometer.toml (bench/validation/oedometer_criteria.md) with
+// `shape` "tetrahedra" (the scene's grains) or "spheres" (each grain one sphere of its volume and mass):
+// the servo's log as oedometer_SHAPE.csv, and a row of oedometer_runs_SHAPE.csv.
+void oedometer(const fs::path& out, const std::string& shape) {
+  const Scene scene = load_scene(ts::bench::reference_scene("../validation/oedometer.toml"));
+  const bool spheres = shape == "spheres";
+  const Run r = run(scene, out / "runs", "oedometer_" + shape, false, {},
+                    spheres ? std::function<void(World&)>(grains_to_spheres) : std::function<void(World&)>());
+  fs::copy_file(out / "runs" / ("oedometer_" + shape) / "servo.csv", out / ("oedometer_" + shape + ".csv"),
+                fs::copy_options::overwrite_existing);
+  ts::write_file_atomically(out / ("oedometer_runs_" + shape + ".csv"),
+                            fmt::format("shape,grains,steps,seconds,grain_radius_m\n{},{},{},{:.1f},{}\n",
+                                        shape, r.grains, r.steps, r.seconds, scene.grain.radius));
+}
+
 // Long runs of the GPU pipeline (float, on whatever GL device there is) against the CPU reference
 // on the same scenes (issue 6, "long runs agree statistically"): the mu = 0.5 heap's angle, the 16 mm
 // silo's discharge and the settled coarse bed (reference/coarse_bed.toml) for four fill seeds.
@@ -528,7 +576,10 @@ void agreement(const fs::path& out, const std::string& part) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|forces [GRAINS]|column|all|agreement[-heap|-silo|-bed]]\n", argv[0]);
+    std::fprintf(stderr,
+                 "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|forces "
+                 "[GRAINS]|column|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres]]\n",
+                 argv[0]);
     return 2;
   }
   try {
@@ -541,6 +592,8 @@ int main(int argc, char** argv) {
     if (what == "silo" || what == "all") silo(out, what == "silo" && argc > 3 ? fs::path(argv[3]) : fs::path());
     if (what == "forces" || what == "all") forces(out, what == "forces" && argc > 3 ? std::stoul(argv[3]) : 30000);
     if (what == "agreement") agreement(out, "all");
+    if (what == "oedometer" || what == "oedometer-tetrahedra") oedometer(out, "tetrahedra");
+    if (what == "oedometer" || what == "oedometer-spheres") oedometer(out, "spheres");
     if (what.rfind("agreement-", 0) == 0) agreement(out, what.substr(10));
     return 0;
   } catch (const std::exception& e) {
