@@ -459,6 +459,8 @@ RunResult SceneRun::run() {
   result_.grains = result_.bodies.grains;
   result_.outputs = output_->count();
   result_.files = output_->files();
+  if (!servos_->empty() && output_->count() > 0)
+    result_.files.push_back({"servo.csv", servos_->rows(), "rows"});
   if (hooks_.on_finish) hooks_.on_finish(*stepper_);
   return result_;
 }

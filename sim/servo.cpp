@@ -64,6 +64,12 @@ bool ServoControl::update(World& world, Stepper& stepper, std::int64_t step) {
   return set;
 }
 
+std::int64_t ServoControl::rows() const {
+  std::int64_t n = 0;
+  for (const auto& s : samples_) n += static_cast<std::int64_t>(s.size());
+  return n;
+}
+
 std::string ServoControl::csv() const {
   std::string csv = "servo,time_s,target_Pa,measured_Pa,position_m,velocity_m_s\n";
   for (std::size_t k = 0; k < samples_.size(); ++k) {

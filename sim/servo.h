@@ -66,6 +66,7 @@ class ServoControl {
   const std::vector<std::vector<ServoSample>>& samples() const { return samples_; }
   // servo.csv: one row per update, "servo" being the prop's index among the servoed props.
   std::string csv() const;
+  std::int64_t rows() const;  // servo.csv's rows, header apart
 
  private:
   std::vector<Servo> servos_;

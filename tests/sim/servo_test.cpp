@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -146,8 +148,13 @@ double mean_stress(const std::vector<ServoSample>& rows, double from, double to)
 
 std::vector<ServoSample> run_bed(const Scene& scene, const StepperFactory& factory = {}) {
   const auto dir = test::temp_dir();
-  run_scene(scene, dir, {}, factory);
-  return test::servo_samples(dir);
+  const RunResult result = run_scene(scene, dir, {}, factory);
+  std::vector<ServoSample> rows = test::servo_samples(dir);
+  // The run summary names servo.csv with its rows (issue 17: every output with its count).
+  const auto servo = std::find_if(result.files.begin(), result.files.end(),
+                                  [](const OutputRecord& f) { return f.pattern == "servo.csv"; });
+  EXPECT_TRUE(servo != result.files.end() && servo->count == static_cast<std::int64_t>(rows.size()));
+  return rows;
 }
 
 constexpr double kHoldFrom = 0.9, kHoldTo = 1.1;  // s: the plate has reached the bed and settled
