@@ -202,7 +202,7 @@ void add_solid_and_output_options(CLI::App* cmd, Options& o) {
                 "Also fill the inside: particles on a face-centred cubic lattice of spacing 2r wherever phi <= -r "
                 "(after the surface ones in the PLY, with normal 0 0 0)");
   cmd->add_flag("--json", o.json, "Print the body.json summary on stdout");
-  cmd->add_flag("--timings", o.sampling.timings, "Per-kernel GPU times");
+  cmd->add_flag("--timings", o.sampling.timings, "Per-kernel GPU times and host-GPU round trips");
   cmd->add_flag("--preview", o.preview, "Also write NAME.preview.png: the mesh's SDF ray-cast with the particles over it");
 }
 

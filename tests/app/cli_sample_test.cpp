@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -220,6 +221,22 @@ TEST(CliSample, JsonPrintsTheBodyAndOnlyFinishedFilesRemain) {
   EXPECT_EQ(q.at("uncovered_subtriangles").get<int>() == 0, q.at("coverage_certified").get<bool>());
   EXPECT_GT(q.at("certificate_floor").get<double>(), 0.0);
   EXPECT_EQ(files_in(dir), (std::set<std::string>{"sphere.body.json", "sphere.particles.ply"}));
+}
+
+// --timings: the kernels' times and the round trips, none in the iterations between the checks.
+TEST(CliSample, TimingsReportNoRoundTripBetweenConvergenceChecks) {
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sample " + quoted(test::asset("sphere.obj")) + " -o " +
+                                    quoted(test::temp_dir()) + kFast + "--timings",
+                                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("sampler/relax.comp"), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(relaxation iterations between checks \(\d+\) +0 )")))
+      << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(convergence checks \((\d+)\) +\d+ .* 1 per check)")))
+      << out;
+  EXPECT_NE(out.find("sample in all"), std::string::npos) << out;
 }
 
 TEST(CliSample, ReportPrintsTheCertificateAndTheHolesItLeaves) {
