@@ -32,7 +32,7 @@ void count_fence_wait() { ++counts.fence_waits; }
 void count_query_read() { ++counts.query_reads; }
 
 std::string host_sync_report(const std::vector<HostSyncPhase>& phases) {
-  std::string out = fmt::format("{:<44} {:>8} {:>8} {:>8} {:>8} {:>8}  {}\n", "host-GPU round trips", "total",
+  std::string out = fmt::format("{:<52} {:>8} {:>8} {:>8} {:>8} {:>8}  {}\n", "host-GPU round trips", "total",
                                 "reads", "finishes", "fences", "queries", "per unit");
   for (const HostSyncPhase& p : phases) {
     const HostSyncCounts& c = p.counts;
@@ -41,7 +41,7 @@ std::string host_sync_report(const std::vector<HostSyncPhase>& phases) {
         p.units > 0 ? fmt::format("{:.3g} per {}",
                                   static_cast<double>(c.total()) / static_cast<double>(p.units), p.unit)
                     : "";
-    out += fmt::format("{:<44} {:>8} {:>8} {:>8} {:>8} {:>8}  {}\n", name, c.total(), c.reads, c.finishes,
+    out += fmt::format("{:<52} {:>8} {:>8} {:>8} {:>8} {:>8}  {}\n", name, c.total(), c.reads, c.finishes,
                        c.fence_waits, c.query_reads, per);
   }
   return out;

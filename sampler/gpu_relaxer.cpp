@@ -18,8 +18,7 @@ GpuRelaxer::GpuRelaxer(gpu::Context& context, sdf::SparseField field, bool timin
       relax_(gpu::Program::compute(library_, "sampler/relax.comp")),
       project_(gpu::Program::compute(library_, "sampler/project.comp")),
       reduce_(gpu::Program::compute(library_, "sampler/reduce_steps.comp")),
-      grid_(library_),
-      syncs_at_start_(gpu::host_sync_counts()) {
+      grid_(library_) {
   if (field_.empty()) throw Error(ExitCode::Internal, "GpuRelaxer needs an uploaded sdf::SparseField");
 }
 
@@ -67,10 +66,9 @@ GpuRelaxer::StepSums GpuRelaxer::check(std::uint32_t count) {
 }
 
 std::vector<gpu::HostSyncPhase> GpuRelaxer::round_trips() const {
-  return {
-      {"relaxation iterations between checks", iteration_syncs_, iterations_run_, "iteration"},
-      {"convergence checks", check_syncs_, checks_run_, "check"},
-      {"relaxer in all (uploads, band removals, results)", gpu::host_sync_counts() - syncs_at_start_, 0, ""}};
+  return {{"relaxation iterations between checks", iteration_syncs_, iterations_run_, "iteration"},
+          {"convergence checks", check_syncs_, checks_run_, "check"},
+          {"relaxation in all (uploads, band removals, results)", relax_syncs_, 0, ""}};
 }
 
 RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const RelaxSettings& settings,
@@ -78,6 +76,7 @@ RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const Rela
                              std::vector<std::uint8_t>* mobile) {
   if (!(settings.spacing > 0.0)) throw InputError("sampler spacing must be positive");
   if (mobile && mobile->size() != positions.size()) throw Error(ExitCode::Internal, "relax: mobile mask size");
+  const gpu::HostSyncScope counted(relax_syncs_);
   const double sigma = settings.sigma_over_spacing * settings.spacing;
   const double cutoff = sigma * std::sqrt(2.0 * std::log(1.0 / settings.kernel_epsilon));
   RelaxStats stats;

@@ -66,7 +66,8 @@ class GpuRelaxer {
 
   std::string timing_report() { return queue_.timing_report(); }
   // Host-GPU round trips by phase over every relax() so far (gpu/host_sync.h): the iterations
-  // between checks (none, by design), the checks, and in all since this relaxer was made.
+  // between checks (none, by design), the checks, and all of relax() (with uploads, band removals
+  // and the results read back).
   std::vector<gpu::HostSyncPhase> round_trips() const;
   std::size_t gpu_bytes() const;
 
@@ -88,7 +89,7 @@ class GpuRelaxer {
   gpu::Program relax_, project_, reduce_;
   gpu::HashGrid grid_;
   gpu::Buffer positions_[2], velocities_, step_info_, partials_;
-  gpu::HostSyncCounts iteration_syncs_, check_syncs_, syncs_at_start_;
+  gpu::HostSyncCounts iteration_syncs_, check_syncs_, relax_syncs_;
   std::int64_t iterations_run_ = 0, checks_run_ = 0;
 };
 

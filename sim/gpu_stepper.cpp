@@ -620,9 +620,10 @@ StepStats GpuStepper::advance(World& world, std::int64_t steps) {
 }
 
 std::vector<gpu::HostSyncPhase> GpuStepper::round_trips() const {
-  return {{"sim steps between outputs", step_syncs_, steps_run_, "step"},
-          {"outputs (statistics, state read back)", output_syncs_, outputs_, "output"},
-          {"total (with uploads, checkpoints, timers)", gpu::host_sync_counts() - syncs_at_start_, 0, ""}};
+  return {
+      {"sim steps between outputs", step_syncs_, steps_run_, "step"},
+      {"outputs (statistics, state read back)", output_syncs_, outputs_, "output"},
+      {"in all (uploads, frames, checkpoints, timers)", gpu::host_sync_counts() - syncs_at_start_, 0, ""}};
 }
 
 std::string GpuStepper::timing_report() {

@@ -63,7 +63,8 @@ class GpuStepper : public Stepper {
   // The world index of each body in GPU memory order (identity until the first re-sort).
   std::vector<std::uint32_t> body_order() const { return original_ids(original_body_, body_count_); }
   // Host-GPU round trips by phase (gpu/host_sync.h): inside step() (none, by design), inside
-  // advance()'s read-backs after the steps, and in all since this stepper was made.
+  // advance()'s read-backs after the steps, and all this thread's since this stepper was made
+  // (with the frames `sim` renders in the same context).
   std::vector<gpu::HostSyncPhase> round_trips() const;
 
  private:

@@ -141,6 +141,7 @@ TEST_F(Relaxer, MakesOneHostRoundTripPerConvergenceCheckAndNoneBetween) {
   EXPECT_EQ(phases[1].counts.reads, 3);
   EXPECT_EQ(phases[1].counts.total(), 3);
   EXPECT_EQ(made.total(), 3 + 1);
+  EXPECT_EQ(phases[2].counts, made);  // all of relax()
 }
 
 }  // namespace
