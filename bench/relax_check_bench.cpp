@@ -1,21 +1,21 @@
 // The cost of the sampler's convergence check (RelaxSettings::check_every, sampler/gpu_relaxer.h):
 // the reduction and its read-back, the one host-GPU round trip of the relaxation loop, against the
-// iterations it follows. On a sphere seeded at random, with the tolerance at 0 so every run makes
-// all its iterations, it times (best of --repeats) M and 2M iterations with one check, which gives
-// the time of an iteration; M iterations checked every iteration, whose excess over the single
-// check divided by the M - 1 extra checks is the time of a check; and M iterations checked every K
-// for each K of --every. Prints one JSON line per K: check_share = t_check / (K t_iteration), the
-// fraction the checks add to the loop, and measured_excess = t(K) / t(one check) - 1, the same
-// seen directly (noisier: a few checks against the whole run).
+// iterations it follows. On a sphere seeded at random, with the tolerance at 0 so the run makes all
+// its --iterations, one relaxation checked every 10 iterations is timed kernel by kernel by the
+// relaxer's timer queries (--timings): t_check = the reduction's time per call, t_iteration = the
+// grid build and the relaxation kernel per iteration. Prints one JSON line per K of --every:
+// check_share = t_check / (K t_iteration), the fraction the checks add to the loop.
 //
 // Criterion, written before the first run (issue 16): at the default K = 10 the check adds under
 // 2 % to the relaxation at 10k and 100k particles on llvmpipe; otherwise the default is raised to
 // the smallest K of --every that meets it at both counts. A hardware GPU adds the pipeline drain
-// that llvmpipe (whose dispatches run to completion) does not have; that part is not measured here.
-// Times are the process's CPU time (llvmpipe's threads are the process's), best of --repeats: on a
-// shared machine wall time measures the other processes too (first run, load 11 on 2 cores: the
-// same work took 3.0 s and 6.2 s of wall time).
-//   tetrasand_bench_relax_check [--particles N] [--iterations M] [--repeats R] [--every K1,K2,...]
+// that llvmpipe (whose dispatches run to completion) does not have; that part is not measured here,
+// nor is the host's copy of the (n + 255) / 256 partial sums (16 bytes each) it reads.
+// Why timer queries and not the run's time: on a shared machine wall time, and even CPU time,
+// measure the other processes too, far more than the few per cent sought (first runs, load 11 on 2
+// cores, 10k particles, 50 iterations: 3.0 s and 6.2 s of wall time, and 2.5 s of CPU time with
+// 3 checks against 2.0 s with 5).
+//   tetrasand_bench_relax_check [--particles N] [--iterations M] [--every K1,K2,...]
 #include <fmt/format.h>
 
 #include <cmath>
@@ -45,7 +45,6 @@ double cpu_seconds() {
 struct Options {
   std::size_t particles = 10'000;
   int iterations = 100;
-  int repeats = 3;
   std::vector<int> every{5, 10, 20};
 };
 
@@ -66,8 +65,6 @@ Options parse(int argc, char** argv) {
       o.particles = std::stoull(value);
     } else if (a == "--iterations") {
       o.iterations = std::stoi(value);
-    } else if (a == "--repeats") {
-      o.repeats = std::stoi(value);
     } else if (a == "--every") {
       o.every = parse_list(value);
     } else {
@@ -113,19 +110,28 @@ Setup make_setup(ts::gpu::Context& context, std::size_t count) {
   return s;
 }
 
-// Best CPU time [s] of `repeats` relaxations of the seeds, M iterations checked every K.
-double best_time(ts::sampler::GpuRelaxer& relaxer, const Setup& s, int iterations, int every, int repeats) {
-  ts::sampler::RelaxSettings settings = s.settings;
-  settings.max_iterations = iterations;
-  settings.check_every = every;
-  double best = 1e300;
-  for (int r = 0; r < repeats; ++r) {
-    std::vector<Eigen::Vector3f> positions = s.seeds;
-    const double start = cpu_seconds();
-    relaxer.relax(positions, settings);
-    best = std::min(best, cpu_seconds() - start);
+// Per-kernel GPU time [ms] and calls, from the relaxer's --timings table ("name calls ms share").
+struct KernelTimes {
+  double check_ms = 0.0, iterations_ms = 0.0;  // the reduction; everything but it and the projection
+  int checks = 0;
+};
+
+KernelTimes parse_report(const std::string& report) {
+  KernelTimes t;
+  std::istringstream lines(report);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream fields(line);
+    std::string name;
+    int calls = 0;
+    double ms = 0.0;
+    if (!(fields >> name >> calls >> ms) || name == "total") continue;
+    if (name == "sampler/reduce_steps.comp") {
+      t.check_ms += ms, t.checks += calls;
+    } else if (name != "sampler/project.comp") {
+      t.iterations_ms += ms;
+    }
   }
-  return best;
+  return t;
 }
 
 }  // namespace
@@ -135,21 +141,23 @@ int main(int argc, char** argv) {
     const Options o = parse(argc, argv);
     ts::gpu::Context context;
     Setup s = make_setup(context, o.particles);
-    ts::sampler::GpuRelaxer relaxer(context, std::move(s.field));
-    const int m = o.iterations;
-    best_time(relaxer, s, m, m, 1);  // warm-up: shaders, buffers
-    const double one_check = best_time(relaxer, s, m, m, o.repeats);
-    const double iteration = (best_time(relaxer, s, 2 * m, 2 * m, o.repeats) - one_check) / m;
-    const double check = (best_time(relaxer, s, m, 1, o.repeats) - one_check) / (m - 1);
+    ts::sampler::GpuRelaxer relaxer(context, std::move(s.field), /*timings=*/true);
+    ts::sampler::RelaxSettings settings = s.settings;
+    settings.max_iterations = o.iterations;
+    settings.check_every = 10;
+    std::vector<Eigen::Vector3f> positions = s.seeds;
+    const double start = cpu_seconds();
+    const ts::sampler::RelaxStats stats = relaxer.relax(positions, settings);
+    const double cpu = cpu_seconds() - start;
+    const KernelTimes t = parse_report(relaxer.timing_report());
+    const double iteration = t.iterations_ms / stats.iterations, check = t.check_ms / std::max(t.checks, 1);
     for (int k : o.every) {
-      const double t = best_time(relaxer, s, m, k, o.repeats);
       fmt::print(
-          "{{\"particles\": {}, \"iterations\": {}, \"every\": {}, \"cpu_seconds\": {:.4f}, "
-          "\"one_check_cpu_seconds\": {:.4f}, \"iteration_ms\": {:.4f}, \"check_ms\": {:.4f}, "
-          "\"check_share\": {:.5f}, \"measured_excess\": {:.5f}, \"renderer\": \"{}\"}}\n",
-          o.particles, m, k, t, one_check, 1e3 * iteration, 1e3 * check, check / (k * iteration),
-          t / one_check - 1.0, context.renderer());
-      std::fflush(stdout);
+          "{{\"particles\": {}, \"iterations\": {}, \"every\": {}, \"iteration_ms\": {:.4f}, \"check_ms\": "
+          "{:.4f}, "
+          "\"check_share\": {:.5f}, \"relax_cpu_seconds\": {:.3f}, \"renderer\": \"{}\"}}\n",
+          o.particles, stats.iterations, k, iteration, check, check / (k * iteration), cpu,
+          context.renderer());
     }
     return 0;
   } catch (const std::exception& e) {
