@@ -214,7 +214,7 @@ void add_solid_and_output_options(CLI::App* cmd, Options& o) {
   cmd->add_flag(
       "--strict", o.strict,
       "Exit 1 unless the verdict is 'body OK' (the body is still written; a batch converts every mesh)");
-  cmd->add_flag("--timings", o.sampling.timings, "Per-kernel GPU times");
+  cmd->add_flag("--timings", o.sampling.timings, "Per-kernel GPU times and host-GPU round trips");
   cmd->add_flag("--preview", o.preview, "Also write NAME.preview.png: the mesh's SDF ray-cast with the particles over it");
   cmd->add_option("--up", o.up,
                   "With --preview: the mesh's up X,Y,Z (+z by convention; `info` tells its tallest axis)")

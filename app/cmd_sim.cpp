@@ -43,7 +43,7 @@ void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option("--precision", o.precision, "GPU arithmetic: float or double (GLSL fp64)")
       ->check(CLI::IsMember({"float", "double"}))
       ->capture_default_str();
-  cmd->add_flag("--timings", o.timings, "Print per-kernel GPU times at the end");
+  cmd->add_flag("--timings", o.timings, "Print per-kernel GPU times and host-GPU round trips at the end");
   cmd->add_option(
          "--resume", o.resume,
          "Go on from the latest checkpoint in DIR (written with [output] checkpoint_every or "

@@ -1,7 +1,7 @@
 // Cundall number (grain time steps per second) of the GPU pipeline and of the CPU reference on the
 // same scenes, in one run, as ratios, from 1k to 1M grains; memory per grain of both. Usage:
 //   tetrasand_bench_sim [--grains 1000,8000,64000,512000,1000000] [--seconds 2] [--min-steps 2]
-//                       [--precision float|double|float,double] [--csv FILE]
+//                       [--precision float|double|float,double] [--csv FILE] [--timings]
 // The scene of every size is the settled bed of bench/bench_scenes.h (reference/bed_tile.toml copied
 // side by side), so each size sees the same contacts per grain. scripts/bench.sh sim plots the CSV.
 // With two precisions the CPU reference is measured once per size and each GPU precision gets a row.
@@ -33,6 +33,7 @@ struct Options {
   int min_steps = 2;
   std::vector<ts::sim::Precision> precisions{ts::sim::Precision::Float};
   std::string csv;
+  bool timings = false;  // per-kernel GPU times and host round trips of each size, on stderr
 };
 
 Options parse(int argc, char** argv) {
@@ -61,6 +62,8 @@ Options parse(int argc, char** argv) {
       }
     } else if (arg == "--csv") {
       o.csv = next();
+    } else if (arg == "--timings") {
+      o.timings = true;
     } else {
       throw std::runtime_error("unknown option " + arg);
     }
@@ -133,9 +136,10 @@ Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Optio
     row.contacts_per_grain = static_cast<double>(stats.contacts + stats.wall_contacts) / static_cast<double>(row.grains);
   }
   for (const ts::sim::Precision precision : options.precisions) {
-    ts::sim::GpuStepper gpu(context, bed.world, bed.settings, precision);
+    ts::sim::GpuStepper gpu(context, bed.world, bed.settings, precision, options.timings);
     row.gpu.push_back(measure([&](int n) { gpu.step(n); }, [&] { context.finish(); }, options.seconds,
                               options.min_steps, batch));
+    if (options.timings) fmt::print(stderr, "{} grains:\n{}", row.grains, gpu.timing_report());
     row.gpu_bytes_per_grain.push_back(static_cast<double>(gpu.gpu_bytes()) / static_cast<double>(row.grains));
   }
   return row;

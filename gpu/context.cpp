@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "gpu/host_sync.h"
 
 namespace ts::gpu {
 namespace {
@@ -260,7 +261,10 @@ Context::~Context() {
   destroy(raw);
 }
 
-void Context::finish() const { glFinish(); }
+void Context::finish() const {
+  count_finish();
+  glFinish();
+}
 
 std::string Context::summary() const {
   return renderer_ + " / " + version_ + " (device " + std::to_string(device_index_) +

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "gpu/host_sync.h"
 
 namespace ts::gpu {
 
@@ -112,8 +113,10 @@ void Buffer::upload(const void* data, std::size_t bytes, std::size_t offset) {
 
 void Buffer::download(void* data, std::size_t bytes, std::size_t offset) const {
   if (offset + bytes > bytes_) throw GpuError(fmt::format("buffer read of {} bytes at {} overruns {} bytes", bytes, offset, bytes_));
+  if (bytes == 0) return;
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  if (bytes) glGetNamedBufferSubData(id_, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+  count_read();
+  glGetNamedBufferSubData(id_, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
 }
 
 void Buffer::fill_zero() {
@@ -216,17 +219,23 @@ void Queue::dispatch(const Program& program, std::uint32_t gx, std::uint32_t gy,
 void Queue::dispatch_items(const Program& program, std::size_t items, GLbitfield barrier) {
   const std::size_t local = static_cast<std::size_t>(program.local_size()[0]);
   const std::size_t groups = (items + local - 1) / local;
-  GLint max_groups = 0;
-  glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &max_groups);
+  // Queried once: a state query per dispatch is a driver call in the innermost loop.
+  if (max_groups_x_ == 0) glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &max_groups_x_);
   // Past the limit a dispatch is a GL error that leaves the buffers as they were: stop instead.
-  if (groups > static_cast<std::size_t>(max_groups)) {
+  if (groups > static_cast<std::size_t>(max_groups_x_)) {
     throw GpuError("dispatch of " + program.name() + " over " + std::to_string(items) + " items needs " +
-                   std::to_string(groups) + " work groups, above this GPU's limit of " + std::to_string(max_groups));
+                   std::to_string(groups) + " work groups, above this GPU's limit of " +
+                   std::to_string(max_groups_x_));
   }
   dispatch(program, static_cast<std::uint32_t>(groups), 1, 1, barrier);
 }
 
 void Queue::check(const std::string& what) const { check_gl(what); }
+
+void Queue::finish() const {
+  count_finish();
+  glFinish();
+}
 
 void Queue::begin(const std::string& name) {
   if (!timings_) return;
@@ -250,18 +259,23 @@ void Queue::end(const std::string& name) {
   auto it = std::find_if(pending_.rbegin(), pending_.rend(), [&](const Pending& p) { return p.name == name; });
   if (it == pending_.rend()) return;
   glQueryCounter(it->stop, GL_TIMESTAMP);
-  // Bound the number of queries in flight: long simulations dispatch millions of kernels.
-  if (pending_.size() >= 256) resolve(true);
+  // Reading results waits for the GPU, so they are read at the end (timings()). Long runs (a
+  // simulation dispatches millions of kernels) bound the queries in flight: past kMaxPendingTimers
+  // the results the GPU has already written are taken without waiting, and only when there are
+  // none does the host wait.
+  if (pending_.size() >= kMaxPendingTimers && resolve(false) == 0) resolve(true);
 }
 
-void Queue::resolve(bool wait) {
-  std::vector<Pending> still;
-  for (auto& p : pending_) {
-    GLint available = 0;
-    glGetQueryObjectiv(p.stop, GL_QUERY_RESULT_AVAILABLE, &available);
-    if (!available && !wait) {
-      still.push_back(p);
-      continue;
+std::size_t Queue::resolve(bool wait) {
+  if (pending_.empty()) return 0;
+  if (wait) count_query_read();
+  std::size_t done = 0;
+  for (; done < pending_.size(); ++done) {
+    const Pending& p = pending_[done];
+    if (!wait) {  // queries finish in the order they were issued: stop at the first still running
+      GLint available = 0;
+      glGetQueryObjectiv(p.stop, GL_QUERY_RESULT_AVAILABLE, &available);
+      if (!available) break;
     }
     GLuint64 t0 = 0, t1 = 0;
     glGetQueryObjectui64v(p.start, GL_QUERY_RESULT, &t0);
@@ -276,7 +290,8 @@ void Queue::resolve(bool wait) {
     spare_queries_.push_back(p.start);
     spare_queries_.push_back(p.stop);
   }
-  pending_ = std::move(still);
+  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(done));
+  return done;
 }
 
 std::vector<KernelTiming> Queue::timings() {

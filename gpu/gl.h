@@ -121,11 +121,14 @@ class Queue {
     work();
     end(name);
   }
-  void finish() const { glFinish(); }
+  // Blocks until the GPU has run everything issued (a host round trip, counted in gpu/host_sync.h).
+  void finish() const;
   bool timings_enabled() const { return timings_; }
   // Whether each kernel (and each draw of gpu/graphics.h) is followed by a GL error check.
   bool checks_errors() const { return check_errors_; }
-  // Resolves outstanding queries and returns totals per kernel, in first-use order.
+  // Timer queries in flight before those already done are read (and, if none is, the host waits).
+  static constexpr std::size_t kMaxPendingTimers = 65536;
+  // Reads outstanding queries (one host round trip) and returns totals per kernel, in first-use order.
   std::vector<KernelTiming> timings();
   // A table for --timings.
   std::string timing_report();
@@ -134,7 +137,9 @@ class Queue {
   void begin(const std::string& name);
   void end(const std::string& name);
   void check(const std::string& what) const;
-  void resolve(bool wait);
+  // Reads the pending queries, all of them (waiting for the GPU: a host round trip), or with
+  // wait = false those already done. Returns how many were read.
+  std::size_t resolve(bool wait);
 
   struct Pending {
     std::string name;
@@ -145,6 +150,7 @@ class Queue {
   std::vector<Pending> pending_;
   std::vector<GLuint> spare_queries_;
   std::vector<KernelTiming> totals_;
+  GLint max_groups_x_ = 0;  // GL_MAX_COMPUTE_WORK_GROUP_COUNT along x, 0 until first needed
 };
 
 // Throws GpuError with `what` when glGetError reports an error.

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "gpu/host_sync.h"
 
 namespace ts::gpu {
 
@@ -159,6 +160,7 @@ void Texture::upload(const void* pixels, GLenum pixel_format, GLenum type, int f
 void Texture::read(void* pixels, std::size_t bytes, GLenum pixel_format, GLenum type, int first,
                    int count) const {
   const int n = layer_count(first, count, "read");
+  count_read();
   glGetTextureSubImage(id(), 0, 0, 0, first, width_, height_, n, pixel_format, type,
                        to_sizei(bytes, "texture read"), pixels);
 }

@@ -35,11 +35,48 @@ void GpuRelaxer::project(std::uint32_t count, int steps) {
   for (int s = 0; s < steps; ++s) queue_.dispatch_items(project_, count);
 }
 
+void GpuRelaxer::iterate(std::uint32_t count, double cutoff) {
+  const gpu::HostSyncScope counted(iteration_syncs_);
+  ++iterations_run_;
+  grid_.build(queue_, positions_[0], count, static_cast<float>(cutoff));
+  positions_[0].bind(TS_SAMPLER_POSITIONS_IN);
+  positions_[1].bind(TS_SAMPLER_POSITIONS_OUT);
+  grid_.bind();
+  velocities_.bind(TS_SAMPLER_VELOCITIES);
+  step_info_.bind(TS_SAMPLER_STEP_INFO);
+  bind_sdf(relax_);
+  relax_.set("count", count);
+  relax_.set("table_size", grid_.table_size());
+  queue_.dispatch_items(relax_, count);
+  std::swap(positions_[0], positions_[1]);
+}
+
+GpuRelaxer::StepSums GpuRelaxer::check(std::uint32_t count) {
+  const gpu::HostSyncScope counted(check_syncs_);
+  ++checks_run_;
+  step_info_.bind(TS_SAMPLER_STEP_INFO);
+  partials_.bind(TS_SAMPLER_PARTIALS);
+  reduce_.set("count", count);
+  queue_.dispatch_items(reduce_, count);
+  StepSums sums;
+  for (const auto& p : partials_.read<Eigen::Vector4f>((count + 255) / 256)) {
+    sums.moved += p.x(), sums.outside += p.z(), sums.moving += p.w();
+  }
+  return sums;
+}
+
+std::vector<gpu::HostSyncPhase> GpuRelaxer::round_trips() const {
+  return {{"relaxation iterations between checks", iteration_syncs_, iterations_run_, "iteration"},
+          {"convergence checks", check_syncs_, checks_run_, "check"},
+          {"relaxation in all (uploads, band removals, results)", relax_syncs_, 0, ""}};
+}
+
 RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const RelaxSettings& settings,
                              const std::function<void(int, std::size_t, double)>& progress,
                              std::vector<std::uint8_t>* mobile) {
   if (!(settings.spacing > 0.0)) throw InputError("sampler spacing must be positive");
   if (mobile && mobile->size() != positions.size()) throw Error(ExitCode::Internal, "relax: mobile mask size");
+  const gpu::HostSyncScope counted(relax_syncs_);
   const double sigma = settings.sigma_over_spacing * settings.spacing;
   const double cutoff = sigma * std::sqrt(2.0 * std::log(1.0 / settings.kernel_epsilon));
   RelaxStats stats;
@@ -74,30 +111,15 @@ RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const Rela
   relax_.set("max_move", static_cast<float>(settings.max_move_over_cell * cutoff));
   relax_.set("band_limit", static_cast<float>(settings.band_limit));
   while (stats.iterations < settings.max_iterations && count > 0) {
-    grid_.build(queue_, positions_[0], count, static_cast<float>(cutoff));
-    positions_[0].bind(TS_SAMPLER_POSITIONS_IN);
-    positions_[1].bind(TS_SAMPLER_POSITIONS_OUT);
-    grid_.bind();
-    velocities_.bind(TS_SAMPLER_VELOCITIES);
-    step_info_.bind(TS_SAMPLER_STEP_INFO);
-    bind_sdf(relax_);
-    relax_.set("count", count);
-    relax_.set("table_size", grid_.table_size());
-    queue_.dispatch_items(relax_, count);
-    std::swap(positions_[0], positions_[1]);
+    iterate(count, cutoff);
     ++stats.iterations;
     if (stats.iterations % settings.check_every != 0 && stats.iterations < settings.max_iterations) continue;
 
-    step_info_.bind(TS_SAMPLER_STEP_INFO);
-    partials_.bind(TS_SAMPLER_PARTIALS);
-    reduce_.set("count", count);
-    queue_.dispatch_items(reduce_, count);
-    const auto partials = partials_.read<Eigen::Vector4f>((count + 255) / 256);
-    double moved = 0.0, outside = 0.0, moving = 0.0;
-    for (const auto& p : partials) moved += p.x(), outside += p.z(), moving += p.w();
-    stats.mean_move_over_spacing = moving > 0.0 ? moved / moving / settings.spacing : 0.0;
+    ++stats.checks;
+    const StepSums sums = check(count);
+    stats.mean_move_over_spacing = sums.moving > 0.0 ? sums.moved / sums.moving / settings.spacing : 0.0;
     if (progress) progress(stats.iterations, count, stats.mean_move_over_spacing);
-    if (outside > 0.0) {
+    if (sums.outside > 0.0) {
       // Drop particles that left the band (rare: seeds start on the surface), on the CPU.
       const auto info = step_info_.read<Eigen::Vector4f>(count);
       download(count);

@@ -10,6 +10,7 @@
 #include "gpu/context.h"
 #include "gpu/gl.h"
 #include "gpu/hash_grid.h"
+#include "gpu/host_sync.h"
 #include "sdf/scan_convert.h"
 #include "sdf/sparse_field.h"
 
@@ -27,7 +28,9 @@ struct RelaxSettings {
   double max_move_over_cell = 0.25;  // CFL guard: no particle moves more than this fraction of a cell
   double band_limit = 0.0;           // |phi| at which a particle has left the band [m]
   int max_iterations = 2000;
-  int check_every = 10;              // convergence read back every k steps
+  // Convergence read back every k steps: each check drains the GPU's queue (a host round trip), the
+  // steps between make none. See docs/architecture.md for the measured cost of the check.
+  int check_every = 10;
   // Converged when the mean gradient step of the mobile particles (gain * tangential repulsion minus
   // phi n, the move plain descent would make) is below tolerance * spacing. Measured floor: 1.9e-4 to
   // 2.5e-4 on llvmpipe (sphere, torus, trefoil, bunny), set by the 8-bit weights of hardware trilinear
@@ -39,6 +42,7 @@ struct RelaxSettings {
 
 struct RelaxStats {
   int iterations = 0;
+  int checks = 0;  // convergence checks read back: ceil(iterations / check_every) unless converged early
   bool converged = false;
   double mean_move_over_spacing = 0.0;  // at the last check
   std::size_t removed = 0;              // left the band and were dropped
@@ -61,11 +65,22 @@ class GpuRelaxer {
                    std::vector<std::uint8_t>* mobile = nullptr);
 
   std::string timing_report() { return queue_.timing_report(); }
+  // Host-GPU round trips by phase over every relax() so far (gpu/host_sync.h): the iterations
+  // between checks (none, by design), the checks, and all of relax() (with uploads, band removals
+  // and the results read back).
+  std::vector<gpu::HostSyncPhase> round_trips() const;
   std::size_t gpu_bytes() const;
 
  private:
   void bind_sdf(const gpu::Program& program) const;
   void project(std::uint32_t count, int steps);
+  // One step: the hashed grid rebuilt, every particle moved (no read-back).
+  void iterate(std::uint32_t count, double cutoff);
+  // The convergence reduction, read back: one host round trip.
+  struct StepSums {
+    double moved = 0.0, outside = 0.0, moving = 0.0;
+  };
+  StepSums check(std::uint32_t count);
   gpu::Context& context_;
   sdf::GridSpec spec_;
   sdf::SparseField field_;
@@ -74,6 +89,8 @@ class GpuRelaxer {
   gpu::Program relax_, project_, reduce_;
   gpu::HashGrid grid_;
   gpu::Buffer positions_[2], velocities_, step_info_, partials_;
+  gpu::HostSyncCounts iteration_syncs_, check_syncs_, relax_syncs_;
+  std::int64_t iterations_run_ = 0, checks_run_ = 0;
 };
 
 }  // namespace ts::sampler

@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mass_properties.h"
+#include "gpu/host_sync.h"
 #include "sampler/interior_fill.h"
 #include "sampler/point_grid.h"
 #include "sampler/sampling_quality.h"
@@ -513,11 +514,22 @@ body::ParticleBody::Quality measure_quality(const Arrangement& a, const Coverage
   return q;
 }
 
+// The --timings table of host-GPU round trips: the scan conversion, the relaxer's phases, and the
+// whole run since `start` (the certificate's passes and the rest).
+std::string round_trip_report(const gpu::HostSyncCounts& scan, const GpuRelaxer& relaxer,
+                              const gpu::HostSyncCounts& start) {
+  std::vector<gpu::HostSyncPhase> phases{{"SDF scan conversion", scan, 0, ""}};
+  for (gpu::HostSyncPhase& phase : relaxer.round_trips()) phases.push_back(std::move(phase));
+  phases.push_back({"sample in all (with the certificate's passes)", gpu::host_sync_counts() - start, 0, ""});
+  return gpu::host_sync_report(phases);
+}
+
 }  // namespace
 
 SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const SampleSettings& settings,
                          const std::function<void(const SampleProgress&)>& progress) {
   const auto start = std::chrono::steady_clock::now();
+  const gpu::HostSyncCounts syncs_at_start = gpu::host_sync_counts();
   SampleResult result;
   // Validate and size (every check before the GPU work).
   if (!(surface_area(mesh) > 0.0)) throw InputError("the mesh has no surface area");
@@ -526,6 +538,7 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   // The field, and seeds spread over the surface.
   const sdf::GridSpec spec = choose_grid(mesh, plan.z.radius, settings);
   sdf::SparseField field = scan_field(context, mesh, spec, plan, settings, result);
+  const gpu::HostSyncCounts scan_syncs = gpu::host_sync_counts() - syncs_at_start;
   std::mt19937_64 rng(settings.seed);
   std::vector<Eigen::Vector3d> seeds = sample_surface_points(mesh, plan.z.count, rng).positions;
   // Relax and close holes.
@@ -548,7 +561,10 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   fill_body(a, exact, mesh, plan, settings, body);
   body.sdf_voxel_size = spec.voxel_size;
   body.quality.seconds = seconds_since(start);
-  if (settings.timings) result.timing_report += relaxer.timing_report() + certifier.timing_report();
+  if (settings.timings) {
+    result.timing_report += relaxer.timing_report() + certifier.timing_report();
+    result.timing_report += round_trip_report(scan_syncs, relaxer, syncs_at_start);
+  }
   return result;
 }
 

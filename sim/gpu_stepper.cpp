@@ -82,7 +82,8 @@ GpuStepper::GpuStepper(gpu::Context& context, const StepSettings& settings, Prec
       resort_fixup_(gpu::Program::compute(library_, "sim/resort_fixup.comp", precision_defines(precision))),
       gather_rows_(gpu::Program::compute(library_, "sim/gather_rows.comp")),
       bucket_sort_(library_),
-      resort_scan_(library_) {}
+      resort_scan_(library_),
+      syncs_at_start_(gpu::host_sync_counts()) {}
 
 template <typename T>
 gpu::Buffer GpuStepper::real_buffer(const std::vector<T>& values) const {
@@ -337,6 +338,8 @@ void GpuStepper::bind_state() const {
 }
 
 void GpuStepper::step(int steps) {
+  const gpu::HostSyncScope counted(step_syncs_);
+  steps_run_ += steps;
   if (particle_count_ == 0) {
     time_ += steps * settings_.dt;
     return;
@@ -610,8 +613,22 @@ std::size_t GpuStepper::gpu_bytes() const {
 StepStats GpuStepper::advance(World& world, std::int64_t steps) {
   if (!loaded_) upload(world);
   step(static_cast<int>(steps));
+  const gpu::HostSyncScope counted(output_syncs_);
+  ++outputs_;
   download(world);  // first, so that a run stopped by statistics() leaves the offending state in `world`
   return statistics();
+}
+
+std::vector<gpu::HostSyncPhase> GpuStepper::round_trips() const {
+  return {
+      {"sim steps between outputs", step_syncs_, steps_run_, "step"},
+      {"outputs (statistics, state read back)", output_syncs_, outputs_, "output"},
+      {"in all (uploads, frames, checkpoints, timers)", gpu::host_sync_counts() - syncs_at_start_, 0, ""}};
+}
+
+std::string GpuStepper::timing_report() {
+  std::string kernels = queue_.timing_report();  // first: its read of the timers is in the total
+  return kernels + gpu::host_sync_report(round_trips());
 }
 
 std::string GpuStepper::save_state() const {

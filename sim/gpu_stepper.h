@@ -13,6 +13,7 @@
 #include "gpu/context.h"
 #include "gpu/gl.h"
 #include "gpu/hash_grid.h"
+#include "gpu/host_sync.h"
 #include "sim/stepper.h"
 #include "sim/world.h"
 
@@ -35,7 +36,8 @@ class GpuStepper : public Stepper {
   StepStats advance(World& world, std::int64_t steps) override;
   // Recomputed by the CPU reference on `world` (sim/cpu_contacts.h).
   std::vector<ContactRecord> contacts(const World& world) override;
-  std::string timing_report() override { return queue_.timing_report(); }
+  // Per-kernel GPU times, then the host-GPU round trips of the steps, of the outputs and in all.
+  std::string timing_report() override;
   const StepSettings& settings() const override { return settings_; }
   std::string engine() const override { return precision_ == Precision::Double ? "gpu double" : "gpu float"; }
   // The persistent buffers in GPU memory order, the re-sort counter, the time and the energy check's
@@ -60,6 +62,10 @@ class GpuStepper : public Stepper {
   std::size_t gpu_bytes() const;
   // The world index of each body in GPU memory order (identity until the first re-sort).
   std::vector<std::uint32_t> body_order() const { return original_ids(original_body_, body_count_); }
+  // Host-GPU round trips by phase (gpu/host_sync.h): inside step() (none, by design), inside
+  // advance()'s read-backs after the steps, and all this thread's since this stepper was made
+  // (with the frames `sim` renders in the same context).
+  std::vector<gpu::HostSyncPhase> round_trips() const;
 
  private:
   template <typename T>
@@ -118,6 +124,9 @@ class GpuStepper : public Stepper {
   double energy_reference_ = 0.0, energy_scale_ = 0.0;  // J, blow-up check as CpuStepper
   bool any_kinematic_ = false;                          // kinematic bodies do work: no energy check
   bool loaded_ = false;
+  // For round_trips(): what the steps and the outputs cost, and the counts when this was made.
+  gpu::HostSyncCounts step_syncs_, output_syncs_, syncs_at_start_;
+  std::int64_t steps_run_ = 0, outputs_ = 0;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
 };
 

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -294,6 +295,22 @@ TEST(CliSample, JsonNamesTheThinRegionsAndTheRadiusThatResolvesThem) {
       << again;
   const auto resolved = nlohmann::json::parse(again.substr(again.find('{')));
   EXPECT_EQ(resolved.at("thin_features").at("triangles").get<int>(), 0) << resolved.at("thin_features");
+}
+
+// --timings: the kernels' times and the round trips, none in the iterations between the checks.
+TEST(CliSample, TimingsReportNoRoundTripBetweenConvergenceChecks) {
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sample " + quoted(test::asset("sphere.obj")) + " -o " +
+                                    quoted(test::temp_dir()) + kFast + "--timings",
+                                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("sampler/relax.comp"), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(relaxation iterations between checks \(\d+\) +0 )")))
+      << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(convergence checks \((\d+)\) +\d+ .* 1 per check)")))
+      << out;
+  EXPECT_NE(out.find("sample in all"), std::string::npos) << out;
 }
 
 TEST(CliSample, ReportPrintsTheCertificateAndTheHolesItLeaves) {

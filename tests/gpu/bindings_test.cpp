@@ -1,7 +1,8 @@
 // Static checks of the binding slots shared by GLSL and C++ (shaders/*/bindings.h): no shader or host
 // call uses a bare slot number, no two blocks of one pass share a slot, and the simulator and the
-// preview renderer, which share a context in `tetrasand sim`, use disjoint slots. Reads the sources
-// only; no GL context.
+// preview renderer, which share a context in `tetrasand sim`, use disjoint slots. And one of the host
+// sources: only the gpu layer, which counts them, makes the GL calls that wait for the GPU. Reads the
+// sources only; no GL context.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -48,6 +49,22 @@ std::vector<std::string> matching_lines(const std::string& text, const std::rege
   std::string line;
   for (int number = 1; std::getline(lines, line); ++number) {
     if (std::regex_search(line, pattern)) hits.push_back(file + ":" + std::to_string(number) + ": " + line);
+  }
+  return hits;
+}
+
+// "file:line: text" of each line matching `pattern` in the C++ of the host folders, but for `except`
+// (paths relative to the source root).
+std::vector<std::string> host_lines_matching(const std::regex& pattern, const std::vector<std::string>& dirs,
+                                             const std::set<std::string>& except = {}) {
+  std::vector<std::string> hits;
+  for (const std::string& dir : dirs) {
+    for (const fs::path& file : files_below(kSource / dir, {".cpp", ".h"})) {
+      const fs::path path = fs::path(dir) / file;
+      if (except.count(path.generic_string())) continue;
+      for (auto& hit : matching_lines(read_text(kSource / path), pattern, path.generic_string()))
+        hits.push_back(hit);
+    }
   }
   return hits;
 }
@@ -150,14 +167,24 @@ TEST(Bindings, NoShaderUsesABareSlotNumber) {
 TEST(Bindings, NoHostCallBindsABareSlotNumber) {
   // Buffer::bind, and the GL calls that take a binding point or unit first.
   const std::regex bare(R"((\.bind\(\s*[0-9])|(glBindBuffer(Base|Range)\(\s*\w+\s*,\s*[0-9])|(glBind(TextureUnit|ImageTexture|Sampler)\(\s*[0-9]))");
-  std::vector<std::string> hits;
-  for (const char* dir : {"core", "gpu", "sdf", "sampler", "sim", "preview", "app", "bench", "tests"}) {
-    for (const fs::path& file : files_below(kSource / dir, {".cpp", ".h"})) {
-      const fs::path path = fs::path(dir) / file;
-      for (auto& hit : matching_lines(read_text(kSource / path), bare, path.generic_string())) hits.push_back(hit);
-    }
-  }
+  const auto hits =
+      host_lines_matching(bare, {"core", "gpu", "sdf", "sampler", "sim", "preview", "app", "bench", "tests"});
   EXPECT_TRUE(hits.empty()) << "use the slot's name from shaders/*/bindings.h:\n" << ::testing::PrintToString(hits);
+}
+
+// Reads of GPU memory, finishes, fence waits and query results drain the GPU's queue; gpu/host_sync.h
+// counts each where the gpu layer makes it, so no other host code may call them (tests may).
+TEST(HostSources, OnlyTheGpuLayerMakesTheGlCallsThatWait) {
+  // No '/' before the call on its line: comments that name a call do not count.
+  const std::regex waits(
+      R"(^[^/]*\bgl(Finish|ClientWaitSync|GetQueryObject\w*|GetQueryBufferObject\w*|Get(Named)?BufferSubData|)"
+      R"(Map(Named)?Buffer\w*|GetTexImage|GetTextureImage|GetTextureSubImage|Readn?Pixels)\s*\()");
+  const std::set<std::string> counted{"gpu/gl.cpp", "gpu/graphics.cpp", "gpu/context.cpp"};
+  ASSERT_GE(host_lines_matching(waits, {"gpu"}).size(), 3u);  // the counted calls: the check sees them
+  const auto hits = host_lines_matching(
+      waits, {"core", "gpu", "sdf", "sampler", "sim", "preview", "app", "bench"}, counted);
+  EXPECT_TRUE(hits.empty()) << "read or wait through gpu::Buffer, gpu::Texture, Queue or Context:\n"
+                            << ::testing::PrintToString(hits);
 }
 
 TEST(Bindings, NoTwoBlocksOfOnePassShareASlot) {

@@ -86,7 +86,15 @@ TEST_F(Relaxer, SpreadsRandomSeedsEvenlyOverASphere) {
   EXPECT_LT(worst_off_surface, 0.05 * d_hex);
 }
 
-TEST_F(Relaxer, SameSeedsGiveBitwiseTheSameResult) {
+// A coarse unit sphere's field, `count` seeds on it and settings that keep them all in the band: for
+// tests of the loop rather than of the result's quality.
+struct CoarseSphere {
+  GpuRelaxer relaxer;
+  std::vector<Eigen::Vector3f> seeds;
+  RelaxSettings settings;
+};
+
+CoarseSphere coarse_sphere(gpu::Context& context, std::size_t count) {
   const TriangleMesh sphere = test::icosphere(1.0, 2);
   const sdf::GridSpec spec = grid_around_sphere(1.0, 0.1, 6);
   sdf::ScanConvertOptions options;
@@ -94,18 +102,46 @@ TEST_F(Relaxer, SameSeedsGiveBitwiseTheSameResult) {
   auto field = sdf::scan_convert(context, sphere, sdf::compute_pseudonormals(sphere), spec, options);
   std::mt19937_64 rng(7);
   std::normal_distribution<double> gauss;
-  std::vector<Eigen::Vector3f> seeds(300);
+  std::vector<Eigen::Vector3f> seeds(count);
   for (auto& p : seeds) p = (Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized() - spec.origin).cast<float>();
   RelaxSettings settings;
   settings.spacing = 0.2;
   settings.band_limit = 0.25;
+  return {GpuRelaxer(context, sdf::SparseField(*field.grid, spec, options.band)), std::move(seeds), settings};
+}
+
+TEST_F(Relaxer, SameSeedsGiveBitwiseTheSameResult) {
+  auto [relaxer, seeds, settings] = coarse_sphere(context, 300);
   settings.max_iterations = 50;
-  GpuRelaxer relaxer(context, sdf::SparseField(*field.grid, spec, options.band));
   auto a = seeds, b = seeds;
   relaxer.relax(a, settings);
   relaxer.relax(b, settings);
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << i;
+}
+
+// Iterations between convergence checks read nothing back; each check reads its reduction once, so
+// M iterations checked every K make ceil(M / K) round trips, and the result's read-back one more.
+TEST_F(Relaxer, MakesOneHostRoundTripPerConvergenceCheckAndNoneBetween) {
+  auto [relaxer, seeds, settings] = coarse_sphere(context, 100);
+  settings.max_iterations = 25;
+  settings.check_every = 10;
+  settings.tolerance = 0.0;  // never converged: all 25 iterations run
+  const gpu::HostSyncCounts before = gpu::host_sync_counts();
+  const RelaxStats stats = relaxer.relax(seeds, settings);
+  const gpu::HostSyncCounts made = gpu::host_sync_counts() - before;
+  ASSERT_EQ(stats.removed, 0u);
+  EXPECT_EQ(stats.iterations, 25);
+  EXPECT_EQ(stats.checks, 3);
+  const std::vector<gpu::HostSyncPhase> phases = relaxer.round_trips();
+  ASSERT_EQ(phases.size(), 3u);
+  EXPECT_EQ(phases[0].units, 25);
+  EXPECT_EQ(phases[0].counts.total(), 0);
+  EXPECT_EQ(phases[1].units, 3);
+  EXPECT_EQ(phases[1].counts.reads, 3);
+  EXPECT_EQ(phases[1].counts.total(), 3);
+  EXPECT_EQ(made.total(), 3 + 1);
+  EXPECT_EQ(phases[2].counts, made);  // all of relax()
 }
 
 }  // namespace

@@ -326,6 +326,33 @@ TEST_F(GpuStepperTest, ForcesAfterAResortAgreeWithTheUnsortedOrder) {
   EXPECT_LT(worst, 1e-5 * scale);
 }
 
+// Between two outputs the steps run on the GPU alone: no buffer read, finish or timer read, also
+// across a re-sort and with --timings' queries in flight (more than the 256 after which timers were
+// once read mid-run); the outputs read back, and the timers are read once, at the end.
+TEST_F(GpuStepperTest, StepsBetweenOutputsMakeNoHostRoundTrip) {
+  World world = jostling_grains(8, 4);
+  StepSettings settings = spring_step();
+  settings.resort_every = 7;
+  GpuStepper gpu(context, world, settings, Precision::Float, /*timings=*/true);
+  gpu.advance(world, 3);
+  const gpu::HostSyncCounts before = gpu::host_sync_counts();
+  gpu.step(30);
+  EXPECT_EQ((gpu::host_sync_counts() - before).total(), 0);
+  gpu.advance(world, 30);
+  const std::vector<gpu::HostSyncPhase> phases = gpu.round_trips();
+  ASSERT_EQ(phases.size(), 3u);
+  EXPECT_EQ(phases[0].units, 63);
+  EXPECT_EQ(phases[0].counts.total(), 0);
+  EXPECT_EQ(phases[1].units, 2);
+  EXPECT_EQ(phases[1].counts.reads, 2 * (7 + 3));  // state with springs, statistics (docs/architecture.md)
+  EXPECT_EQ(phases[1].counts.query_reads, 0);
+  EXPECT_EQ(phases[2].counts.query_reads, 0);
+  const std::string report = gpu.timing_report();
+  EXPECT_NE(report.find("sim/contact_forces.comp"), std::string::npos) << report;
+  EXPECT_NE(report.find("sim steps between outputs (63)"), std::string::npos) << report;
+  EXPECT_EQ(gpu.round_trips()[2].counts.query_reads, 1) << report;
+}
+
 TEST_F(GpuStepperTest, FreeFallMatchesAnalyticSolutionToTheChosenPrecision) {
   for (Precision precision : {Precision::Float, Precision::Double}) {
   World world;

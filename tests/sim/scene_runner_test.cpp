@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -151,7 +152,8 @@ namespace ts::sim {
 namespace {
 
 // `tetrasand sim --timings` on the GPU with the spring model: the run finishes (the kernel report
-// used to read a destroyed stepper), reports the spring slots, and metrics.csv has their column.
+// used to read a destroyed stepper), reports the spring slots and the host-GPU round trips, and
+// metrics.csv has the slots' column.
 TEST(SimCommand, GpuRunWithSpringsAndTimingsReportsBoth) {
   std::ifstream in(test::asset("scenes/two_grain_collision.toml"));
   std::stringstream text;
@@ -168,6 +170,8 @@ TEST(SimCommand, GpuRunWithSpringsAndTimingsReportsBoth) {
   EXPECT_EQ(code, 0) << output;
   EXPECT_NE(output.find("sim/contact_forces.comp"), std::string::npos) << output;
   EXPECT_NE(output.find("spring slots: 0 overflows"), std::string::npos) << output;
+  // The round trips: none in the steps between outputs (docs/architecture.md, where the host waits).
+  EXPECT_TRUE(std::regex_search(output, std::regex(R"(sim steps between outputs \(\d+\) +0 )"))) << output;
   std::ifstream csv(dir / "out" / "metrics.csv");
   std::string header;
   std::getline(csv, header);

@@ -1,0 +1,78 @@
+// The host-GPU round-trip counts (gpu/host_sync.h): each call that waits for the GPU is counted once,
+// work that is only issued is not, and timer queries are read at the end, not while kernels run.
+#include "gpu/host_sync.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "gpu/context.h"
+#include "gpu/gl.h"
+#include "shaders/test/bindings.h"
+
+namespace ts::gpu {
+namespace {
+
+class HostSync : public ::testing::Test {
+ protected:
+  Context context;
+  ShaderLibrary library;
+};
+
+TEST_F(HostSync, EachBufferReadIsOneRoundTripAndUploadsNone) {
+  Buffer buffer(64);
+  const HostSyncCounts before = host_sync_counts();
+  buffer.upload(std::vector<float>(16, 1.0f).data(), 64);
+  buffer.fill_zero();
+  EXPECT_EQ((host_sync_counts() - before).total(), 0);
+  buffer.read<float>(16);
+  buffer.read<float>(4, 8);
+  buffer.read<float>(0);  // nothing to read, no wait
+  const HostSyncCounts made = host_sync_counts() - before;
+  EXPECT_EQ(made.reads, 2);
+  EXPECT_EQ(made.total(), 2);
+}
+
+TEST_F(HostSync, FinishIsCountedOnTheQueueAndTheContext) {
+  Queue queue;
+  const HostSyncCounts before = host_sync_counts();
+  queue.finish();
+  context.finish();
+  EXPECT_EQ((host_sync_counts() - before).finishes, 2);
+}
+
+TEST_F(HostSync, TimerQueriesAreReadOnlyAtTheEnd) {
+  Program saxpy = Program::compute(library, "test/saxpy.comp");
+  Buffer x(4), y(4);
+  x.bind(TS_TEST_SAXPY_X);
+  y.bind(TS_TEST_SAXPY_Y);
+  saxpy.set("a", 1.0f);
+  saxpy.set("count", 1u);
+  Queue queue(/*timings=*/true);
+  const HostSyncCounts before = host_sync_counts();
+  const int kernels = 600;  // more than the 256 after which timers were once read mid-run
+  for (int k = 0; k < kernels; ++k) queue.dispatch_items(saxpy, 1);
+  EXPECT_EQ((host_sync_counts() - before).total(), 0);
+  const auto timings = queue.timings();
+  ASSERT_EQ(timings.size(), 1u);
+  EXPECT_EQ(timings[0].calls, static_cast<std::size_t>(kernels));
+  const HostSyncCounts made = host_sync_counts() - before;
+  EXPECT_EQ(made.query_reads, 1);
+  EXPECT_EQ(made.total(), 1);
+  queue.timings();  // nothing pending: no second wait
+  EXPECT_EQ((host_sync_counts() - before).total(), 1);
+}
+
+TEST(HostSyncReport, ListsEachPhaseWithItsRoundTripsPerUnit) {
+  HostSyncCounts checks;
+  checks.reads = 3;
+  const std::string report =
+      host_sync_report({{"iterations", {}, 25, "iteration"}, {"checks", checks, 3, "check"}});
+  EXPECT_NE(report.find("host-GPU round trips"), std::string::npos) << report;
+  EXPECT_NE(report.find("iterations (25)"), std::string::npos) << report;
+  EXPECT_NE(report.find("0 per iteration"), std::string::npos) << report;
+  EXPECT_NE(report.find("1 per check"), std::string::npos) << report;
+}
+
+}  // namespace
+}  // namespace ts::gpu
