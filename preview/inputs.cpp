@@ -53,13 +53,14 @@ LoadedParticles load_particles(const std::filesystem::path& file, double radius)
   } else {
     out.particles.centers = to_double(body::read_particles_ply(file).positions);
     if (out.particles.centers.empty()) throw InputError(file, "holds no particles");
-    const bool beside =
-        ends_with(name, ".particles.ply") &&
-        std::filesystem::exists(file.parent_path() / (name.substr(0, name.size() - 14) + ".body.json"));
-    if (beside) {
-      out.sampled_radius =
-          body::read_body(file.parent_path() / (name.substr(0, name.size() - 14) + ".body.json"))
-              .particle_radius;
+    // NAME.particles.ply: the NAME.body.json beside it knows the radius.
+    const std::string suffix = ".particles.ply";
+    const std::filesystem::path beside =
+        ends_with(name, suffix)
+            ? file.parent_path() / (name.substr(0, name.size() - suffix.size()) + ".body.json")
+            : std::filesystem::path();
+    if (!beside.empty() && std::filesystem::exists(beside)) {
+      out.sampled_radius = body::read_body(beside).particle_radius;
       out.radius_source = "body.json";
     } else {
       out.sampled_radius = estimate_radius(out.particles.centers);

@@ -114,7 +114,7 @@ std::size_t grains_of(const Scene& scene, const World& world) {
 class OutputWriter {
  public:
   OutputWriter(const Scene& scene, const std::filesystem::path& dir, const RunHooks& hooks)
-      : scene_(scene), settings_(scene.output), dir_(dir), hooks_(hooks) {
+      : scene_(scene), dir_(dir), hooks_(hooks) {
     std::filesystem::create_directories(dir_);
     csv_ = "step,time_s,grains,kinetic_translational_J,kinetic_rotational_J,potential_J,elastic_J,contacts,"
            "wall_contacts,max_overlap_ratio,velocity_clamps,angular_velocity_clamps,overlap_clamps,spring_overflows\n";
@@ -122,7 +122,7 @@ class OutputWriter {
 
   void write(const World& world, const StepStats& stats, std::int64_t step, Stepper& stepper) {
     const std::string index = fmt::format("{:06d}", frame_);
-    if (settings_.csv) {
+    if (scene_.output.csv) {
       csv_ += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{},{},{}\n", step,
                           world.time, grains_of(scene_, world), stats.energy.translational,
                           stats.energy.rotational, stats.energy.potential, stats.elastic_energy,
@@ -130,10 +130,11 @@ class OutputWriter {
                           stats.angular_velocity_clamps, stats.overlap_clamps, stats.spring_overflows);
       write_file_atomically(dir_ / "metrics.csv", csv_);  // whole file each time: valid after any interruption
     }
-    if (settings_.ply) write_particles_ply(world, dir_ / ("particles_" + index + ".ply"));
-    if (settings_.vtp) write_particles_vtp(world, dir_ / ("particles_" + index + ".vtp"));
-    if (settings_.contacts) write_contacts_csv(stepper.contacts(world), dir_ / ("contacts_" + index + ".csv"));
-    if (settings_.frames) {
+    if (scene_.output.ply) write_particles_ply(world, dir_ / ("particles_" + index + ".ply"));
+    if (scene_.output.vtp) write_particles_vtp(world, dir_ / ("particles_" + index + ".vtp"));
+    if (scene_.output.contacts)
+      write_contacts_csv(stepper.contacts(world), dir_ / ("contacts_" + index + ".csv"));
+    if (scene_.output.frames) {
       if (hooks_.write_frame) {
         hooks_.write_frame(world, frame_, dir_);
       } else if (frame_ == 0) {
@@ -150,11 +151,11 @@ class OutputWriter {
   // run's included: its frame counter goes on from the checkpoint's).
   std::vector<OutputRecord> files() const {
     std::vector<OutputRecord> files;
-    if (settings_.csv) files.push_back({"metrics.csv", frame_, "rows"});
-    if (settings_.ply) files.push_back({"particles_NNNNNN.ply", frame_, "files"});
-    if (settings_.vtp) files.push_back({"particles_NNNNNN.vtp", frame_, "files"});
-    if (settings_.contacts) files.push_back({"contacts_NNNNNN.csv", frame_, "files"});
-    if (settings_.frames && hooks_.write_frame) files.push_back({"frame_NNNNNN.png", frame_, "files"});
+    if (scene_.output.csv) files.push_back({"metrics.csv", frame_, "rows"});
+    if (scene_.output.ply) files.push_back({"particles_NNNNNN.ply", frame_, "files"});
+    if (scene_.output.vtp) files.push_back({"particles_NNNNNN.vtp", frame_, "files"});
+    if (scene_.output.contacts) files.push_back({"contacts_NNNNNN.csv", frame_, "files"});
+    if (scene_.output.frames && hooks_.write_frame) files.push_back({"frame_NNNNNN.png", frame_, "files"});
     return files;
   }
   // Goes on after `frames` outputs whose metrics.csv was `csv` (a resumed run).
@@ -165,7 +166,6 @@ class OutputWriter {
 
  private:
   const Scene& scene_;
-  OutputSettings settings_;
   std::filesystem::path dir_;
   const RunHooks& hooks_;
   std::string csv_;
