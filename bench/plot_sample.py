@@ -14,6 +14,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+# The sampler's defaults (sampler/sample_mesh.h), starred on the trade plot.
+DEFAULT_ROUNDS, DEFAULT_MAX_ITERATIONS = 12, 2000
 STYLE = {"tetrasand": ("tab:blue", "o", "tetrasand (llvmpipe)"), "Open3D": ("tab:orange", "s", "Open3D poisson disk")}
 
 
@@ -52,6 +54,9 @@ def plot_trade(rows, png):
             ax.plot(t, [float(r[key]) for r in mine], marker="o", color=colour, label=f"--max-iterations {cap}")
             for r, x in zip(mine, t):
                 ax.annotate(f"{r['rounds']}", (x, float(r[key])), fontsize=7, xytext=(3, 3), textcoords="offset points")
+                if int(r["rounds"]) == DEFAULT_ROUNDS and cap == DEFAULT_MAX_ITERATIONS:
+                    ax.scatter([x], [float(r[key])], marker="*", s=220, color="gold", edgecolor="black", zorder=5,
+                               label="default (--rounds 12, --max-iterations 2000)")
     mesh = rows[0]["mesh"]
     axes[0].set_title(f"{mesh}, {rows[0]['requested']} particles: c / r (labels: --rounds)")
     axes[1].set_title("relative radius rho")

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
-# Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|peers-sim|sim|sim-accuracy|validation|oedometer|agreement|all]
+# Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|agreement|all]
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
 #               its section of docs/benchmarks.md (--quick: knot1 and armadillo at 64^3 and 128^3, 1,000
@@ -21,6 +21,10 @@
 #               100k and 200k particles, an independent 10M-probe check of each, and the criteria of
 #               bench/certificate_criteria.md -> section certificate of docs/benchmarks.md
 #               (--quick: 1k and 10k only)                                    (~25 min on llvmpipe, 2 cores)
+#   defaults    every default (dt, integrator, precision, damping, friction model, sampler rounds,
+#               iterations and voxel, sdf band) against the trade tables and bench/defaults_criteria.md,
+#               with the sampler-voxel and sdf-band trades run anew (knot1, bunny)
+#               -> section defaults of docs/benchmarks.md, docs/benchmarks/defaults.png  (~5 min, 2 cores)
 #   validation  restitution, angle of repose, column collapse (4 x 20,000 grains), Mankoc-sized silo
 #               discharge (80,000 grains) with a Beverloo fit, contact-force distribution (the silo's fill
 #               and 3 more 30,000-grain piles), on the CPU reference
@@ -63,7 +67,7 @@ while [ $# -gt 0 ]; do
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in peers|sdf|sparse|sample|certificate|peers-sim|sim|sim-accuracy|validation|oedometer|agreement|all) ;;
+case "$what" in peers|sdf|sparse|sample|certificate|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|agreement|all) ;;
   *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;;
 esac
 [ "$quick" -eq 1 ] && sdf_cases="knot1@64,128 armadillo@64,128"
@@ -119,6 +123,11 @@ if runs certificate; then
   (cd "$root" && "$py" bench/certificate_bench.py --tetrasand "$bin/tetrasand" --counts "${counts[@]}" \
     --csv "$work/certificate.csv" --markdown docs/benchmarks.md \
     --command "scripts/bench.sh certificate$([ "$quick" -eq 1 ] && echo ' --quick')") || status=1
+fi
+if runs defaults; then
+  defaults_args=()
+  [ "$quick" -eq 1 ] && defaults_args=(--quick --repeats 1)
+  "$py" "$root/bench/defaults.py" "$bin/tetrasand" "$root/docs" --work "$work/defaults" "${defaults_args[@]}" || status=1
 fi
 if runs validation; then
   "$bin/tetrasand_validation_runs" "$work/validation" all

@@ -13,7 +13,7 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfmt-dev libstb-dev libssl-dev
   libgtest-dev googletest
   libcgal-demo assimp-testmodels
-  lammps
+  lammps python3
 )
 
 missing=()
