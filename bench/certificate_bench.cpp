@@ -75,7 +75,9 @@ nlohmann::json certificate_figures(ts::gpu::Context& context, const ts::Triangle
           {"evaluated", c.evaluated},
           {"levels", c.levels},
           {"margin_over_r", c.margin / r},
-          {"budget_reached", c.budget_reached}};
+          {"budget_reached", c.budget_reached},
+          {"tiles", c.tiles},
+          {"tiles_redone", c.tiles_redone}};
 }
 
 double probe_pass(const ts::TriangleMesh& mesh, const std::vector<Eigen::Vector3f>& centres,

@@ -21,7 +21,8 @@ import argparse, csv, json, os, platform, re, subprocess, sys, tempfile, time
 
 FIELDS = ["mesh", "requested", "particles", "sample_s", "rounds", "sample_certificate_s", "sample_passes",
           "sample_probes_s", "certified", "bound_over_r", "lower_over_r", "probes_c_over_r", "independent_c_over_r",
-          "certificate_s", "probes_s", "ratio", "evaluated", "uncovered", "levels", "margin_over_r", "criterion_holds"]
+          "certificate_s", "probes_s", "ratio", "evaluated", "uncovered", "levels", "tiles", "margin_over_r",
+          "criterion_holds"]
 
 
 def run_sample(exe, mesh, count, out, extra):
@@ -101,15 +102,15 @@ def main():
 def table(rows, independent):
     lines = [f"| N | sample s | rounds | certificate in the run: s (passes) | share of the run | probe pass in the run s "
              f"| certified | bound c / r | lower c / r | 1M probes c / r | {independent / 1e6:.0f}M probes c / r "
-             "| certificate s | 1M-probe pass s | ratio | sub-triangles | levels | margin / r |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| certificate s | 1M-probe pass s | ratio | sub-triangles | levels | tiles | margin / r |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['particles']} | {r['sample_s']:.1f} | {r['rounds']} | {r['sample_certificate_s']:.2f} "
                      f"({r['sample_passes']}) | {r['sample_certificate_s'] / r['sample_s']:.0%} | {r['sample_probes_s']:.2f} | "
                      f"{'yes' if r['certified'] else 'NO'} | {r['bound_over_r']:.4f} | "
                      f"{r['lower_over_r']:.4f} | {r['probes_c_over_r']:.4f} | {r['independent_c_over_r']:.4f} | "
                      f"{r['certificate_s']:.2f} | {r['probes_s']:.2f} | {r['ratio']:.2f} | {r['evaluated']} | "
-                     f"{r['levels']} | {r['margin_over_r']:.1e} |")
+                     f"{r['levels']} | {r.get('tiles', 1)} | {r['margin_over_r']:.1e} |")
     return "\n".join(lines)
 
 

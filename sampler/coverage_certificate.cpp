@@ -153,12 +153,11 @@ CoverageCertifier::Frame CoverageCertifier::upload_centres(std::span<const Eigen
   return frame;
 }
 
-void CoverageCertifier::seed_queue() {
-  std::vector<gpu::layout::uvec4> level0(mesh_.triangle_count());
-  for (std::size_t t = 0; t < level0.size(); ++t) level0[t] = {static_cast<std::uint32_t>(t), 0u, 0u, 0u};
+void CoverageCertifier::seed_queue(std::uint32_t begin, std::uint32_t end) {
+  std::vector<gpu::layout::uvec4> level0(end - begin);
+  for (std::uint32_t t = begin; t < end; ++t) level0[t - begin] = {t, 0u, 0u, 0u};
   ensure(queue_buffers_[0], level0.size() * sizeof(gpu::layout::uvec4));
   if (!level0.empty()) queue_buffers_[0].upload(std::span<const gpu::layout::uvec4>(level0));
-  totals_.fill_zero();
 }
 
 CoverageCertifier::LevelCounts CoverageCertifier::evaluate(std::uint32_t count, const Frame& frame,
@@ -299,6 +298,36 @@ void CoverageCertifier::finish(CoverageCertificate& result, const Frame& frame, 
   result.margin = frame.margin;
 }
 
+CoverageCertifier::Tile CoverageCertifier::certify_tile(std::uint32_t begin, std::uint32_t end,
+                                                        const Frame& frame,
+                                                        const CertificateSettings& settings, float& witness) {
+  Tile tile;
+  seed_queue(begin, end);
+  std::uint32_t count = end - begin;
+  for (int level = 0; count > 0; ++level) {
+    LevelCounts counts = evaluate(count, frame, settings, witness, false);
+    if (counts.children > settings.max_subtriangles) {
+      if (end - begin > 1) {
+        tile.over_budget = true;
+        tile.children = counts.children;
+        return tile;
+      }
+      counts = evaluate(count, frame, settings, witness, true);
+      tile.budget_reached = true;
+    }
+    scatter(count, counts);
+    std::vector<UncoveredPiece> pieces = read_pieces(counts.uncovered);
+    tile.pieces.insert(tile.pieces.end(), pieces.begin(), pieces.end());
+    witness = bits_to_float(totals_.read<std::uint32_t>(2)[1]);
+    log::debug("certificate level {}: {} sub-triangles, {} split, {} left uncovered, witness {:.4g} m", level,
+               count, counts.children / 4, counts.uncovered, witness);
+    tile.evaluated += count;
+    tile.levels = level + 1;
+    count = counts.children;
+  }
+  return tile;
+}
+
 CoverageCertificate CoverageCertifier::certify(std::span<const Eigen::Vector3f> centres, double radius,
                                                const CertificateSettings& settings) {
   if (centres.empty()) throw Error(ExitCode::Internal, "coverage certificate: no centres");
@@ -314,24 +343,38 @@ CoverageCertificate CoverageCertifier::certify(std::span<const Eigen::Vector3f> 
   result.radius = radius;
   result.floor = radius / settings.floor_divisor;
   const Frame frame = upload_centres(centres, radius);
-  seed_queue();
-  auto count = static_cast<std::uint32_t>(mesh_.triangle_count());
+  totals_.fill_zero();
   float witness = 0.0f;
-  for (int level = 0; count > 0; ++level) {
-    LevelCounts counts = evaluate(count, frame, settings, witness, false);
-    if (counts.children > settings.max_subtriangles) {
-      counts = evaluate(count, frame, settings, witness, true);
-      result.budget_reached = true;
+  // Ranges of triangles still to certify, the next one last. A range given up past the budget is
+  // split into enough parts that each should fit; what its given-up levels added to the totals (the
+  // largest bound of a final piece, the deepest point) are facts about real pieces of the surface,
+  // so they stay: the bound can only be looser for it, never optimistic.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges{
+      {0u, static_cast<std::uint32_t>(mesh_.triangle_count())}};
+  while (!ranges.empty()) {
+    const auto [begin, end] = ranges.back();
+    ranges.pop_back();
+    Tile tile = certify_tile(begin, end, frame, settings, witness);
+    if (tile.over_budget) {
+      const std::uint32_t size = end - begin;
+      const std::uint32_t parts = std::clamp<std::uint32_t>(
+          static_cast<std::uint32_t>(2 * (tile.children / settings.max_subtriangles + 1)), 2u, size);
+      for (std::uint32_t k = parts; k-- > 0;) {
+        ranges.emplace_back(begin + static_cast<std::uint32_t>(std::uint64_t{size} * k / parts),
+                            begin + static_cast<std::uint32_t>(std::uint64_t{size} * (k + 1) / parts));
+      }
+      ++result.tiles_redone;
+      log::debug(
+          "certificate: triangles [{}, {}) would make {} sub-triangles at one level, over the budget of {}: "
+          "split into {} tiles",
+          begin, end, tile.children, settings.max_subtriangles, parts);
+      continue;
     }
-    scatter(count, counts);
-    std::vector<UncoveredPiece> pieces = read_pieces(counts.uncovered);
-    result.pieces.insert(result.pieces.end(), pieces.begin(), pieces.end());
-    witness = bits_to_float(totals_.read<std::uint32_t>(2)[1]);
-    log::debug("certificate level {}: {} sub-triangles, {} split, {} left uncovered, witness {:.4g} m", level,
-               count, counts.children / 4, counts.uncovered, witness);
-    result.evaluated += count;
-    result.levels = level + 1;
-    count = counts.children;
+    result.pieces.insert(result.pieces.end(), tile.pieces.begin(), tile.pieces.end());
+    result.evaluated += tile.evaluated;
+    result.levels = std::max(result.levels, tile.levels);
+    result.budget_reached = result.budget_reached || tile.budget_reached;
+    ++result.tiles;
   }
   bound_unsearched(result.pieces, centres, radius);
   finish(result, frame, witness);

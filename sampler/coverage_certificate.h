@@ -31,9 +31,11 @@ struct CertificateSettings {
   // The neighbour search visits at most this many shells of grid cells (cell = radius) around a
   // sub-triangle; one that finds no centre there is bounded on the CPU (exact nearest centre).
   int max_shells = 8;
-  // Sub-triangles one level may hand to the next; past it that level is final (still conservative:
-  // what is not proven covered is reported uncovered). 8M sub-triangles take about 330 MB; at most
-  // 16M (the prefix scan's one-dispatch limit).
+  // Sub-triangles one level may hand to the next, which bounds the certificate's GPU memory (8M take
+  // about 330 MB; at most 16M, the prefix scan's one-dispatch limit). Triangles are certified in
+  // tiles (ranges of triangles): a tile whose next level would pass this is split and redone, so the
+  // budget costs time, not refinement. Only a single triangle past it has that level made final
+  // (still conservative: what is not proven covered is reported uncovered).
   std::size_t max_subtriangles = std::size_t{1} << 23;
 };
 
@@ -61,7 +63,10 @@ struct CoverageCertificate {
   int levels = 0;
   double floor = 0.0;                  // m, radius / floor_divisor
   double margin = 0.0;                 // m, the float margin added to the bound (absolute part)
-  bool budget_reached = false;         // a level was made final by CertificateSettings::max_subtriangles
+  bool budget_reached =
+      false;              // one triangle's level was made final by CertificateSettings::max_subtriangles
+  std::size_t tiles = 0;  // triangle ranges certified (1 when the whole mesh fitted the budget)
+  std::size_t tiles_redone = 0;        // ranges given up past the budget and split
   std::vector<UncoveredPiece> pieces;  // every uncovered final sub-triangle, deepest first
 };
 
@@ -93,8 +98,19 @@ class CoverageCertifier {
   struct LevelCounts {
     std::uint32_t children = 0, uncovered = 0;
   };
+  // What certifying one range of triangles gave; `over_budget`: given up, the range must be split.
+  struct Tile {
+    std::vector<UncoveredPiece> pieces;
+    std::size_t evaluated = 0;
+    int levels = 0;
+    bool budget_reached = false;
+    bool over_budget = false;
+    std::uint32_t children = 0;  // with over_budget: the sub-triangles the level would have made
+  };
   Frame upload_centres(std::span<const Eigen::Vector3f> centres, double radius);
-  void seed_queue();
+  void seed_queue(std::uint32_t begin, std::uint32_t end);
+  Tile certify_tile(std::uint32_t begin, std::uint32_t end, const Frame& frame,
+                    const CertificateSettings& settings, float& witness);
   LevelCounts evaluate(std::uint32_t count, const Frame& frame, const CertificateSettings& settings,
                        float witness_so_far, bool no_split);
   void scatter(std::uint32_t count, const LevelCounts& counts);

@@ -450,7 +450,8 @@ void warn_about_quality(const CoverageFigures& f, int rounds, const SamplingPlan
   }
   if (c.budget_reached) {
     result.warnings.push_back(
-        "the coverage certificate reached its sub-triangle budget: it stopped refining early "
+        "the coverage certificate reached its sub-triangle budget on a single triangle (one triangle alone "
+        "needs more sub-triangles at one level than the budget): it stopped refining that triangle early "
         "(still conservative, but coarser)");
   }
   const ThinFeatures& thin = result.thin;

@@ -313,7 +313,7 @@ TEST(CoverageCertificate, NeverBelowDenseSamplingNorTheExactValueOnARandomSet) {
   }
 }
 
-TEST(CoverageCertificate, SameInputGivesTheSameBitsAndABudgetStaysConservative) {
+TEST(CoverageCertificate, SameInputGivesTheSameBitsAndABudgetCostsTilesNotRefinement) {
   const TriangleMesh sphere = test::icosphere(1.0, 3);
   const std::vector<Eigen::Vector3d> centres(sphere.vertices.begin(), sphere.vertices.begin() + 42);
   const std::vector<Eigen::Vector3f> stored = to_float(centres);
@@ -329,13 +329,31 @@ TEST(CoverageCertificate, SameInputGivesTheSameBitsAndABudgetStaysConservative) 
     EXPECT_EQ(a.pieces[k].position, b.pieces[k].position);
     EXPECT_EQ(a.pieces[k].bound, b.pieces[k].bound);
   }
-  // A level budget smaller than the work makes that level final: coarser, never optimistic.
+  // A level budget smaller than the work splits the triangles into tiles, each certified to the
+  // floor: the verdict of the unlimited run, bounds as tight to within the floor, nothing coarser.
   const double exact = exact_covering_radius(sphere, to_double(stored));
   CertificateSettings tight;
   tight.max_subtriangles = 5000;
   for (const double r : {0.3, 1.2 * exact}) {
-    const CoverageCertificate budget = certifier.certify(stored, r, tight);
+    const CoverageCertificate whole = certifier.certify(stored, r);
+    const CoverageCertificate tiled = certifier.certify(stored, r, tight);
+    EXPECT_EQ(whole.tiles, 1u);
+    EXPECT_GT(tiled.tiles, 1u);
+    EXPECT_GE(tiled.tiles_redone, 1u);
+    EXPECT_FALSE(tiled.budget_reached);
+    EXPECT_EQ(tiled.covered, whole.covered);
+    EXPECT_GE(tiled.covering_bound, exact);
+    EXPECT_LE(tiled.covering_lower, exact);
+    EXPECT_LE(tiled.covering_bound, exact + std::max(r, exact) / tight.floor_divisor + 1e-6);
+    EXPECT_EQ(tiled.covered, tiled.covering_bound <= r);
+  }
+  // A budget even one triangle passes makes that triangle's level final: coarser, never optimistic.
+  CertificateSettings starved;
+  starved.max_subtriangles = 3;
+  for (const double r : {0.3, 1.2 * exact}) {
+    const CoverageCertificate budget = certifier.certify(stored, r, starved);
     EXPECT_TRUE(budget.budget_reached);
+    EXPECT_EQ(budget.tiles, sphere.triangle_count());
     EXPECT_GE(budget.covering_bound, exact);
     EXPECT_LE(budget.covering_lower, exact);
     EXPECT_EQ(budget.covered, budget.covering_bound <= r);
