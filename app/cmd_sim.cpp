@@ -44,7 +44,7 @@ void add_options(CLI::App* cmd, Options& o) {
       cmd->add_option(
              "--backend", o.backend,
              "auto: the GPU pipeline on a hardware GPU, the double-precision CPU reference when the GL "
-             "device is a software renderer (Mesa llvmpipe, where the CPU reference is about 10x faster); "
+             "device is a software renderer (Mesa llvmpipe, where the CPU reference is 3-30x faster); "
              "gpu or cpu: that one")
           ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
           ->capture_default_str();
