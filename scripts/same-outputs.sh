@@ -59,7 +59,7 @@ run_jobs() {
   # The GPU pipeline by name: since --backend (issue 16) plain `sim` runs the CPU reference on llvmpipe.
   # A base built before it has no --backend, and its plain `sim` is the GPU pipeline.
   local gpu=()
-  if "$bin" sim --help 2>/dev/null | grep -q -- --backend; then gpu=(--backend gpu); fi
+  if "$bin" sim --help 2>/dev/null | grep -- --backend >/dev/null; then gpu=(--backend gpu); fi  # no -q: pipefail
   {
     "$bin" info "$a/bunny.obj" --json >info_bunny.json
     "$bin" info "$a/torus.obj" --json >info_torus.json
