@@ -122,7 +122,7 @@ enum class Backend { Gpu, Cpu };
 // The GL context a run needs (the GPU pipeline's, or only the frames' renderer's; null when neither)
 // and the backend. auto takes the CPU reference when the GL device is a software renderer and says
 // so in one line; a device that cannot make a context at all stays an error (exit 3), as under
-// --backend gpu: a broken driver on a GPU machine should not turn into a run 10-100x slower.
+// --backend gpu: a broken driver on a GPU machine should say so, not turn into a much slower run.
 Backend choose_backend(const Options& o, const GlobalOptions& global, bool frames,
                        std::unique_ptr<gpu::Context>& context) {
   const std::string requested = requested_backend(o);
