@@ -1,6 +1,8 @@
-// `tetrasand sdf MESH -o OUT.vdb`: narrow-band SDF by GPU scan conversion, written as an OpenVDB level set.
+// `tetrasand sdf MESH -o OUT.vdb`: narrow-band SDF by GPU scan conversion (or, --backend cpu, the exact
+// CPU path), written as an OpenVDB level set.
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <unistd.h>
 
 #include <cctype>
@@ -36,6 +38,7 @@ struct Options {
   double band = 3.0;
   int padding = -1;
   std::string sign = "pseudonormal";
+  std::string backend = "gpu";  // gpu: scan conversion; cpu: the exact SDF (sdf/exact_sdf.h)
   double scale = 1.0;
   double slab_mb = 1024;
   bool timings = false, compare = false, json = false;
@@ -77,18 +80,28 @@ void add_options(CLI::App* cmd, Options& o) {
       ->capture_default_str();
   cmd->add_option("--padding", o.padding, "Voxels beyond the bounding box (default: band + 1)")
       ->check(finite());
+  cmd->add_option(
+         "--backend", o.backend,
+         "gpu: scan conversion on the GL device; cpu: the exact SDF (CGAL AABB tree, double precision, "
+         "TBB on every core; no GL device needed). On llvmpipe cpu is faster in most runs of "
+         "docs/benchmarks.md (SDF)")
+      ->check(CLI::IsMember({"gpu", "cpu"}))
+      ->capture_default_str();
   cmd->add_option("--sign", o.sign, "Sign method: pseudonormal (closed meshes) or winding (robust to holes)")
       ->check(CLI::IsMember({"pseudonormal", "winding"}))
       ->capture_default_str();
   cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor first (e.g. 1000: metres -> mm)")
       ->check(positive());
-  cmd->add_option("--max-slab-mb", o.slab_mb, "GPU memory for one z-slab of the grid [MiB]")
+  cmd->add_option("--max-slab-mb", o.slab_mb, "GPU memory for one z-slab of the grid [MiB] (--backend gpu)")
       ->check(positive())
       ->capture_default_str();
-  cmd->add_flag("--timings", o.timings, "Per-kernel GPU times and peak GPU memory");
+  cmd->add_flag("--timings", o.timings,
+                "Per-kernel GPU times and peak GPU memory (--backend gpu), memory per band voxel");
   cmd->add_flag("--json", o.json, "Print the run's figures (grid, band voxels, memory per band voxel, times) as JSON");
-  cmd->add_flag("--compare-openvdb", o.compare,
-                "Also build OpenVDB's meshToLevelSet and the exact SDF; print how both compare with exact distance");
+  cmd->add_flag(
+      "--compare-openvdb", o.compare,
+      "Also build OpenVDB's meshToLevelSet and the exact SDF; print how both compare with exact distance "
+      "(--backend gpu)");
 }
 
 // The mesh, scaled, with a warning where its signs cannot be trusted.
@@ -150,44 +163,52 @@ class ScanProgress {
 
 // Writes the level set in the format the suffix asks for; returns the size of its NanoVDB form (the
 // GPU field's) when it was made or `measure` asks for it, else 0.
-std::size_t write_level_set(const Options& o, const sdf::ScanConvertResult& result, const gpu::Context& context,
+std::size_t write_level_set(const Options& o, const sdf::ScanConvertResult& result, const std::string& device,
                             bool measure) {
   if (is_nanovdb_path(o.output)) {
     const sdf::NanoGrid nano = sdf::to_nanovdb(*result.grid);
     sdf::write_nvdb(o.output, nano, {o.mesh});
     return nano.size();
   }
-  const std::map<std::string, std::string> metadata{
-      {"tetrasand:source", o.mesh},
-      {"tetrasand:source_sha256", sha256_file(o.mesh)},
-      {"tetrasand:band_voxels", fmt::format("{}", o.band)},
-      {"tetrasand:sign", o.sign},
-      {"tetrasand:renderer", context.summary()}};
+  const std::map<std::string, std::string> metadata{{"tetrasand:source", o.mesh},
+                                                    {"tetrasand:source_sha256", sha256_file(o.mesh)},
+                                                    {"tetrasand:band_voxels", fmt::format("{}", o.band)},
+                                                    {"tetrasand:sign", o.sign},
+                                                    {"tetrasand:renderer", device}};
   sdf::write_vdb(o.output, result.grid, metadata, {o.mesh});
   return measure ? sdf::to_nanovdb(*result.grid).size() : 0;
 }
 
-void print_figures(const Figures& f) {
+void print_figures(const Options& o, const Figures& f) {
   const double per = f.band_voxels ? 1.0 / static_cast<double>(f.band_voxels) : 0.0;
-  fmt::print("memory: {} band voxels; host level set {:.1f} MiB ({:.1f} bytes a band voxel), as NanoVDB {:.1f} MiB "
-             "({:.1f} bytes a band voxel); scan conversion {:.1f} MiB on the GPU at its peak, {:.1f} MiB read back\n",
-             f.band_voxels, f.host_bytes / 1048576.0, static_cast<double>(f.host_bytes) * per,
-             f.nanovdb_bytes / 1048576.0, static_cast<double>(f.nanovdb_bytes) * per, f.scan_gpu_bytes / 1048576.0,
-             f.readback_bytes / 1048576.0);
+  fmt::print(
+      "memory: {} band voxels; host level set {:.1f} MiB ({:.1f} bytes a band voxel), as NanoVDB {:.1f} MiB "
+      "({:.1f} bytes a band voxel)",
+      f.band_voxels, f.host_bytes / 1048576.0, static_cast<double>(f.host_bytes) * per,
+      f.nanovdb_bytes / 1048576.0, static_cast<double>(f.nanovdb_bytes) * per);
+  if (o.backend == "gpu") {
+    fmt::print("; scan conversion {:.1f} MiB on the GPU at its peak, {:.1f} MiB read back",
+               f.scan_gpu_bytes / 1048576.0, f.readback_bytes / 1048576.0);
+  }
+  fmt::print("\n");
 }
 
-void print_json(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec, const sdf::ScanConvertStats& st,
-                const Figures& f, const gpu::Context& context) {
+void print_json(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
+                const sdf::ScanConvertStats& st, const Figures& f, const std::string& device) {
   const nlohmann::ordered_json out = {
       {"mesh", o.mesh},
       {"output", o.output},
       {"triangles", mesh.triangle_count()},
-      {"grid", {{"dims", {spec.dims.x(), spec.dims.y(), spec.dims.z()}}, {"voxel_size", spec.voxel_size}, {"band", o.band}}},
+      {"grid",
+       {{"dims", {spec.dims.x(), spec.dims.y(), spec.dims.z()}},
+        {"voxel_size", spec.voxel_size},
+        {"band", o.band}}},
       {"band_voxels", f.band_voxels},
       {"host_bytes", f.host_bytes},
       {"host_bytes_per_band_voxel", f.band_voxels ? static_cast<double>(f.host_bytes) / f.band_voxels : 0.0},
       {"nanovdb_bytes", f.nanovdb_bytes},
-      {"nanovdb_bytes_per_band_voxel", f.band_voxels ? static_cast<double>(f.nanovdb_bytes) / f.band_voxels : 0.0},
+      {"nanovdb_bytes_per_band_voxel",
+       f.band_voxels ? static_cast<double>(f.nanovdb_bytes) / f.band_voxels : 0.0},
       {"scan_peak_gpu_bytes", f.scan_gpu_bytes},
       {"readback_bytes", f.readback_bytes},
       {"slabs", st.slabs},
@@ -196,7 +217,8 @@ void print_json(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec&
       {"needle_triangles", st.needle_triangles},
       {"scan_seconds", f.scan_seconds},
       {"total_seconds", f.total_seconds},
-      {"renderer", context.summary()}};
+      {"backend", o.backend},
+      {"renderer", device}};
   fmt::print("{}\n", out.dump(2));
 }
 
@@ -209,7 +231,7 @@ void print_summary(const Options& o, const TriangleMesh& mesh, const sdf::GridSp
     fmt::print("{} degenerate triangles skipped, {} needle triangles bounded by rectangles\n", st.degenerate_triangles,
                st.needle_triangles);
   }
-  if (o.timings) {
+  if (o.timings && o.backend == "gpu") {
     fmt::print("{} slabs of {} layers, {} draws, peak GPU memory {:.1f} MiB, {:.3f} s\n{}", st.slabs,
                st.layers_per_slab, st.draws, st.peak_gpu_bytes / 1048576.0, st.seconds, st.timing_report);
   }
@@ -234,12 +256,12 @@ void print_comparison(const Options& o, const TriangleMesh& mesh, const sdf::Gri
                                           sdf::compare_grids(*result.grid, *vdb, spec.voxel_size, band_world)));
 }
 
-int run_sdf(const Options& o, const GlobalOptions& global) {
-  const auto start = std::chrono::steady_clock::now();
-  is_nanovdb_path(o.output);  // a wrong suffix is a usage error before any work
-  const TriangleMesh mesh = load_sdf_mesh(o);
-  const sdf::GridSpec spec = naming_file(o.mesh, [&] { return grid_of(o, mesh); });
+// The GPU path: scan conversion on the GL device, signs by winding number afterwards where asked.
+// *device: the GL device's summary.
+sdf::ScanConvertResult gpu_level_set(const Options& o, const GlobalOptions& global, const TriangleMesh& mesh,
+                                     const sdf::GridSpec& spec, std::string* device) {
   gpu::Context context(context_options(global));
+  *device = context.summary();
   sdf::ScanConvertOptions scan;
   scan.band = o.band;
   scan.timings = o.timings;
@@ -252,28 +274,65 @@ int run_sdf(const Options& o, const GlobalOptions& global) {
   progress.end();
   // The winding-number signs replace the pseudonormal ones where the mesh cannot give them.
   if (o.sign == "winding") sdf::resign_by_winding_number(*result.grid, sdf::ExactDistance(mesh));
+  return result;
+}
+
+// The CPU path: the exact SDF (sdf/exact_sdf.h) on every core, timed from the AABB tree's build to
+// the flood-filled level set. *device: what ran it.
+sdf::ScanConvertResult cpu_level_set(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
+                                     std::string* device) {
+  *device = fmt::format("CPU exact SDF (CGAL AABB tree, double precision, {} TBB threads)",
+                        tbb::this_task_arena::max_concurrency());
+  const auto start = std::chrono::steady_clock::now();
+  sdf::ScanConvertResult result;
+  result.grid = naming_file(o.mesh, [&] {
+    return sdf::exact_sdf_grid(
+        mesh, spec, o.band, o.sign == "winding" ? sdf::SignMethod::Winding : sdf::SignMethod::Pseudonormal);
+  });
+  result.stats.band_voxels = result.grid->activeVoxelCount();
+  result.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+int run_sdf(const Options& o, const GlobalOptions& global) {
+  const auto start = std::chrono::steady_clock::now();
+  is_nanovdb_path(o.output);  // a wrong suffix is a usage error before any work
+  if (o.compare && o.backend == "cpu") {
+    throw Error(
+        ExitCode::Usage,
+        "--compare-openvdb compares the GPU field with the exact one; with --backend cpu the field is the "
+        "exact one");
+  }
+  const TriangleMesh mesh = load_sdf_mesh(o);
+  const sdf::GridSpec spec = naming_file(o.mesh, [&] { return grid_of(o, mesh); });
+  std::string device;
+  sdf::ScanConvertResult result = o.backend == "cpu" ? cpu_level_set(o, mesh, spec, &device)
+                                                     : gpu_level_set(o, global, mesh, spec, &device);
   Figures figures{result.stats.band_voxels, result.grid->memUsage(), 0, result.stats.peak_gpu_bytes,
                   result.stats.readback_bytes, result.stats.seconds, 0.0};
-  figures.nanovdb_bytes = write_level_set(o, result, context, o.timings || o.json);
+  figures.nanovdb_bytes = write_level_set(o, result, device, o.timings || o.json);
   figures.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (o.json) {
-    print_json(o, mesh, spec, result.stats, figures, context);
+    print_json(o, mesh, spec, result.stats, figures, device);
     return 0;
   }
   print_summary(o, mesh, spec, result.stats);
-  if (o.timings) print_figures(figures);
+  fmt::print("device: {}; {} {:.3f} s\n", device, o.backend == "cpu" ? "exact SDF" : "scan conversion",
+             result.stats.seconds);
+  if (o.timings) print_figures(o, figures);
   if (o.compare) print_comparison(o, mesh, spec, result);
-  fmt::print("total {:.2f} s on {}\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-             context.summary());
+  fmt::print("total {:.2f} s\n",
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return 0;
 }
 
 }  // namespace
 
 Runner add_sdf_command(CLI::App& app, const GlobalOptions& global) {
-  return add_command<Options>(app, global, "sdf",
-                              "Narrow-band signed distance field by GPU scan conversion (OpenVDB level set)", run_sdf,
-                              add_options);
+  return add_command<Options>(
+      app, global, "sdf",
+      "Narrow-band signed distance field by GPU scan conversion or the exact CPU path (OpenVDB level set)",
+      run_sdf, add_options);
 }
 
 }  // namespace ts::app

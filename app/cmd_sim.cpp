@@ -1,4 +1,4 @@
-// `tetrasand sim SCENE.toml`: run a sand scene on the GPU (or the CPU reference with --cpu).
+// `tetrasand sim SCENE.toml`: run a sand scene on the GPU pipeline or the CPU reference (--backend).
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <unistd.h>
@@ -27,8 +27,9 @@ struct Options {
   std::string scene;
   std::string output = "sim-out";
   double duration = 0;  // s; 0 = the scene's
-  bool cpu = false;
-  std::string precision = "float";
+  std::string backend = "auto";  // auto, gpu or cpu
+  bool cpu = false;              // --cpu: the alias of --backend cpu
+  std::string precision;         // float or double; empty: not given (float on the GPU)
   bool timings = false;
   std::string resume;  // DIR: go on from its latest checkpoint, writing there
 };
@@ -39,10 +40,21 @@ void add_options(CLI::App* cmd, Options& o) {
                                         "Output directory (metrics.csv, particle dumps, frames, checkpoints)")
                             ->capture_default_str();
   cmd->add_option("--duration", o.duration, "Simulated time [s], overriding the scene's")->check(positive());
-  cmd->add_flag("--cpu", o.cpu, "Use the double-precision CPU reference instead of the GPU pipeline");
-  cmd->add_option("--precision", o.precision, "GPU arithmetic: float or double (GLSL fp64)")
-      ->check(CLI::IsMember({"float", "double"}))
-      ->capture_default_str();
+  CLI::Option* backend =
+      cmd->add_option(
+             "--backend", o.backend,
+             "auto: the GPU pipeline on a hardware GPU, the double-precision CPU reference when the GL "
+             "device is a software renderer (Mesa llvmpipe, where the CPU reference is 3-30x faster); "
+             "gpu or cpu: that one")
+          ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
+          ->capture_default_str();
+  cmd->add_flag("--cpu", o.cpu, "Alias of --backend cpu (the double-precision CPU reference)")
+      ->excludes(backend);
+  cmd->add_option(
+         "--precision", o.precision,
+         "GPU pipeline arithmetic: float (default) or double (GLSL fp64); the CPU reference is always "
+         "double, so --backend cpu refuses it")
+      ->check(CLI::IsMember({"float", "double"}));
   cmd->add_flag("--timings", o.timings, "Print per-kernel GPU times and host-GPU round trips at the end");
   cmd->add_option(
          "--resume", o.resume,
@@ -90,16 +102,57 @@ std::string describe_bodies(const sim::BodyCounts& c) {
   return fmt::format("{}", fmt::join(parts, "; "));
 }
 
+// --backend, or cpu for its alias --cpu. --precision with the CPU reference is a usage error: it
+// would be ignored (the reference computes in double), and a user who gives it means the GPU.
+std::string requested_backend(const Options& o) {
+  const std::string requested = o.cpu ? "cpu" : o.backend;
+  if (requested == "cpu" && !o.precision.empty()) {
+    throw Error(ExitCode::Usage,
+                fmt::format("--precision {}: the CPU reference (--backend cpu) computes in double "
+                            "only; --precision sets the GPU pipeline's arithmetic",
+                            o.precision));
+  }
+  return requested;
+}
+
+// Which engine runs the steps: the GPU pipeline (sim/gpu_stepper.h) or the CPU reference
+// (sim/cpu_reference.h).
+enum class Backend { Gpu, Cpu };
+
+// The GL context a run needs (the GPU pipeline's, or only the frames' renderer's; null when neither)
+// and the backend. auto takes the CPU reference when the GL device is a software renderer and says
+// so in one line; a device that cannot make a context at all stays an error (exit 3), as under
+// --backend gpu: a broken driver on a GPU machine should say so, not turn into a much slower run.
+Backend choose_backend(const Options& o, const GlobalOptions& global, bool frames,
+                       std::unique_ptr<gpu::Context>& context) {
+  const std::string requested = requested_backend(o);
+  if (requested == "cpu") {
+    if (frames) context = std::make_unique<gpu::Context>(context_options(global));
+    return Backend::Cpu;
+  }
+  context = std::make_unique<gpu::Context>(context_options(global));
+  if (requested == "gpu" || !context->software()) return Backend::Gpu;
+  const std::string& renderer = context->renderer();
+  fmt::print(
+      "backend: CPU reference (the GL device is {}, a software renderer; --backend gpu forces the GPU "
+      "pipeline{})\n",
+      renderer.substr(0, renderer.find(" (")),
+      o.precision.empty() ? "" : "; --precision applies to it only, the CPU reference computes in double");
+  std::fflush(stdout);
+  if (!frames) context.reset();
+  return Backend::Cpu;
+}
+
 const std::string& output_dir(const Options& o) { return o.resume.empty() ? o.output : o.resume; }
 
 void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResult& result, double seconds,
-                   const gpu::Context* context) {
+                   Backend backend, const gpu::Context* context) {
   // Steps this process ran (a resumed run started at resumed_from).
   const auto stepped = static_cast<double>(result.steps - std::max<std::int64_t>(result.resumed_from, 0));
   fmt::print("{}: {} steps of {:.3g} s, {} grains, {:.1f} s wall ({:.3g} grain-steps/s, {})\n", o.scene,
              result.steps, result.dt, result.grains, seconds,
              seconds > 0 ? stepped * static_cast<double>(result.grains) / seconds : 0.0,
-             o.cpu ? "CPU reference" : context->summary());
+             backend == Backend::Cpu ? "CPU reference" : context->summary());
   fmt::print("bodies: {}\n", describe_bodies(result.bodies));
   fmt::print("clamps: {} velocity, {} angular velocity, {} overlap (each clamp means a less accurate result)\n",
              result.last.velocity_clamps, result.last.angular_velocity_clamps, result.last.overlap_clamps);
@@ -119,11 +172,12 @@ void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResu
 }
 
 int run_sim(const Options& o, const GlobalOptions& global) {
+  requested_backend(o);  // a usage error before any work
   const sim::Scene scene = sim::load_scene(o.scene);
   std::unique_ptr<gpu::Context> context;
-  sim::StepperFactory make_stepper;
-  if (!o.cpu) {
-    context = std::make_unique<gpu::Context>(context_options(global));
+  const Backend backend = choose_backend(o, global, scene.output.frames, context);
+  sim::StepperFactory make_stepper;  // empty: the CPU reference
+  if (backend == Backend::Gpu) {
     const auto precision = o.precision == "double" ? sim::Precision::Double : sim::Precision::Float;
     make_stepper = [&, precision](const sim::StepSettings& settings) -> std::unique_ptr<sim::Stepper> {
       return std::make_unique<sim::GpuStepper>(*context, settings, precision, o.timings);
@@ -134,7 +188,6 @@ int run_sim(const Options& o, const GlobalOptions& global) {
   sim::RunHooks hooks;
   std::unique_ptr<preview::SimFrameWriter> frames;  // [output] frames = true: PNGs through the preview renderer
   if (scene.output.frames) {
-    if (!context) context = std::make_unique<gpu::Context>(context_options(global));
     frames = std::make_unique<preview::SimFrameWriter>(*context, scene);
     hooks.write_frame = [&frames](const sim::World& world, std::int64_t frame, const std::filesystem::path& dir) {
       frames->write(world, frame, dir);
@@ -156,7 +209,8 @@ int run_sim(const Options& o, const GlobalOptions& global) {
   const sim::RunResult result = sim::run_scene(scene, output_dir(o), hooks, make_stepper, control);
   if (terminal) std::fprintf(stderr, "\n");
   if (!result.time_step_warning.empty()) log::warn("{}", result.time_step_warning);
-  print_summary(o, scene, result, std::chrono::duration<double>(Clock::now() - start).count(), context.get());
+  print_summary(o, scene, result, std::chrono::duration<double>(Clock::now() - start).count(), backend,
+                context.get());
   if (!timing_report.empty()) fmt::print("{}", timing_report);
   return 0;
 }
@@ -164,8 +218,9 @@ int run_sim(const Options& o, const GlobalOptions& global) {
 }  // namespace
 
 Runner add_sim_command(CLI::App& app, const GlobalOptions& global) {
-  return add_command<Options>(app, global, "sim", "Run a tetrahedral-grain DEM scene (TOML) on the GPU", run_sim,
-                              add_options);
+  return add_command<Options>(app, global, "sim",
+                              "Run a tetrahedral-grain DEM scene (TOML) on the GPU or the CPU reference",
+                              run_sim, add_options);
 }
 
 }  // namespace ts::app

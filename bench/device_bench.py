@@ -156,6 +156,8 @@ class Run:
         return rc, time.perf_counter() - start, err, {"mesh": s["mesh"], "rows": rows}
 
     def sim(self, cap):
+        # tetrasand_bench_sim builds GpuStepper and CpuStepper itself (bench/sim_bench.cpp): the GPU
+        # pipeline is timed on every device, whatever `tetrasand sim --backend auto` would pick there.
         s = self.sizes["sim"]
         table = os.path.join(self.work, "sim.csv")
         cmd = [self.exe("sim"), "--grains", ",".join(map(str, s["grains"])), "--precision", ",".join(s["precisions"]),

@@ -59,7 +59,7 @@ def creep(tetrasand: str, tangential: str, cpu: bool, out: pathlib.Path):
     every = round(SETTLE / DT)
     scene = out / f"pile_{tangential}.toml"
     scene.write_text(pile_scene(SETTLE + WATCH, tangential, every))
-    command = [tetrasand, "sim", str(scene), "-o", str(out / tangential)] + (["--cpu"] if cpu else [])
+    command = [tetrasand, "sim", str(scene), "-o", str(out / tangential)] + ["--backend", "cpu" if cpu else "gpu"]
     run = subprocess.run(command, capture_output=True, text=True)
     if run.returncode != 0:
         sys.exit(f"{' '.join(command)} failed:\n{run.stdout}{run.stderr}")

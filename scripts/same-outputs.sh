@@ -56,6 +56,10 @@ run_jobs() {
   mkdir -p "$dir"
   cd "$dir"
   local log="$dir/log.txt"
+  # The GPU pipeline by name: since --backend (issue 16) plain `sim` runs the CPU reference on llvmpipe.
+  # A base built before it has no --backend, and its plain `sim` is the GPU pipeline.
+  local gpu=()
+  if "$bin" sim --help 2>/dev/null | grep -- --backend >/dev/null; then gpu=(--backend gpu); fi  # no -q: pipefail
   {
     "$bin" info "$a/bunny.obj" --json >info_bunny.json
     "$bin" info "$a/torus.obj" --json >info_torus.json
@@ -73,16 +77,16 @@ run_jobs() {
     "$bin" preview "$a/cube.obj" -o turn.png --size 96x96 --turntable 3 --contact-sheet --resolution 32 --ortho
     "$bin" sim "$a/scenes/two_grain_collision.toml" -o sim_two --cpu
     "$bin" sim "$a/scenes/free_fall.toml" -o sim_fall_cpu --cpu
-    "$bin" sim "$a/scenes/free_fall.toml" -o sim_fall_gpu
+    "$bin" sim "$a/scenes/free_fall.toml" -o sim_fall_gpu "${gpu[@]}"
     "$bin" sim "$a/scenes/prop_drop.toml" -o sim_prop_cpu --cpu --duration 0.05
-    "$bin" sim "$a/scenes/prop_drop.toml" -o sim_prop_gpu --duration 0.02
-    "$bin" sim "$a/scenes/prop_drop.toml" -o sim_prop_gpu64 --duration 0.01 --precision double
+    "$bin" sim "$a/scenes/prop_drop.toml" -o sim_prop_gpu --duration 0.02 "${gpu[@]}"
+    "$bin" sim "$a/scenes/prop_drop.toml" -o sim_prop_gpu64 --duration 0.01 --precision double "${gpu[@]}"
     "$bin" sim "$a/scenes/blade.toml" -o sim_blade_cpu --cpu --duration 0.02
-    "$bin" sim "$a/scenes/hourglass.toml" -o sim_hourglass_gpu --duration 0.005
+    "$bin" sim "$a/scenes/hourglass.toml" -o sim_hourglass_gpu --duration 0.005 "${gpu[@]}"
     printf '%s\n' '' '[output]' 'every = 50' 'frames = true' 'csv = true' >frames.tail
     cat "$a/scenes/free_fall.toml" | sed '/^\[output\]/,$d' >fall_frames.toml
     cat frames.tail >>fall_frames.toml
-    "$bin" sim fall_frames.toml -o sim_frames --duration 0.02
+    "$bin" sim fall_frames.toml -o sim_frames --duration 0.02 "${gpu[@]}"
     "$bin" export lammps "$a/scenes/prop_drop.toml" -o lammps_prop
     "$bin" export lammps "$a/scenes/hourglass.toml" -o lammps_hourglass
   } >"$log" 2>&1 || { echo "a job failed with $bin; see $log" >&2; tail -20 "$log" >&2; return 1; }

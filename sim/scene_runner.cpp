@@ -97,6 +97,14 @@ void write_contacts_csv(const std::vector<ContactRecord>& contacts, const std::f
 
 namespace {
 
+// The `tetrasand sim` options that choose an engine (Stepper::engine()), for a resume's error.
+std::string engine_flags(const std::string& engine) {
+  if (engine == "cpu reference") return "--backend cpu";
+  if (engine == "gpu double") return "--backend gpu --precision double";
+  if (engine == "gpu float") return "--backend gpu";
+  return "the engine's options";
+}
+
 std::size_t bodies_moving(const World& world, MotionType motion) {
   return static_cast<std::size_t>(std::count(world.bodies.motion.begin(), world.bodies.motion.end(), motion));
 }
@@ -295,9 +303,9 @@ void SceneRun::resume() {
   }
   if (state.engine != stepper_->engine()) {
     throw InputError(
-        file, fmt::format("written by the {} engine, and this run uses the {} (give the same --cpu and "
-                          "--precision as the run that wrote it)",
-                          state.engine, stepper_->engine()));
+        file, fmt::format("written by the {} engine, and this run uses the {} (resume with {}, as the run "
+                          "that wrote it)",
+                          state.engine, stepper_->engine(), engine_flags(state.engine)));
   }
   if (std::bit_cast<std::uint64_t>(state.dt) != std::bit_cast<std::uint64_t>(result_.dt)) {
     throw InputError(file, fmt::format("written with dt = {:.17g} s, but the scene now gives {:.17g} s",

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Simulation against LAMMPS, side by side in one run (docs/benchmarks.md, section peers-sim).
 
-The same scenes run on tetrasand's CPU reference (`tetrasand sim --cpu`), its GPU pipeline
-(`tetrasand sim`, on whatever EGL device is there: llvmpipe without a GPU) and LAMMPS
+The same scenes run on tetrasand's CPU reference (`tetrasand sim --backend cpu`), its GPU pipeline
+(`tetrasand sim --backend gpu`, on whatever EGL device is there: llvmpipe without a GPU) and LAMMPS
 (`tetrasand export lammps` + Debian's `lmp`, serial and `mpirun -np 2`), with the same material,
 time step and duration. Reported: grain-steps per second as ratios to LAMMPS serial (process wall
 time, start-up included, the same for every code) and the physical outcome:
@@ -77,7 +77,7 @@ def run(cmd, cwd=None, env=None):
 
 
 def tetrasand(bin_dir, scene, out, gpu):
-    cmd = [os.path.join(bin_dir, "tetrasand"), "sim", scene, "-o", out] + ([] if gpu else ["--cpu"])
+    cmd = [os.path.join(bin_dir, "tetrasand"), "sim", scene, "-o", out] + (["--backend", "gpu"] if gpu else ["--backend", "cpu"])
     wall, text = run(cmd)
     m = re.search(r": (\d+) steps of ([0-9.e+-]+) s, (\d+) grains, .*grain-steps/s, (.*)\)\n", text)
     steps, grains, device = int(m.group(1)), int(m.group(3)), m.group(4)

@@ -140,7 +140,7 @@ TEST(SimResume, CpuRunKilledAtRandomMomentsEndsInTheUninterruptedState) {
 }
 
 TEST(SimResume, GpuRunKilledAtRandomMomentsEndsInTheUninterruptedState) {
-  expect_killed_runs_end_the_same({}, 2, 21);
+  expect_killed_runs_end_the_same({"--backend", "gpu"}, 2, 21);
 }
 
 TEST(SimResume, ResumeRefusesAMissingFolderAndTakesNoOutputOption) {
