@@ -376,8 +376,13 @@ std::vector<SceneContactCase> scene_contact_cases(const Scene& scene, const Worl
       const GrainShape& h = kinds[j].shape;
       const PairCoefficients c = pair(sand, scene.grains[kinds[j].type].material);
       const double rh = h.particle_radius;
-      cases.push_back({{g.mass * h.mass / (g.mass + h.mass), r * rh / (r + rh), c.effective_modulus,
-                        1 / (inverse_tangential + grain_tangential_inverse_mass(h)), c.tangential_damping},
+      // A kind against itself as m/2, r/2 exactly: the step of a one-kind scene is the one it always had.
+      const double m_eff = i == j ? g.mass / 2 : g.mass * h.mass / (g.mass + h.mass);
+      const double r_eff = i == j ? r / 2 : r * rh / (r + rh);
+      cases.push_back({{m_eff, r_eff, c.effective_modulus,
+                        i == j ? 1 / (2 * inverse_tangential)
+                               : 1 / (inverse_tangential + grain_tangential_inverse_mass(h)),
+                        c.tangential_damping},
                        std::min(r, rh),
                        std::max(g.mass, h.mass),
                        grain,

@@ -400,7 +400,7 @@ Bed measure_bed(const std::vector<Sphere>& spheres, double half, double inset) {
   std::map<long, std::pair<Eigen::Vector3d, double>> grains;  // body -> (sum of centres, volume)
   std::map<long, int> count;
   for (const Sphere& s : spheres) {
-    auto& g = grains[s.body];
+    auto& g = grains.try_emplace(s.body, Eigen::Vector3d::Zero(), 0.0).first->second;
     g.first += s.x;
     g.second += s.r * s.r * s.r;
     ++count[s.body];

@@ -76,6 +76,10 @@ void expect_settled_beds_agree(const Scene& scene) {
   // next the CPU reference's 120-grain bed varies by 2.9 % (mean) and 4.6 % (upper decile), max - min
   // over seeds 1-4; the GPU run of the same seed differs by less than either (0.2 % and 0.9 % seen).
   const std::vector<double> zc = heights(cpu_world), zg = heights(gpu_world);
+  ::testing::Test::RecordProperty("mean_height_cpu_m", std::to_string(mean(zc)));
+  ::testing::Test::RecordProperty("mean_height_gpu_m", std::to_string(mean(zg)));
+  ::testing::Test::RecordProperty("q90_height_cpu_m", std::to_string(quantile(zc, 0.9)));
+  ::testing::Test::RecordProperty("q90_height_gpu_m", std::to_string(quantile(zg, 0.9)));
   EXPECT_NEAR(mean(zg) / mean(zc), 1.0, 0.03) << "mean centre height CPU " << mean(zc) << " m, GPU " << mean(zg);
   EXPECT_NEAR(quantile(zg, 0.9) / quantile(zc, 0.9), 1.0, 0.05)
       << "90th percentile CPU " << quantile(zc, 0.9) << " m, GPU " << quantile(zg, 0.9);
