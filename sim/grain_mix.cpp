@@ -47,6 +47,7 @@ std::vector<std::size_t> apportion(const std::vector<double>& weights, std::size
 double draw_scale(const SizeSpec& size, std::mt19937_64& rng) {
   if (size.distribution == SizeDistribution::Uniform)
     return size.min + (size.max - size.min) * uniform01(rng);
+  if (!(size.min < size.max)) return size.min;  // a window of one scale (the parser refuses it)
   for (;;) {  // lognormal, redrawn outside [min, max] (which hold the median, so this ends)
     const double s = size.median * std::exp(size.sigma * standard_normal(rng));
     if (s >= size.min && s <= size.max) return s;

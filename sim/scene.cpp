@@ -383,6 +383,8 @@ void read_size(TableReader& emitter, const fs::path& file, Emitter& e) {
     s.sigma = r.positive("sigma");
     s.min = r.positive("min", s.median * std::exp(-3 * s.sigma));
     s.max = r.positive("max", s.median * std::exp(3 * s.sigma));
+    if (!(s.min < s.max))
+      r.fail("max", fmt::format("{} must exceed min = {} (one scale: no size key)", s.max, s.min));
     if (!(s.min <= s.median && s.median <= s.max))
       r.fail(s.min > s.median ? "min" : "max",
              fmt::format("the truncation [{}, {}] must hold the median {}", s.min, s.max, s.median));

@@ -124,6 +124,10 @@ TEST(GrainTypes, BadGrainAndSizeKeysNameFileLineAndKey) {
             "scene.toml:35: emitter.size.max: 0.8 is below min = 1.2");
   EXPECT_EQ(parse_error(two_types(fill("grain = \"fine\"\nsize = { sieve = [[0.8, 1.0], [0.8, 2.0]] }\n"))),
             "scene.toml:35: emitter.size.sieve: scale 0.8 is listed twice");
+  EXPECT_EQ(parse_error(two_types(
+                fill("grain = \"fine\"\nsize = { distribution = \"lognormal\", median = 1.0, sigma = 0.2, "
+                     "min = 1.0, max = 1.0 }\n"))),
+            "scene.toml:35: emitter.size.max: 1 must exceed min = 1 (one scale: no size key)");
   EXPECT_EQ(parse_error(two_types(fill("grain = \"fine\"\nsize = { distribution = \"gamma\" }\n"))),
             "scene.toml:35: emitter.size.distribution: \"gamma\" is not one of: uniform, lognormal, sieve");
   std::string twice = two_types(fill("grain = \"fine\"\n"));
