@@ -5,12 +5,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <optional>
 #include <set>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "sim/grain.h"
+#include "sim/grain_mix.h"
 #include "sim/scene_runner.h"
 #include "sim/scene_world.h"
 
@@ -218,15 +221,27 @@ void check_exportable(const Scene& scene, const World& w) {
 struct PourEvent {
   std::int64_t step;
   const Emitter* emitter;
+  std::vector<double> molfrac;  // share of each molecule template (DeckPlan::templates)
 };
+
+// A molecule template for fix deposit: a grain type at one scale (a sieve class, or the mass-mean
+// scale of one equal-count size bin of a uniform or lognormal distribution).
+struct GrainTemplate {
+  std::uint16_t type;
+  double scale;
+};
+
+// Continuous size distributions of pour emitters become this many equal-count bins per grain type.
+constexpr std::size_t kSizeBins = 5;
 
 // Everything the deck's sections are written from: the initial world, the grain, the molecule and
 // atom type of every body, the simulation box, the run's length and the pour events in time order.
 struct DeckPlan {
-  DeckPlan(const Scene& s, World w, const GrainShape& g) : scene(s), world(std::move(w)), grain(g) {}
+  DeckPlan(const Scene& s, World w) : scene(s), world(std::move(w)), kinds(scene_grain_kinds(s)) {}
   const Scene& scene;
   World world;
-  GrainShape grain;
+  std::vector<GrainKind> kinds;  // the smallest and largest grain of each type
+  std::vector<GrainTemplate> templates;
   double dt = 0;  // s
   std::int64_t steps = 0;
   std::vector<std::int64_t> mol;  // molecule id per body
@@ -263,8 +278,10 @@ struct DeckPlan {
 // The box around every particle and pour region, the largest radius and body, the frozen count.
 void plan_geometry(DeckPlan& plan) {
   const World& w = plan.world;
-  plan.max_radius = plan.grain.particle_radius;
-  plan.max_body_extent = 2 * plan.grain.bounding_radius;
+  for (const GrainKind& k : plan.kinds) {
+    plan.max_radius = std::max(plan.max_radius, k.shape.particle_radius);
+    plan.max_body_extent = std::max(plan.max_body_extent, 2 * k.shape.bounding_radius);
+  }
   const std::vector<Eigen::Vector3d> x = particle_positions(w);
   for (std::size_t i = 0; i < x.size(); ++i) {
     plan.box.add(x[i], w.particles.radius[i]);
@@ -276,34 +293,108 @@ void plan_geometry(DeckPlan& plan) {
   }
 }
 
+// The templates a pour emitter's grains are drawn from, and its share of each: one per type and
+// scale it releases; a uniform or lognormal size in kSizeBins equal-count bins per type, each at
+// the cube root of its mean scale^3 (the bin's mass per grain).
+std::vector<std::pair<GrainTemplate, double>> pour_templates(const Emitter& e) {
+  std::map<std::uint16_t, std::vector<double>> scales;  // per type, its grains' scales
+  for (const GrainDraw& d : emitter_grain_draws(e)) scales[d.type].push_back(d.scale);
+  const bool continuous =
+      e.size.distribution == SizeDistribution::Uniform || e.size.distribution == SizeDistribution::Lognormal;
+  const double total = static_cast<double>(e.count);
+  std::vector<std::pair<GrainTemplate, double>> out;
+  for (auto& [type, list] : scales) {
+    std::sort(list.begin(), list.end());
+    if (!continuous) {
+      for (std::size_t i = 0; i < list.size();) {
+        std::size_t j = i;
+        while (j < list.size() && list[j] == list[i]) ++j;
+        out.push_back({{type, list[i]}, static_cast<double>(j - i) / total});
+        i = j;
+      }
+      continue;
+    }
+    const std::size_t bins = std::min(kSizeBins, list.size());
+    for (std::size_t b = 0; b < bins; ++b) {
+      const std::size_t lo = b * list.size() / bins, hi = (b + 1) * list.size() / bins;
+      double cubes = 0;
+      for (std::size_t i = lo; i < hi; ++i) cubes += list[i] * list[i] * list[i];
+      out.push_back(
+          {{type, std::cbrt(cubes / static_cast<double>(hi - lo))}, static_cast<double>(hi - lo) / total});
+    }
+  }
+  return out;
+}
+
 void plan_pours(DeckPlan& plan) {
   for (const Emitter& e : plan.scene.emitters) {
     if (e.type != EmitterType::Pour) continue;
-    plan.box.add(e.min, plan.grain.bounding_radius);
-    plan.box.add(e.max, plan.grain.bounding_radius);
+    const double bound = emitter_bound(plan.scene, e);
+    plan.box.add(e.min, bound);
+    plan.box.add(e.max, bound);
     if (e.rate * plan.dt > 1.0) {
       refuse(plan.scene, fmt::format("a pour rate of {} grains/s is more than one grain per step of {:.3g} s (fix "
                                      "deposit inserts at most one)", e.rate, plan.dt));
     }
-    plan.pours.push_back({static_cast<std::int64_t>(std::llround(e.start / plan.dt)), &e});
+    PourEvent event{static_cast<std::int64_t>(std::llround(e.start / plan.dt)), &e, {}};
+    for (const auto& [t, share] : pour_templates(e)) {
+      auto it = std::find_if(plan.templates.begin(), plan.templates.end(),
+                             [&](const GrainTemplate& u) { return u.type == t.type && u.scale == t.scale; });
+      const auto k = static_cast<std::size_t>(it - plan.templates.begin());
+      if (it == plan.templates.end()) plan.templates.push_back(t);
+      event.molfrac.resize(plan.templates.size(), 0.0);
+      event.molfrac[k] += share;
+    }
+    plan.pours.push_back(event);
   }
+  for (PourEvent& p : plan.pours) p.molfrac.resize(plan.templates.size(), 0.0);
   std::stable_sort(plan.pours.begin(), plan.pours.end(),
                    [](const PourEvent& a, const PourEvent& b) { return a.step < b.step; });
+}
+
+// The mean mass (kg) and particle radius (m) of the grains of `material` (every grain when none
+// is of it), in the initial world and the pours, for the reference contacts of its atom type.
+std::pair<double, double> mean_grain(const DeckPlan& plan, std::optional<std::uint16_t> material) {
+  const World& w = plan.world;
+  std::vector<std::pair<double, double>> grains;  // mass, radius
+  for (std::size_t b = fixture_bodies(plan.scene, w); b < w.bodies.size(); ++b) {
+    const std::uint32_t first = w.bodies.first_particle[b];
+    if (!material || w.particles.material[first] == *material)
+      grains.emplace_back(1.0 / w.bodies.inverse_mass[b], w.particles.radius[first]);
+  }
+  for (const PourEvent& p : plan.pours) {
+    for (const GrainDraw& d : emitter_grain_draws(*p.emitter)) {
+      if (material && plan.scene.grains[d.type].material != *material) continue;
+      const GrainShape g = scaled_grain(plan.scene, d.type, d.scale);
+      grains.emplace_back(g.mass, g.particle_radius);
+    }
+  }
+  if (grains.empty() && material) return mean_grain(plan, std::nullopt);
+  if (grains.empty()) return {plan.kinds.front().shape.mass, plan.kinds.front().shape.particle_radius};
+  // One size: that grain's figures exactly (no rounding in a mean).
+  if (std::all_of(grains.begin(), grains.end(), [&](const auto& g) { return g == grains.front(); }))
+    return grains.front();
+  double mass = 0, radius = 0;
+  for (const auto& [m, r] : grains) {
+    mass += m;
+    radius += r;
+  }
+  const auto n = static_cast<double>(grains.size());
+  return {mass / n, radius / n};
 }
 
 void plan_atom_types(DeckPlan& plan) {
   const World& w = plan.world;
   for (std::uint16_t m = 0; m < w.materials.size(); ++m) {
-    plan.types.push_back({m, plan.grain.mass, plan.grain.particle_radius});
+    const auto [mass, radius] = mean_grain(plan, m);
+    plan.types.push_back({m, mass, radius});
   }
   plan.body_type.assign(w.bodies.size(), 0);
-  plan.dynamic_types = {plan.scene.grain.material + 1};
-  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+  for (const GrainKind& k : plan.kinds) plan.dynamic_types.insert(plan.scene.grains[k.type].material + 1);
+  // Dynamic props (fixtures that move): one atom type each. Grains follow the fixtures.
+  for (std::size_t b = 0; b < fixture_bodies(plan.scene, w); ++b) {
     if (!is_dynamic(w, b)) continue;
     const std::uint32_t first = w.bodies.first_particle[b];
-    const bool is_grain = w.bodies.particle_count[b] == 4 && w.particles.radius[first] == plan.grain.particle_radius &&
-                          w.particles.material[first] == plan.scene.grain.material;
-    if (is_grain) continue;
     plan.types.push_back({w.particles.material[first], 1.0 / w.bodies.inverse_mass[b], w.particles.radius[first]});
     plan.body_type[b] = static_cast<int>(plan.types.size());
     plan.dynamic_types.insert(plan.body_type[b]);
@@ -311,8 +402,7 @@ void plan_atom_types(DeckPlan& plan) {
 }
 
 DeckPlan make_plan(const Scene& scene) {
-  DeckPlan plan(scene, make_world(scene),
-                make_tetrahedral_grain(scene.grain.radius, scene.grain.edge, scene.materials[scene.grain.material].density));
+  DeckPlan plan(scene, make_world(scene));
   check_exportable(scene, plan.world);
   std::string warning;
   plan.dt = resolve_time_step(scene, plan.world, &warning);
@@ -327,6 +417,15 @@ DeckPlan make_plan(const Scene& scene) {
   plan.g_ref = std::max(scene.gravity.norm(), 1e-3);
   plan_atom_types(plan);
   return plan;
+}
+
+// The molecule files: grain.mol for one template (the first grain type at scale 1 when no emitter
+// pours), grain1.mol, grain2.mol ... for several.
+std::vector<std::string> template_files(const DeckPlan& plan) {
+  if (plan.templates.size() <= 1) return {"grain.mol"};
+  std::vector<std::string> files;
+  for (std::size_t k = 0; k < plan.templates.size(); ++k) files.push_back(fmt::format("grain{}.mol", k + 1));
+  return files;
 }
 
 // Where LAMMPS does not do exactly what tetrasand does (LammpsDeck::approximations).
@@ -358,6 +457,24 @@ std::vector<std::string> approximations(const DeckPlan& plan) {
         "overlap its whole weight would make on one contact; spread over many contacts the overlaps are smaller "
         "and LAMMPS's damping (~ delta^(1/4)) somewhat lower than tetrasand's gamma_s");
   }
+  if (plan.kinds.size() > 1) {
+    out.push_back(
+        "grain sizes: each material has one atom type, its tangential damping matched at the material's mean "
+        "grain "
+        "(mass and radius); grains of other sizes see LAMMPS's damping scale as sqrt(m*) and R*^(1/4) where "
+        "tetrasand's gamma_s is constant");
+  }
+  if (std::any_of(plan.pours.begin(), plan.pours.end(), [](const PourEvent& p) {
+        const SizeDistribution d = p.emitter->size.distribution;
+        return d == SizeDistribution::Uniform || d == SizeDistribution::Lognormal;
+      })) {
+    out.push_back(
+        fmt::format("pour emitters with a uniform or lognormal size: fix deposit draws from {} molecule "
+                    "templates per grain "
+                    "type, one per equal-count size bin at the bin's mass-mean scale, not from the "
+                    "continuous distribution",
+                    kSizeBins));
+  }
   if (!plan.pours.empty()) {
     out.push_back(
         "pour emitters: fix deposit inserts one grain every round(1/(rate dt)) steps at random free sites of the same "
@@ -386,7 +503,11 @@ void header_section(const DeckPlan& plan, const std::vector<std::string>& approx
   out.line("# Files:    data.tetrasand  every particle of the initial state (grains, props, rough walls), molecule = body");
   out.line("#           bodies.rigid    explicit mass, centre of mass, world-frame inertia, velocity, angular momentum");
   out.line("#                           of every dynamic body (LAMMPS would sum the overlapping spheres instead)");
-  out.line("#           grain.mol       the grain template (used by fix deposit for pour emitters)");
+  out.line(plan.templates.size() > 1
+               ? fmt::format("#           grain1.mol ...  the {} grain templates, a grain type at one size "
+                             "each (fix deposit, pour emitters)",
+                             plan.templates.size())
+               : "#           grain.mol       the grain template (used by fix deposit for pour emitters)");
   out.line("# Output:   log.lammps (thermo every [output] every steps), particles.dump, final.dump (last state)");
   out.line("# Units:    SI (m, kg, s, Pa), as the scene file.");
   out.line(fmt::format("# Scene:    {} dynamic bodies, {} frozen particles (static/kinematic), {} smooth planes, {} "
@@ -417,7 +538,9 @@ void setup_section(const DeckPlan& plan, Script& out) {
   out.line(fmt::format("comm_modify     vel yes cutoff {}", num(plan.max_body_extent + 2 * plan.max_radius + plan.skin())));
   out.line("fix             prop all property/atom mol ghost yes");
   out.line("read_data       data.tetrasand fix prop NULL Molecules");
-  out.line(plan.pours.empty() ? "" : "molecule        grain grain.mol");
+  std::string molecules = "molecule        grain";
+  for (const std::string& f : template_files(plan)) molecules += fmt::format(" {}", f);
+  out.line(plan.pours.empty() ? "" : molecules);
   out.line("");
   const std::int64_t first_frozen = static_cast<std::int64_t>(plan.dynamic_count) + 1;
   const std::int64_t last_id = static_cast<std::int64_t>(plan.world.bodies.size());
@@ -553,11 +676,20 @@ void run_section(const DeckPlan& plan, Script& out) {
     const auto every = std::max<std::int64_t>(1, std::llround(1.0 / (e.rate * plan.dt)));
     out.line(fmt::format("region          pour{} block {} {} {} {} {} {} units box", pour_id, num(e.min.x()),
                          num(e.max.x()), num(e.min.y()), num(e.max.y()), num(e.min.z()), num(e.max.z())));
-    out.line(fmt::format("fix             pour{} dynamic deposit {} 0 {} {} region pour{} mol grain rigid rb near {} "
-                         "attempt 100 vx {} {} vy {} {} vz {} {} units box",
-                         pour_id, e.count, every, 1000 + e.seed % 1000000, pour_id,
-                         num(2.02 * plan.grain.particle_radius), num(e.velocity.x()), num(e.velocity.x()),
-                         num(e.velocity.y()), num(e.velocity.y()), num(e.velocity.z()), num(e.velocity.z())));
+    double radius = 0;  // m, the largest sphere this emitter releases
+    std::string molfrac;
+    for (std::size_t k = 0; k < plan.templates.size(); ++k) {
+      molfrac += fmt::format(" {}", num(p.molfrac[k]));
+      const GrainTemplate& t = plan.templates[k];
+      if (p.molfrac[k] > 0) radius = std::max(radius, t.scale * plan.scene.grains[t.type].radius);
+    }
+    out.line(fmt::format(
+        "fix             pour{} dynamic deposit {} 0 {} {} region pour{} mol grain{} rigid rb near {} "
+        "attempt 100 vx {} {} vy {} {} vz {} {} units box",
+        pour_id, e.count, every, 1000 + e.seed % 1000000, pour_id,
+        plan.templates.size() > 1 ? fmt::format(" molfrac{}", molfrac) : std::string(), num(2.02 * radius),
+        num(e.velocity.x()), num(e.velocity.x()), num(e.velocity.y()), num(e.velocity.y()),
+        num(e.velocity.z()), num(e.velocity.z())));
   }
   if (plan.steps > at) out.line(fmt::format("run             {}", plan.steps - at));
   out.line("write_dump      dynamic custom final.dump id mol type x y z radius");
@@ -608,9 +740,16 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
   write_file_atomically(dir / "data.tetrasand", data_file(plan.world, plan.mol, plan.body_type, plan.types.size(), plan.box),
                         inputs);
   write_file_atomically(dir / "bodies.rigid", bodies_file(plan.world, plan.mol, plan.dynamic_count), inputs);
-  write_file_atomically(dir / "grain.mol", molecule_file(plan.grain, scene.grain.material), inputs);
   write_file_atomically(deck.input, in.text(), inputs);
-  deck.files = {deck.input, dir / "data.tetrasand", dir / "bodies.rigid", dir / "grain.mol"};
+  deck.files = {deck.input, dir / "data.tetrasand", dir / "bodies.rigid"};
+  const std::vector<std::string> files = template_files(plan);
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    const GrainTemplate& t = k < plan.templates.size() ? plan.templates[k] : GrainTemplate{0, 1.0};
+    write_file_atomically(dir / files[k],
+                          molecule_file(scaled_grain(scene, t.type, t.scale), scene.grains[t.type].material),
+                          inputs);
+    deck.files.push_back(dir / files[k]);
+  }
   return deck;
 }
 

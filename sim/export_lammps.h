@@ -11,7 +11,9 @@
 //                    angular momentum of every dynamic body, given explicitly (LAMMPS would
 //                    otherwise sum the overlapping spheres' masses about their centres)
 //   grain.mol        the grain template (four spheres, explicit mass, COM and inertia) used by
-//                    fix deposit for pour emitters
+//                    fix deposit for pour emitters; with several grain types or sizes poured,
+//                    grain1.mol, grain2.mol ...: one per type and size (sieve class or size bin),
+//                    drawn by fix deposit's molfrac in the emitter's proportions
 //
 // The contact model is the same as tetrasand's (Tsuji damping): per pair of materials, LAMMPS
 // `hertz/material` gets E = 2 E* with nu = 0 (so its E_eff equals tetrasand's mixed E*), and a

@@ -246,18 +246,152 @@ void read_material(const toml::table& t, const fs::path& file, Scene& scene) {
   scene.material_names.push_back(name);
 }
 
-void read_grain(TableReader& root, const fs::path& file, Scene& scene) {
-  const toml::node* n = root.node("grain");
-  if (!n) root.missing("grain", "; a [grain] table: radius, edge, material");
-  if (!n->is_table()) root.fail("grain", "must be a [grain] table (radius, edge, material)");
-  TableReader r(*n->as_table(), "grain", file);
-  scene.grain.radius = r.positive("radius");
-  scene.grain.edge = r.positive("edge", 2 * scene.grain.radius);
-  if (scene.grain.edge > 2 * scene.grain.radius * (1 + 1e-9)) {
-    r.fail("edge", fmt::format("{} m leaves the spheres apart: must be <= 2 radius = {} m", scene.grain.edge,
-                               2 * scene.grain.radius));
+GrainSpec read_grain_type(const toml::table& t, const fs::path& file, const Scene& scene, bool named) {
+  TableReader r(t, "grain", file);
+  GrainSpec g;
+  g.line = line_of(t);
+  g.name = named ? r.required_string("name") : r.optional_string("name").value_or("");
+  for (const GrainSpec& other : scene.grains) {
+    if (other.name == g.name)
+      r.fail("name", fmt::format("\"{}\" is defined twice (also at line {})", g.name, other.line));
   }
-  scene.grain.material = material_index(r, scene, "material");
+  g.radius = r.positive("radius");
+  g.edge = r.positive("edge", 2 * g.radius);
+  if (g.edge > 2 * g.radius * (1 + 1e-9)) {
+    r.fail("edge",
+           fmt::format("{} m leaves the spheres apart: must be <= 2 radius = {} m", g.edge, 2 * g.radius));
+  }
+  g.material = material_index(r, scene, "material");
+  r.reject_unknown_keys();
+  return g;
+}
+
+// `[grain]` (one type) or `[[grain]]` tables (several, each with a name).
+void read_grains(TableReader& root, const fs::path& file, Scene& scene) {
+  const toml::node* n = root.node("grain");
+  const char* form =
+      "; a [grain] table (radius, edge, material) or [[grain]] tables (name, radius, edge, material)";
+  if (!n) root.missing("grain", form);
+  if (const toml::table* one = n->as_table()) {
+    scene.grains.push_back(read_grain_type(*one, file, scene, false));
+    return;
+  }
+  const toml::array* many = n->as_array();
+  if (!many || !many->is_array_of_tables() || many->empty())
+    root.fail("grain", std::string("must be") + (form + 1));
+  if (many->size() > 65535) root.fail("grain", "too many grain types");
+  for (const toml::node& t : *many)
+    scene.grains.push_back(read_grain_type(*t.as_table(), file, scene, many->size() > 1));
+}
+
+// emitter.grain: a type's name, or a list of them with `fractions` (number fractions, normalised).
+void read_emitter_grains(TableReader& r, const Scene& scene, Emitter& e) {
+  std::vector<std::string> names;
+  auto type_of = [&](const std::string& name) {
+    for (std::size_t t = 0; t < scene.grains.size(); ++t)
+      if (scene.grains[t].name == name) return static_cast<std::uint16_t>(t);
+    std::vector<std::string> have;
+    for (const GrainSpec& g : scene.grains) have.push_back(fmt::format("\"{}\"", g.name));
+    r.fail("grain", fmt::format("no grain type named \"{}\" (have: {})", name, fmt::join(have, ", ")));
+  };
+  const toml::node* n = r.node("grain");
+  if (!n && scene.grains.size() > 1)
+    r.missing("grain",
+              " when the scene has several grain types: a [[grain]] name, or a list of them with fractions");
+  e.grains = {0};
+  if (n && n->is_string()) e.grains = {type_of(*n->value<std::string>())};
+  if (n && !n->is_string()) {
+    const toml::array* a = n->as_array();
+    if (!a || a->empty() || !a->is_homogeneous(toml::node_type::string))
+      r.fail("grain", "must be a grain type's name or an array of names");
+    e.grains.clear();
+    for (const toml::node& name : *a) {
+      const std::uint16_t t = type_of(*name.value<std::string>());
+      if (std::find(e.grains.begin(), e.grains.end(), t) != e.grains.end())
+        r.fail("grain", fmt::format("\"{}\" is listed twice", *name.value<std::string>()));
+      e.grains.push_back(t);
+    }
+  }
+  e.fractions.assign(e.grains.size(), 1.0);
+  const toml::node* f = r.node("fractions");
+  if (!f && e.grains.size() > 1) r.missing("fractions", " with several grain types: their number fractions");
+  if (!f) return;
+  const toml::array* a = f->as_array();
+  if (!a || a->size() != e.grains.size() ||
+      !std::all_of(a->begin(), a->end(), [](const toml::node& x) { return x.is_number(); })) {
+    r.fail("fractions", fmt::format("must be an array of {} numbers, one per grain type", e.grains.size()));
+  }
+  double total = 0;
+  for (std::size_t k = 0; k < a->size(); ++k) {
+    e.fractions[k] = *a->get(k)->value<double>();
+    if (!(e.fractions[k] >= 0) || !std::isfinite(e.fractions[k]))
+      r.fail("fractions", "must be finite and >= 0");
+    total += e.fractions[k];
+  }
+  if (!(total > 0)) r.fail("fractions", "must not all be 0");
+  for (double& x : e.fractions) x /= total;
+}
+
+// sieve = [[scale, mass_fraction], ...]: scales > 0 and distinct, fractions >= 0 (normalised).
+void read_sieve(TableReader& r, SizeSpec& s) {
+  const toml::array* rows = r.node("sieve")->as_array();
+  const char* form = "must be an array of [scale, mass fraction] pairs";
+  if (!rows || rows->empty()) r.fail("sieve", form);
+  double total = 0;
+  for (const toml::node& row : *rows) {
+    const toml::array* pair = row.as_array();
+    if (!pair || pair->size() != 2 || !pair->get(0)->is_number() || !pair->get(1)->is_number())
+      r.fail("sieve", form);
+    const double scale = *pair->get(0)->value<double>(), fraction = *pair->get(1)->value<double>();
+    if (!(scale > 0) || !std::isfinite(scale)) r.fail("sieve", fmt::format("scale {}: must be > 0", scale));
+    if (!(fraction >= 0) || !std::isfinite(fraction))
+      r.fail("sieve", fmt::format("mass fraction {} at scale {}: must be >= 0", fraction, scale));
+    for (const auto& [other, ignored] : s.sieve)
+      if (other == scale) r.fail("sieve", fmt::format("scale {} is listed twice", scale));
+    s.sieve.emplace_back(scale, fraction);
+    total += fraction;
+  }
+  if (!(total > 0)) r.fail("sieve", "the mass fractions must not all be 0");
+  for (auto& [scale, fraction] : s.sieve) fraction /= total;
+}
+
+// emitter.size = { distribution = "uniform", min, max } | { distribution = "lognormal", median, sigma
+// [, min, max] } | { sieve = [[scale, mass_fraction], ...] }.
+void read_size(TableReader& emitter, const fs::path& file, Emitter& e) {
+  const toml::node* n = emitter.node("size");
+  if (!n) return;
+  if (!n->is_table())
+    emitter.fail("size",
+                 "must be a table: { distribution = \"uniform\", min, max }, "
+                 "{ distribution = \"lognormal\", median, sigma } or { sieve = [...] }");
+  TableReader r(*n->as_table(), "emitter.size", file);
+  SizeSpec& s = e.size;
+  const bool sieve = r.has("sieve");
+  const std::size_t kind = r.choice("distribution", {"uniform", "lognormal", "sieve"},
+                                    sieve ? std::optional<std::size_t>(2) : std::nullopt);
+  if (kind == 2 && !sieve) r.missing("sieve", ": [[scale, mass fraction], ...]");
+  if (kind != 2 && sieve)
+    r.fail("sieve", "sieve classes go with distribution = \"sieve\" (or no distribution)");
+  if (kind == 0) {
+    s.distribution = SizeDistribution::Uniform;
+    s.min = r.positive("min");
+    s.max = r.positive("max");
+    if (s.max < s.min) r.fail("max", fmt::format("{} is below min = {}", s.max, s.min));
+  } else if (kind == 1) {
+    s.distribution = SizeDistribution::Lognormal;
+    s.median = r.positive("median");
+    s.sigma = r.positive("sigma");
+    s.min = r.positive("min", s.median * std::exp(-3 * s.sigma));
+    s.max = r.positive("max", s.median * std::exp(3 * s.sigma));
+    if (!(s.min < s.max))
+      r.fail("max", fmt::format("{} must exceed min = {} (one scale: no size key)", s.max, s.min));
+    if (!(s.min <= s.median && s.median <= s.max))
+      r.fail(s.min > s.median ? "min" : "max",
+             fmt::format("the truncation [{}, {}] must hold the median {}", s.min, s.max, s.median));
+  } else {
+    s.distribution = SizeDistribution::Sieve;
+    read_sieve(r, s);
+  }
   r.reject_unknown_keys();
 }
 
@@ -269,6 +403,8 @@ void read_emitter(const toml::table& t, const fs::path& file, Scene& scene) {
   e.count = static_cast<std::size_t>(r.integer("count", std::nullopt, 1));
   e.velocity = r.vector<3>("velocity", Eigen::Vector3d::Zero());
   e.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0));
+  read_emitter_grains(r, scene, e);
+  read_size(r, file, e);
   if (e.type == EmitterType::Column) {
     e.centre = r.vector<3>("centre", std::nullopt);
     e.radius = r.positive("radius");
@@ -505,7 +641,7 @@ Scene read_scene(const toml::table& root_table, const fs::path& file) {
   scene.gravity = root.vector<3>("gravity", scene.gravity);
   for_each_table(root, "material", [&](const toml::table& t) { read_material(t, file, scene); });
   if (scene.materials.empty()) root.fail("material", "no [[material]] table: a scene needs at least one");
-  read_grain(root, file, scene);
+  read_grains(root, file, scene);
   for_each_table(root, "emitter", [&](const toml::table& t) { read_emitter(t, file, scene); });
   for_each_table(root, "prop", [&](const toml::table& t) { read_prop(t, file, scene); });
   for_each_table(root, "boundary", [&](const toml::table& t) { read_boundary(t, file, scene); });

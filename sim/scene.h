@@ -15,6 +15,7 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "sim/contact_model.h"
@@ -25,10 +26,28 @@
 
 namespace ts::sim {
 
+// A grain type: `[grain]` (the only type) or one of the `[[grain]]` tables.
 struct GrainSpec {
+  std::string name;      // required when there are several types; "" for a lone unnamed type
   double radius = 1e-3;  // m, each of the four spheres
   double edge = 2e-3;    // m, sphere centre distance (default 2 radius: touching spheres)
   std::uint16_t material = 0;
+  int line = 0;
+};
+
+// An emitter's grain size distribution: a dimensionless scale on its grain types (radius and edge
+// together, so the shape stays), drawn per grain (sim/grain_mix.h).
+enum class SizeDistribution {
+  None,       // every grain at scale 1
+  Uniform,    // scale uniform in [min, max], by number
+  Lognormal,  // ln scale normal (median, sigma), redrawn outside [min, max]
+  Sieve,      // classes (scale, mass fraction): the grains of each class weigh that share of the total
+};
+struct SizeSpec {
+  SizeDistribution distribution = SizeDistribution::None;
+  double min = 1, max = 1;       // uniform bounds; lognormal truncation (default median e^(-+3 sigma))
+  double median = 1, sigma = 0;  // lognormal
+  std::vector<std::pair<double, double>> sieve;  // (scale, mass fraction); fractions sum to 1
 };
 
 enum class EmitterType {
@@ -46,8 +65,13 @@ struct Emitter {
   double rate = 0;                                   // grains/s (pour)
   double start = 0;                                  // s (pour)
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s, initial velocity of every grain
-  std::uint64_t seed = 1;                            // jitter and orientations
-  int line = 0;                                      // where it was declared, for messages
+  std::uint64_t seed = 1;                              // jitter, orientations, types and sizes
+  // Grain types (indices into Scene::grains) and their number fractions (sum 1): `grain` and
+  // `fractions`; the counts are exact (largest remainder), the order shuffled.
+  std::vector<std::uint16_t> grains{0};
+  std::vector<double> fractions{1.0};
+  SizeSpec size;
+  int line = 0;  // where it was declared, for messages
 };
 
 struct Prop {
@@ -121,7 +145,7 @@ struct Scene {
   std::filesystem::path file;
   std::vector<Material> materials;
   std::vector<std::string> material_names;
-  GrainSpec grain;
+  std::vector<GrainSpec> grains;             // `[grain]`, or the `[[grain]]` tables in file order
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2
   std::vector<Emitter> emitters;
   std::vector<Prop> props;

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "sim/grain.h"
+#include "sim/grain_mix.h"
 
 namespace ts::sim {
 namespace {
@@ -16,34 +17,39 @@ namespace {
 void check_weight(const Scene& scene, const World& world, const WorldSources& sources) {
   const double g = scene.gravity.norm();  // m/s^2
   if (g == 0) return;
-  const Material& sand = scene.materials[scene.grain.material];
-  const double mass = make_tetrahedral_grain(scene.grain.radius, scene.grain.edge, sand.density).mass;  // kg
   const double ratio = scene.simulation.step.max_overlap_ratio;
   for (const SceneContactCase& c : scene_contact_cases(scene, world, &sources)) {
     const double k_n =
         4.0 / 3.0 * c.contact.effective_modulus * std::sqrt(c.contact.effective_radius);  // N/m^1.5
-    const double resting = std::pow(mass * g / k_n, 2.0 / 3.0);                           // m
+    const double resting = std::pow(c.load_mass * g / k_n, 2.0 / 3.0);                    // m
     const double cap = (ratio > 0 ? ratio : 1.0) * c.smaller_radius;                      // m
     if (resting <= cap) continue;
     const std::string limit =
         ratio > 0 ? fmt::format("the overlap clamp at {:.3g} m ({} of the smaller radius)", cap, ratio)
                   : fmt::format("the radius {:.3g} m", cap);
     throw InputError(fmt::format(
-        "{}: |g| = {:.3g} m/s^2 presses a grain resting on {} {:.3g} m into it, past {}: no contact can hold "
+        "{}: |g| = {:.3g} m/s^2 presses {} resting on {} {:.3g} m into it, past {}: no contact can hold "
         "a "
         "grain's own weight, so grains sink through walls and each other whatever the time step; at most "
         "|g| = {:.3g} m/s^2 fits these materials (or stiffer ones: larger E)",
-        scene_location(scene, "gravity"), g, c.partner, resting, limit, g * std::pow(cap / resting, 1.5)));
+        scene_location(scene, "gravity"), g, c.grain, c.partner, resting, limit,
+        g * std::pow(cap / resting, 1.5)));
   }
 }
 
 // Criterion 2: with the automatic step, the design impact's travel in one step against the CFL distance.
 void check_impact(const Scene& scene, const World& world, double dt) {
   if (scene.simulation.dt > 0) return;  // a dt given by hand warns (resolve_time_step) and runs
-  double radius = scene.grain.radius;   // m
+  // The grid cell follows the largest particle; without the CFL clamp the smallest grain's radius is
+  // the travel a contact can take unseen.
+  double radius = 0, smallest = 1e300;  // m
+  for (const GrainKind& k : scene_grain_kinds(scene)) {
+    radius = std::max(radius, k.shape.particle_radius);
+    smallest = std::min(smallest, k.shape.particle_radius);
+  }
   for (double r : world.particles.radius) radius = std::max(radius, r);
   const double cfl = scene.simulation.step.cfl;
-  const double reach = cfl > 0 ? cfl * 2 * radius : scene.grain.radius;  // m per step
+  const double reach = cfl > 0 ? cfl * 2 * radius : smallest;  // m per step
   const DesignSpeed design = scene_design_speed(scene, world);
   if (design.speed * dt <= reach) return;
   // The largest speed v with v dt(v) <= reach: v dt(v) grows with v (dt falls as v^-1/5 at most).
@@ -54,7 +60,7 @@ void check_impact(const Scene& scene, const World& world, double dt) {
   }
   const std::string distance =
       cfl > 0 ? fmt::format("the CFL distance {:.3g} m ({} grid cells of {:.3g} m)", reach, cfl, 2 * radius)
-              : fmt::format("the grain radius {:.3g} m", reach);
+              : fmt::format("the smallest grain radius {:.3g} m", reach);
   throw InputError(fmt::format(
       "{}: impacts at the design speed {:.3g} m/s move a grain {:.3g} m in one automatic step of {:.3g} s, "
       "farther "

@@ -9,7 +9,7 @@
 #include <numbers>
 
 #include "core/error.h"
-#include "sim/grain.h"
+#include "sim/grain_mix.h"
 #include "sim/scene_world.h"
 
 namespace ts::sim {
@@ -17,12 +17,6 @@ namespace {
 
 [[noreturn]] void fail(const Scene& scene, int line, std::string_view key, const std::string& problem) {
   throw InputError(fmt::format("{}: {}", scene_location(scene, key, line), problem));
-}
-
-double grain_bound(const Scene& scene) {
-  return make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
-                                scene.materials[scene.grain.material].density)
-      .bounding_radius;
 }
 
 // The edge of the largest cube of lattice sites that fits (m).
@@ -153,8 +147,7 @@ void check_emitter_cells(const Scene& scene, const Emitter& e, double cell) {
 }  // namespace
 
 void check_scene_sizes(const Scene& scene) {
-  const double bound = grain_bound(scene);
-  for (const Emitter& e : scene.emitters) check_emitter(scene, e, bound);
+  for (const Emitter& e : scene.emitters) check_emitter(scene, e, emitter_bound(scene, e));
   double rough = 0;
   for (const Boundary& b : scene.boundaries) {
     if (!b.rough) continue;
@@ -172,7 +165,8 @@ void check_scene_sizes(const Scene& scene) {
 void check_world_sizes(const Scene& scene, const World& world) {
   check_total(scene, total_grains(scene), static_cast<double>(world.particles.size()),
               "rough boundaries and props");
-  double radius = scene.grain.radius;  // m
+  double radius = 0;  // m: the grid cell is the largest particle's diameter
+  for (const GrainKind& k : scene_grain_kinds(scene)) radius = std::max(radius, k.shape.particle_radius);
   for (double r : world.particles.radius) radius = std::max(radius, r);
   const double cell = 2 * radius;
   for (const Emitter& e : scene.emitters) check_emitter_cells(scene, e, cell);

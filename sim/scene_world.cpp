@@ -175,10 +175,13 @@ void add_prop(World& world, const Prop& p) {
   apply_tracks(world, 0.0);
 }
 
-void add_grains(World& world, const GrainShape& grain, std::uint16_t material, const std::vector<Eigen::Vector3d>& sites,
-                const Emitter& e, std::mt19937_64& rng) {
+void add_grains(World& world, const Scene& scene, const std::vector<Eigen::Vector3d>& sites, const Emitter& e,
+                std::mt19937_64& rng) {
+  const std::vector<GrainDraw> draws = emitter_grain_draws(e);
   for (std::size_t i = 0; i < e.count; ++i) {
-    add_grain(world, grain, material, sites[i], random_orientation(rng), e.velocity);
+    const GrainDraw& d = draws[i];
+    add_grain(world, scaled_grain(scene, d.type, d.scale), scene.grains[d.type].material, sites[i],
+              random_orientation(rng), e.velocity);
   }
 }
 
@@ -268,35 +271,35 @@ World make_world(const Scene& scene, WorldSources* sources) {
     sources->bodies = names.bodies;
     sources->prop_bodies = prop_bodies;
   }
-  const GrainShape grain = make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
-                                                  scene.materials[scene.grain.material].density);
   for (const Emitter& e : scene.emitters) {
     if (e.type == EmitterType::Pour) continue;
     std::mt19937_64 rng(e.seed);
+    const double bound = emitter_bound(scene, e);  // m: the lattice is spaced for the largest grain
     const std::vector<Eigen::Vector3d> sites = e.type == EmitterType::Fill
-                                                   ? grain_sites_in_box(e.min, e.max, grain.bounding_radius, rng)
-                                                   : column_sites(e, grain.bounding_radius, rng);
+                                                   ? grain_sites_in_box(e.min, e.max, bound, rng)
+                                                   : column_sites(e, bound, rng);
     if (sites.size() < e.count) {
-      throw InputError(fmt::format("{}: the region holds only {} grains without overlap (spacing {:.3g} m = 2.2 "
-                                   "bounding radii), count = {}",
-                                   where(scene, e.line, "emitter.count"), sites.size(),
-                                   2 * grain.bounding_radius * kSiteMargin, e.count));
+      throw InputError(
+          fmt::format("{}: the region holds only {} grains without overlap (spacing {:.3g} m = 2.2 "
+                      "bounding radii of the largest grain), count = {}",
+                      where(scene, e.line, "emitter.count"), sites.size(), 2 * bound * kSiteMargin, e.count));
     }
-    add_grains(world, grain, scene.grain.material, sites, e, rng);
+    add_grains(world, scene, sites, e, rng);
   }
   return world;
 }
 
 PourEmitter::PourEmitter(const Scene& scene, const Emitter& emitter)
-    : grain_(make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
-                                    scene.materials[scene.grain.material].density)),
+    : types_(scene.grains),
+      draws_(emitter_grain_draws(emitter)),
+      bound_(emitter_bound(scene, emitter)),
       emitter_(emitter),
-      material_(scene.grain.material),
       rng_(emitter.seed) {
-  sites_ = grain_sites_in_box(emitter.min, emitter.max, grain_.bounding_radius, rng_);
+  for (const GrainSpec& g : types_) densities_.push_back(scene.materials[g.material].density);
+  sites_ = grain_sites_in_box(emitter.min, emitter.max, bound_, rng_);
   if (sites_.empty()) {
     throw InputError(fmt::format("{}: the region is smaller than one grain (bounding diameter {:.3g} m)",
-                                 where(scene, emitter.line, "emitter.max"), 2 * grain_.bounding_radius));
+                                 where(scene, emitter.line, "emitter.max"), 2 * bound_));
   }
 }
 
@@ -329,54 +332,84 @@ std::size_t PourEmitter::emit(World& world) {
   for (std::size_t tries = 0; emitted_ < due && tries < sites_.size(); ++tries) {
     const Eigen::Vector3d& site = sites_[next_site_];
     next_site_ = (next_site_ + 1) % sites_.size();
+    const GrainDraw& d = draws_[emitted_];
+    const GrainSpec& type = types_[d.type];
+    const GrainShape grain =
+        make_tetrahedral_grain(d.scale * type.radius, d.scale * type.edge, densities_[d.type]);
     bool free = true;
     for (std::size_t b = 0; b < world.bodies.size() && free; ++b) {
       if (world.bodies.motion[b] != MotionType::Dynamic) continue;
-      const double clearance = (grain_.bounding_radius + world.bodies.bounding_radius[b]) * 1.02;  // m
+      const double clearance = (grain.bounding_radius + world.bodies.bounding_radius[b]) * 1.02;  // m
       free = (world.bodies.position[b] - site).norm() >= clearance;
     }
     if (!free) continue;
-    add_grain(world, grain_, material_, site, random_orientation(rng_), emitter_.velocity);
+    add_grain(world, grain, type.material, site, random_orientation(rng_), emitter_.velocity);
     ++emitted_;
     ++added;
   }
   return added;
 }
 
+std::size_t fixture_bodies(const Scene& scene, const World& world) {
+  std::size_t fixtures = 0;
+  for (MotionType m : world.bodies.motion) fixtures += m != MotionType::Dynamic ? 1 : 0;
+  for (const Prop& p : scene.props) fixtures += p.motion == MotionType::Dynamic ? 1 : 0;
+  return std::min(fixtures, world.bodies.size());
+}
+
 std::vector<SceneContactCase> scene_contact_cases(const Scene& scene, const World& world,
                                                   const WorldSources* sources) {
-  const GrainShape g = make_tetrahedral_grain(scene.grain.radius, scene.grain.edge,
-                                              scene.materials[scene.grain.material].density);
-  const Material& sand = scene.materials[scene.grain.material];
-  const double inverse_tangential = grain_tangential_inverse_mass(g);  // 1/kg
-  auto pair = [&](std::uint16_t other) {
-    return make_pair_coefficients(sand, scene.materials[other], scene.simulation.step.normal_damping);
+  const std::vector<GrainKind> kinds = scene_grain_kinds(scene);
+  const bool one_kind = kinds.size() == 1;
+  auto pair = [&](std::uint16_t a, std::uint16_t b) {
+    return make_pair_coefficients(scene.materials[a], scene.materials[b],
+                                  scene.simulation.step.normal_damping);
   };
   std::vector<SceneContactCase> cases;
-  const PairCoefficients grains = pair(scene.grain.material);
-  const double r = g.particle_radius;
-  cases.push_back(
-      {{g.mass / 2, r / 2, grains.effective_modulus, 1 / (2 * inverse_tangential), grains.tangential_damping},
-       r,
-       "another grain"});
-  for (const Boundary& b : scene.boundaries) {
-    const PairCoefficients c = pair(b.material);
-    const double radius = b.rough ? r * b.particle_radius / (r + b.particle_radius) : r;
-    cases.push_back({{g.mass, radius, c.effective_modulus, 1 / inverse_tangential, c.tangential_damping},
-                     b.rough ? std::min(r, b.particle_radius) : r,
-                     fmt::format("the {}boundary at line {}", b.rough ? "rough " : "", b.line)});
-  }
-  for (std::size_t k = 0; k < world.bodies.size(); ++k) {
-    const std::uint32_t first = world.bodies.first_particle[k];
-    if (world.bodies.particle_count[k] == 4 && world.particles.radius[first] == r) continue;  // a grain
-    const PairCoefficients c = pair(world.particles.material[first]);
-    const double rp = world.particles.radius[first];
-    const double inverse_mass = world.bodies.inverse_mass[k];
-    const bool named = sources && k < sources->bodies.size();
-    cases.push_back({{1 / (1 / g.mass + inverse_mass), r * rp / (r + rp), c.effective_modulus,
-                      1 / inverse_tangential, c.tangential_damping},
-                     std::min(r, rp),
-                     named ? sources->bodies[k] : fmt::format("body {}", k)});
+  for (std::size_t i = 0; i < kinds.size(); ++i) {
+    const GrainShape& g = kinds[i].shape;
+    const std::uint16_t sand = scene.grains[kinds[i].type].material;
+    const std::string grain = one_kind ? "a grain" : kinds[i].name;
+    const double inverse_tangential = grain_tangential_inverse_mass(g);  // 1/kg
+    const double r = g.particle_radius;
+    for (std::size_t j = i; j < kinds.size(); ++j) {  // grain against grain, each pair of kinds once
+      const GrainShape& h = kinds[j].shape;
+      const PairCoefficients c = pair(sand, scene.grains[kinds[j].type].material);
+      const double rh = h.particle_radius;
+      // A kind against itself as m/2, r/2 exactly: the step of a one-kind scene is the one it always had.
+      const double m_eff = i == j ? g.mass / 2 : g.mass * h.mass / (g.mass + h.mass);
+      const double r_eff = i == j ? r / 2 : r * rh / (r + rh);
+      cases.push_back({{m_eff, r_eff, c.effective_modulus,
+                        i == j ? 1 / (2 * inverse_tangential)
+                               : 1 / (inverse_tangential + grain_tangential_inverse_mass(h)),
+                        c.tangential_damping},
+                       std::min(r, rh),
+                       std::max(g.mass, h.mass),
+                       grain,
+                       one_kind ? "another grain" : kinds[j].name});
+    }
+    for (const Boundary& b : scene.boundaries) {
+      const PairCoefficients c = pair(sand, b.material);
+      const double radius = b.rough ? r * b.particle_radius / (r + b.particle_radius) : r;
+      cases.push_back({{g.mass, radius, c.effective_modulus, 1 / inverse_tangential, c.tangential_damping},
+                       b.rough ? std::min(r, b.particle_radius) : r,
+                       g.mass,
+                       grain,
+                       fmt::format("the {}boundary at line {}", b.rough ? "rough " : "", b.line)});
+    }
+    for (std::size_t k = 0; k < fixture_bodies(scene, world); ++k) {
+      const std::uint32_t first = world.bodies.first_particle[k];
+      const PairCoefficients c = pair(sand, world.particles.material[first]);
+      const double rp = world.particles.radius[first];
+      const double inverse_mass = world.bodies.inverse_mass[k];
+      const bool named = sources && k < sources->bodies.size();
+      cases.push_back({{1 / (1 / g.mass + inverse_mass), r * rp / (r + rp), c.effective_modulus,
+                        1 / inverse_tangential, c.tangential_damping},
+                       std::min(r, rp),
+                       g.mass,
+                       grain,
+                       named ? sources->bodies[k] : fmt::format("body {}", k)});
+    }
   }
   return cases;
 }
@@ -423,8 +456,9 @@ DesignSpeed scene_design_speed(const Scene& scene, const World& world) {
 }
 
 std::vector<ParticleKind> scene_particle_kinds(const Scene& scene) {
-  const Material& sand = scene.materials[scene.grain.material];
-  std::vector<ParticleKind> kinds{{scene.grain.radius, sand}};
+  std::vector<ParticleKind> kinds;
+  for (const GrainKind& k : scene_grain_kinds(scene))
+    kinds.push_back({k.shape.particle_radius, scene.materials[scene.grains[k.type].material]});
   for (const Boundary& b : scene.boundaries) {
     if (b.rough) kinds.push_back({b.particle_radius, scene.materials[b.material]});
   }

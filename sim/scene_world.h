@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sim/grain.h"
+#include "sim/grain_mix.h"
 #include "sim/scene.h"
 #include "sim/time_step.h"
 #include "sim/world.h"
@@ -30,13 +31,20 @@ struct WorldSources {
 // the walls and bodies.
 World make_world(const Scene& scene, WorldSources* sources = nullptr);
 
+// The bodies make_world adds before the grains (rough walls and props; world order): grains are the
+// bodies from this index on (emitters only append grains).
+std::size_t fixture_bodies(const Scene& scene, const World& world);
+
 // A kind of contact a grain of the scene will see, and what it is with.
 struct SceneContactCase {
   ContactCase contact;
   double smaller_radius = 0;  // m, of the two spheres
+  double load_mass = 0;       // kg: the heavier grain of the contact, whose weight it holds at rest
+  std::string grain;          // "a grain", or the GrainKind's name when there are several kinds
   std::string partner;        // "another grain", "the boundary at line 12", a WorldSources body name
 };
-// Grain-grain, grain-boundary (each [[boundary]]) and grain-body (each rough wall and prop body).
+// For each GrainKind (scene_grain_kinds): against each kind (itself included), each [[boundary]],
+// and each rough wall and prop body. With one kind, grain-grain, grain-boundary and grain-body.
 std::vector<SceneContactCase> scene_contact_cases(const Scene& scene, const World& world,
                                                   const WorldSources* sources = nullptr);
 
@@ -50,7 +58,7 @@ struct DesignSpeed {
 // (at least 0.5 m/s).
 DesignSpeed scene_design_speed(const Scene& scene, const World& world);
 
-// The particle kinds of the Rayleigh bound: the grain's spheres and each rough boundary's.
+// The particle kinds of the Rayleigh bound: each GrainKind's spheres and each rough boundary's.
 std::vector<ParticleKind> scene_particle_kinds(const Scene& scene);
 
 // The time-step bound for the scene's contact kinds at `impact_speed` (m/s; 0: the design speed).
@@ -83,9 +91,11 @@ class PourEmitter {
   void restore(const PourProgress& progress);
 
  private:
-  GrainShape grain_;
+  std::vector<GrainSpec> types_;   // the scene's grain types
+  std::vector<double> densities_;  // kg/m^3, of each type's material
+  std::vector<GrainDraw> draws_;   // type and scale of each grain, in release order
+  double bound_ = 0;               // m, bounding radius of the emitter's largest grain
   Emitter emitter_;
-  std::uint16_t material_;
   std::vector<Eigen::Vector3d> sites_;  // m, lattice sites of the region
   std::size_t next_site_ = 0, emitted_ = 0;
   std::mt19937_64 rng_;

@@ -625,6 +625,8 @@ discharge rate 10 % (since 2026-12-02 on the mean of four fill seeds, before on 
 
 AGREEMENT_START, AGREEMENT_END = "<!-- section: agreement -->\n", "<!-- end: agreement -->\n"
 OEDOMETER_START, OEDOMETER_END = "<!-- section: oedometer -->\n", "<!-- end: oedometer -->\n"  # bench/validation/oedometer.py
+# The bidisperse bed against LAMMPS: written by hand from its test (tests/sim/export_lammps_test.cpp).
+BIDISPERSE_START, BIDISPERSE_END = "<!-- section: bidisperse -->\n", "<!-- end: bidisperse -->\n"
 
 
 def main():
@@ -681,7 +683,9 @@ produced by `scripts/bench.sh peers-sim`.
     if os.path.exists(note):
         header += "\n" + open(note).read()
     text = (header + "\n" + "\n".join(parts) + "\n" + kept(OEDOMETER_START, OEDOMETER_END, "scripts/bench.sh oedometer")
-            + kept(AGREEMENT_START, AGREEMENT_END, "scripts/bench.sh agreement"))
+            + kept(AGREEMENT_START, AGREEMENT_END, "scripts/bench.sh agreement")
+            + kept(BIDISPERSE_START, BIDISPERSE_END,
+                   "ctest -R LammpsSettlesExportedBidisperseBedToTetrasandsHeightAndPacking"))
     open(path + ".tmp", "w").write(text)
     os.replace(path + ".tmp", path)
     print(text)

@@ -331,7 +331,7 @@ void silo(const fs::path& out, const fs::path& scene_file) {
                                         grains, filled.settle_time, filled.fill, 2 * scene.boundaries.at(0).radius, dt,
                                         filled.wall_seconds));
 
-  const double d = 2 * scene.grain.radius * std::cbrt(4.0);  // m, volume-equivalent diameter
+  const double d = 2 * scene.grains.at(0).radius * std::cbrt(4.0);  // m, volume-equivalent diameter
   std::string csv = "orifice_m,time_s,discharged\n";
   std::string runs = "orifice_m,grains,rim_spheres,removed_on_rim,seconds\n";
   for (double ratio : {5.0, 6.0, 7.0, 8.0}) {
@@ -524,7 +524,7 @@ void oedometer(const fs::path& out, const std::string& shape) {
                 fs::copy_options::overwrite_existing);
   ts::write_file_atomically(out / ("oedometer_runs_" + shape + ".csv"),
                             fmt::format("shape,grains,steps,seconds,grain_radius_m\n{},{},{},{:.1f},{}\n",
-                                        shape, r.grains, r.steps, r.seconds, scene.grain.radius));
+                                        shape, r.grains, r.steps, r.seconds, scene.grains.at(0).radius));
 }
 
 // Long runs of the GPU pipeline (float, on whatever GL device there is) against the CPU reference

@@ -28,9 +28,9 @@ namespace fs = std::filesystem;
 // generator), a fill, tangential springs, a keyframed kinematic plate, a rough floor and smooth walls.
 // Checkpoints every 37 steps fall inside the stretches between pour releases (36 steps) and outputs
 // (100 steps).
-std::string scene_text(const std::string& engine_keys) {
+std::string scene_text(const std::string& engine_keys, const std::string& pour_size = "") {
   test::PouredScene p;
-  p.pour_extra = "velocity = [0.0, 0.0, -0.5]\n";
+  p.pour_extra = "velocity = [0.0, 0.0, -0.5]\n" + pour_size;
   p.boundaries = R"([[boundary]]
 type = "plane"
 rough = true
@@ -50,8 +50,9 @@ material = "sand"
   return test::poured_scene(p);
 }
 
-Scene write_scene(const fs::path& dir, const std::string& engine_keys = "") {
-  write_file_atomically(dir / "scene.toml", scene_text(engine_keys));
+Scene write_scene(const fs::path& dir, const std::string& engine_keys = "",
+                  const std::string& pour_size = "") {
+  write_file_atomically(dir / "scene.toml", scene_text(engine_keys, pour_size));
   return load_scene(dir / "scene.toml");
 }
 
@@ -110,6 +111,14 @@ void expect_resume_is_bitwise(const Scene& scene, const StepperFactory& factory,
 TEST(Checkpoint, ResumedCpuRunIsBitwiseTheUninterruptedOne) {
   const fs::path dir = test::temp_dir();
   expect_resume_is_bitwise(write_scene(dir), {}, dir);
+}
+
+// Poured grains of varying size (issue 18): each has its own mass and inertia, which the checkpoint
+// keeps with the bodies; the emitter's sizes still to come follow from its seed and release count.
+TEST(Checkpoint, ResumedPolydispersePourIsBitwiseTheUninterruptedOne) {
+  const fs::path dir = test::temp_dir();
+  const Scene scene = write_scene(dir, "", "size = { distribution = \"uniform\", min = 0.7, max = 1.0 }\n");
+  expect_resume_is_bitwise(scene, {}, dir);
 }
 
 TEST(Checkpoint, ResumedGpuRunIsBitwiseTheUninterruptedOneAcrossResorts) {

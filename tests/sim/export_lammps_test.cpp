@@ -4,10 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -342,6 +346,191 @@ csv = false
     ++n;
   }
   EXPECT_NEAR(y / n, mean.y(), 2e-3);
+}
+
+// ---- Grain types and sizes (issue 18).
+
+struct Sphere {
+  Eigen::Vector3d x;  // m
+  double r;           // m
+  long body;
+};
+
+// The atoms of the last frame of a LAMMPS custom dump "id mol type x y z radius".
+std::vector<Sphere> dump_spheres(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<Sphere> spheres;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("ITEM: NUMBER OF ATOMS", 0) != 0) continue;
+    std::getline(in, line);
+    const long n = std::stol(line);
+    for (int k = 0; k < 5; ++k) std::getline(in, line);
+    spheres.clear();
+    for (long i = 0; i < n && std::getline(in, line); ++i) {
+      std::istringstream row(line);
+      long id = 0, mol = 0, type = 0;
+      Sphere s{};
+      row >> id >> mol >> type >> s.x.x() >> s.x.y() >> s.x.z() >> s.r;
+      s.body = mol;
+      spheres.push_back(s);
+    }
+  }
+  return spheres;
+}
+
+std::vector<Sphere> grain_spheres(const World& w) {
+  std::vector<Sphere> spheres;
+  const std::vector<Eigen::Vector3d> x = particle_positions(w);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (w.bodies.motion[w.particles.body[i]] == MotionType::Dynamic)
+      spheres.push_back({x[i], w.particles.radius[i], static_cast<long>(w.particles.body[i])});
+  }
+  return spheres;
+}
+
+// The bed's figures of docs/validation.md (section "Bidisperse bed against LAMMPS"): H, twice the
+// volume-weighted mean grain-centre height (a grain's volume ~ its spheres' r^3), and phi, the solid
+// fraction of the spheres' union on a 40^3 grid in 0.25 H < z < 0.75 H, |x|, |y| < half - inset.
+struct Bed {
+  double height = 0;   // m
+  double packing = 0;  // solid fraction
+};
+Bed measure_bed(const std::vector<Sphere>& spheres, double half, double inset) {
+  std::map<long, std::pair<Eigen::Vector3d, double>> grains;  // body -> (sum of centres, volume)
+  std::map<long, int> count;
+  for (const Sphere& s : spheres) {
+    auto& g = grains.try_emplace(s.body, Eigen::Vector3d::Zero(), 0.0).first->second;
+    g.first += s.x;
+    g.second += s.r * s.r * s.r;
+    ++count[s.body];
+  }
+  double moment = 0, volume = 0;
+  for (const auto& [body, g] : grains) {
+    moment += g.first.z() / count[body] * g.second;
+    volume += g.second;
+  }
+  Bed bed;
+  bed.height = 2 * moment / volume;
+  const int n = 40;
+  const double lo = -half + inset, span = 2 * (half - inset), z0 = 0.25 * bed.height,
+               zspan = 0.5 * bed.height;
+  int solid = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k) {
+        const Eigen::Vector3d p(lo + (i + 0.5) * span / n, lo + (j + 0.5) * span / n,
+                                z0 + (k + 0.5) * zspan / n);
+        solid += std::any_of(spheres.begin(), spheres.end(),
+                             [&](const Sphere& s) { return (s.x - p).squaredNorm() < s.r * s.r; });
+      }
+  bed.packing = solid / static_cast<double>(n * n * n);
+  return bed;
+}
+
+// The pre-set criterion of docs/validation.md: the bidisperse bed (100 fine r = 0.75 mm and 100 coarse
+// r = 1.25 mm grains, one lattice, a smooth 2 cm box) settles in LAMMPS to tetrasand's bed height and
+// packing fraction within 3 % each, from the same total grain mass.
+TEST(ExportLammps, LammpsSettlesExportedBidisperseBedToTetrasandsHeightAndPacking) {
+  const fs::path dir = test::temp_dir();
+  Scene scene = write_scene(dir, read_file(test::asset("scenes/reference/bidisperse_bed.toml")));
+  const World initial = make_world(scene);
+  const LammpsDeck deck = export_lammps(scene, dir / "deck");
+  EXPECT_EQ(deck.dynamic_bodies, 200u);
+  run_lammps(deck);
+  if (HasFatalFailure()) return;
+  World last;
+  RunHooks hooks;
+  hooks.on_output = [&](const World& world, const StepStats&, std::int64_t) { last = world; };
+  run_scene(scene, dir / "tetrasand", hooks);
+
+  // The same grains: 400 spheres of each size, the same total mass in both decks.
+  const std::vector<Sphere> lammps = dump_spheres(dir / "deck" / "final.dump"), ours = grain_spheres(last);
+  ASSERT_EQ(lammps.size(), 800u);
+  std::map<double, int> sizes;
+  for (const Sphere& s : lammps) ++sizes[std::round(s.r * 1e6)];
+  EXPECT_EQ(sizes, (std::map<double, int>{{750.0, 400}, {1250.0, 400}}));
+  double mass = 0, rigid = 0;
+  for (std::size_t b = 0; b < initial.bodies.size(); ++b) mass += 1 / initial.bodies.inverse_mass[b];
+  std::istringstream bodies(read_file(dir / "deck" / "bodies.rigid"));
+  std::string line;
+  while (std::getline(bodies, line) && line[0] == '#') {
+  }
+  while (std::getline(bodies, line)) {
+    std::istringstream row(line);
+    double id = 0, m = 0;
+    row >> id >> m;
+    rigid += m;
+  }
+  EXPECT_NEAR(rigid / mass, 1.0, 1e-12);
+  // Settled: less kinetic energy per grain than lifting a fine grain by a tenth of its radius.
+  const double fine = make_tetrahedral_grain(0.75e-3, 1.5e-3, 2600).mass;
+  const Energy e = energy(last);
+  EXPECT_LT((e.translational + e.rotational) / 200, 0.1 * fine * 9.81 * 0.75e-3);
+
+  const Bed a = measure_bed(lammps, 0.01, 2.5e-3), b = measure_bed(ours, 0.01, 2.5e-3);
+  RecordProperty("H_lammps_mm", std::to_string(a.height * 1e3));
+  RecordProperty("H_tetrasand_mm", std::to_string(b.height * 1e3));
+  RecordProperty("phi_lammps", std::to_string(a.packing));
+  RecordProperty("phi_tetrasand", std::to_string(b.packing));
+  std::printf(
+      "bidisperse bed: H LAMMPS %.4f mm, tetrasand %.4f mm (%+.2f %%); phi LAMMPS %.4f, tetrasand %.4f "
+      "(%+.2f %%)\n",
+      a.height * 1e3, b.height * 1e3, (a.height / b.height - 1) * 100, a.packing, b.packing,
+      (a.packing / b.packing - 1) * 100);
+  EXPECT_LT(b.height, 0.5 * 2 * 0.075);  // fell and settled (filled up to 15 cm)
+  EXPECT_NEAR(a.height / b.height, 1.0, 0.03)
+      << "bed height LAMMPS " << a.height << " m, tetrasand " << b.height;
+  EXPECT_NEAR(a.packing / b.packing, 1.0, 0.03)
+      << "packing LAMMPS " << a.packing << ", tetrasand " << b.packing;
+}
+
+// A pour of two types, one sieved into two sizes and the other continuous: one molecule template per
+// type and size (sieve class, or size bin of the continuous one), fix deposit drawing them in the
+// emitter's proportions; LAMMPS runs the deck and inserts grains of each size.
+TEST(ExportLammps, PolydispersePourWritesOneTemplatePerTypeAndSizeAndRunsInLammps) {
+  const fs::path dir = test::temp_dir();
+  std::string text = read_file(test::asset("scenes/reference/bidisperse_bed.toml"));
+  const std::string fill =
+      text.substr(text.find("[[emitter]]"), text.find("[[boundary]]") - text.find("[[emitter]]"));
+  text.replace(text.find(fill), fill.size(), R"([[emitter]]
+type = "pour"
+min = [-0.008, -0.008, 0.02]
+max = [0.008, 0.008, 0.04]
+count = 20
+rate = 1000.0
+grain = "fine"
+size = { sieve = [[0.8, 0.5], [1.0, 0.5]] }
+seed = 3
+[[emitter]]
+type = "pour"
+min = [-0.008, -0.008, 0.05]
+max = [0.008, 0.008, 0.07]
+count = 20
+rate = 1000.0
+grain = "coarse"
+size = { distribution = "uniform", min = 0.9, max = 1.1 }
+seed = 4
+
+)");
+  text.replace(text.find("duration = 0.5"), 14, "duration = 0.03");
+  const Scene scene = write_scene(dir, text);
+  const LammpsDeck deck = export_lammps(scene, dir / "deck");
+  const std::string in = read_file(deck.input);
+  // 2 sieve classes + 5 size bins.
+  EXPECT_NE(in.find("molecule        grain grain1.mol grain2.mol grain3.mol grain4.mol grain5.mol grain6.mol "
+                    "grain7.mol\n"),
+            std::string::npos)
+      << in;
+  for (int k = 1; k <= 7; ++k) EXPECT_TRUE(fs::exists(dir / "deck" / fmt::format("grain{}.mol", k))) << k;
+  EXPECT_FALSE(fs::exists(dir / "deck" / "grain.mol"));
+  EXPECT_NE(in.find("mol grain molfrac "), std::string::npos) << in;
+  run_lammps(deck);
+  if (HasFatalFailure()) return;
+  std::set<double> radii;
+  for (const Sphere& s : dump_spheres(dir / "deck" / "final.dump")) radii.insert(std::round(s.r * 1e7));
+  EXPECT_GE(radii.size(), 4u) << "LAMMPS inserted grains of " << radii.size() << " sizes";
+  EXPECT_TRUE(radii.count(6000.0) && radii.count(7500.0)) << "both sieve classes of the fine grain";
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ Scene pile_scene(double mu, std::size_t count, double duration,
                  TangentialModel tangential = TangentialModel::Viscous) {
   const std::filesystem::path file = test::asset("scenes/reference/coarse_pile.toml");
   Scene scene = parse_scene(read_file(file), file.string());
-  EXPECT_EQ(scene.grain.radius, kRadius);
+  EXPECT_EQ(scene.grains.at(0).radius, kRadius);
   scene.materials.at(0).friction = mu;
   scene.emitters.at(0).count = count;
   scene.simulation.duration = duration;

@@ -33,7 +33,7 @@ TEST(Scene, MinimalSceneParsesWithDefaults) {
   const Scene s = parse_scene(kMinimal, "scene.toml");
   ASSERT_EQ(s.materials.size(), 1u);
   EXPECT_DOUBLE_EQ(s.materials[0].youngs_modulus, 1e7);
-  EXPECT_DOUBLE_EQ(s.grain.edge, 2e-3);
+  EXPECT_DOUBLE_EQ(s.grains.at(0).edge, 2e-3);
   EXPECT_EQ(s.simulation.dt, 0.0);  // auto
   EXPECT_EQ(s.gravity, Eigen::Vector3d(0, 0, -9.81));
 }
