@@ -338,8 +338,11 @@ void plan_pours(DeckPlan& plan) {
     }
     PourEvent event{static_cast<std::int64_t>(std::llround(e.start / plan.dt)), &e, {}};
     for (const auto& [t, share] : pour_templates(e)) {
-      auto it = std::find_if(plan.templates.begin(), plan.templates.end(),
-                             [&](const GrainTemplate& u) { return u.type == t.type && u.scale == t.scale; });
+      // A named copy: clang 14 cannot capture a structured binding in a lambda.
+      const GrainTemplate& wanted = t;
+      auto it = std::find_if(plan.templates.begin(), plan.templates.end(), [&](const GrainTemplate& u) {
+        return u.type == wanted.type && u.scale == wanted.scale;
+      });
       const auto k = static_cast<std::size_t>(it - plan.templates.begin());
       if (it == plan.templates.end()) plan.templates.push_back(t);
       event.molfrac.resize(plan.templates.size(), 0.0);
