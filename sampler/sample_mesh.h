@@ -1,6 +1,7 @@
 #pragma once
 // The main job: a closed mesh becomes a particle rigid body (thesis 6.3; Bell, Yu & Mucha 2005).
-//   1. SDF by GPU scan conversion, voxel = r / 2 unless set (see SampleSettings::voxel_size);
+//   1. SDF by GPU scan conversion (or exact CPU distance: SdfBackend), voxel = r / 2 unless set
+//      (see SampleSettings::voxel_size);
 //   2. seeds spread area-uniformly with the injected seed, as many as the coverage target needs;
 //   3. GPU relaxation (attraction to the zero level set + Gaussian repulsion);
 //   4. exact projection onto the mesh, crowded pairs (closer than 0.6 spacing) thinned, coverage
