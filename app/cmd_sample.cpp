@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -44,6 +45,13 @@ struct Options {
   bool json = false, allow_open = false, preview = false;
   std::vector<double> up{0.0, 0.0, 1.0};  // --preview's world up
   bool strict = false;                     // a body short of OK exits 1 (it is still written)
+  std::string sdf_backend = "auto";
+  double context_seconds = 0.0;  // s, the GPU context's creation (once for a batch)
+};
+
+// Wall time of the command's own stages of one mesh [s]; sample_mesh's are in SampleResult::stages.
+struct CommandSeconds {
+  double context = 0.0, load = 0.0, write = 0.0, total = 0.0;
 };
 
 struct BatchRow {
@@ -178,8 +186,12 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
   cmd->add_option("--voxel", s.voxel_size, "SDF voxel [m] (default r / 2)")->check(positive());
   cmd->add_option("--rounds", s.max_rounds, "Most hole-closing rounds")->check(non_negative())->capture_default_str();
   cmd->add_option("--probes", s.probes,
-                  "Random surface points of the statistical covering radius (beside the certificate)")
+                  "Most random surface points of the statistical covering radius (beside the certificate)")
       ->check(finite())
+      ->capture_default_str();
+  cmd->add_option("--probes-per-particle", s.probes_per_particle,
+                  "Probes per surface particle (at least 65536, at most --probes); 0: always --probes")
+      ->check(non_negative())
       ->capture_default_str();
   cmd->add_option(
          "--certificate-floor", s.certificate.floor_divisor,
@@ -190,6 +202,12 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
   cmd->add_option("--scale", o.scale, "Multiply coordinates by this factor first")->check(positive());
   cmd->add_option("--max-iterations", s.relax.max_iterations, "Most relaxation steps of the first relaxation (later rounds: 200)")
       ->check(positive())
+      ->capture_default_str();
+  cmd->add_option(
+         "--sdf-backend", o.sdf_backend,
+         "Where the SDF is built: gpu (scan conversion), cpu (exact distance, all cores) or auto (cpu on "
+         "a software renderer for grids up to 2^23 voxels, else gpu)")
+      ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
       ->capture_default_str();
   cmd->add_option("--sdf-budget-mib", o.sdf_budget_mib,
                   "Most GPU memory the sparse SDF may take [MiB]; a larger field stops the run (exit 1) with the "
@@ -338,13 +356,66 @@ nlohmann::json thin_features_json(const sampler::ThinFeatures& thin) {
 }
 
 // The written body.json, and beside it what only this run knows: the verdict and the thin features.
+// What this run cost and where it ran: the device, the SDF's path, the probes and each stage's seconds.
+nlohmann::json run_json(const sampler::SampleResult& result, const CommandSeconds& c,
+                        const gpu::Context& context) {
+  const sampler::StageSeconds& t = result.stages;
+  return {{"device", context.summary()},
+          {"software_device", context.software()},
+          {"sdf_backend", result.sdf_on_cpu ? "cpu" : "gpu"},
+          {"probes", result.probes},
+          {"certificate_passes", result.certificate_passes},
+          {"seconds",
+           {{"context", c.context},
+            {"load", c.load},
+            {"plan", t.plan},
+            {"sdf", t.sdf},
+            {"setup", t.setup},
+            {"relaxation", t.relaxation},
+            {"projection", t.projection},
+            {"certificate", t.certificate},
+            {"injection", t.injection},
+            {"probes", t.probes},
+            {"thin_features", t.thin_features},
+            {"body", t.body},
+            {"write", c.write},
+            {"total", c.total}}}};
+}
+
+// The stages of one mesh's run in the order they run, with their share of the command's time.
+void print_stage_table(const sampler::SampleResult& result, const CommandSeconds& c) {
+  const sampler::StageSeconds& t = result.stages;
+  const std::vector<std::pair<std::string, double>> rows{
+      {"GPU context creation", c.context},
+      {"mesh load and checks", c.load},
+      {"plan: exact-distance tree, sizing, mass", t.plan},
+      {result.sdf_on_cpu ? "SDF: exact distance (CPU), NanoVDB, upload"
+                         : "SDF: scan conversion, NanoVDB, upload",
+       t.sdf},
+      {"seeds, programs and buffers", t.setup},
+      {"relaxation (all rounds)", t.relaxation},
+      {"projection and thinning", t.projection},
+      {fmt::format("certificate ({} passes)", result.certificate_passes), t.certificate},
+      {"hole injection", t.injection},
+      {fmt::format("probe pass ({} probes)", result.probes), t.probes},
+      {"thin features", t.thin_features},
+      {"quality, holes, mass properties", t.body},
+      {"writing the body", c.write}};
+  fmt::print("{:<46} {:>9} {:>7}\n", "stage", "s", "share");
+  for (const auto& [name, seconds] : rows) {
+    fmt::print("{:<46} {:>9.3f} {:>6.1f}%\n", name, seconds, c.total > 0.0 ? 100.0 * seconds / c.total : 0.0);
+  }
+  fmt::print("{:<46} {:>9.3f}\n", "total (the command, this mesh)", c.total);
+}
+
 void print_json(const std::filesystem::path& json, const sampler::BodyVerdict& verdict,
-                const sampler::ThinFeatures& thin, bool one_line) {
+                const sampler::ThinFeatures& thin, const nlohmann::json& run, bool one_line) {
   std::ifstream in(json);
   nlohmann::json out = nlohmann::json::parse(in);
   out["verdict"] = sampler::verdict_name(verdict.verdict);
   out["verdict_reasons"] = verdict.reasons;
   out["thin_features"] = thin_features_json(thin);
+  out["run"] = run;
   fmt::print("{}\n", out.dump(one_line ? -1 : 2));  // a batch prints JSON Lines
 }
 
@@ -367,11 +438,15 @@ void print_body_report(const Options& o, const sampler::SampleResult& result, co
   fmt::print(
       "  probes           covering radius {:.6g} m = {:.3f} r over {} random surface points (a lower "
       "figure){}\n",
-      q.covering_radius, q.covering_over_r, o.sampling.probes,
+      q.covering_radius, q.covering_over_r, result.probes,
       q.covering_over_r_plus_grain ? fmt::format(" = {:.3f} (r + r_grain)", *q.covering_over_r_plus_grain)
                                    : "");
   fmt::print("  on the surface   largest |phi| = {:.2e} r\n", q.max_abs_phi_over_r);
   print_thin_features(result.thin, body.particle_radius);
+  const sampler::StageSeconds& t = result.stages;
+  fmt::print("  device           {}: SDF {} {:.2f} s, relaxation {:.2f} s, certificate {:.2f} s\n",
+             context.summary(), result.sdf_on_cpu ? "by exact distance on the CPU" : "by GPU scan conversion",
+             t.sdf, t.relaxation, t.certificate);
   fmt::print(
       "  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {} (certificate {:.2f} s "
       "in {} passes, probes {:.2f} s)\n",
@@ -387,22 +462,35 @@ void print_body_report(const Options& o, const sampler::SampleResult& result, co
 // One mesh: sample, write the body (and its preview), report and judge it; `row` gets the batch
 // summary's figures. Returns the mesh's exit code: 1 under --strict when the verdict is short of OK.
 int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
+  CommandSeconds seconds;
+  seconds.context = o.context_seconds;
   sampler::SampleSettings settings = o.sampling;
   settings.max_sdf_bytes = o.sdf_budget_mib << 20;
+  settings.sdf_backend = o.sdf_backend == "cpu"   ? sampler::SdfBackend::Cpu
+                         : o.sdf_backend == "gpu" ? sampler::SdfBackend::Gpu
+                                                  : sampler::SdfBackend::Auto;
   const TriangleMesh mesh = load_sample_mesh(o, settings);
+  seconds.load = since(start);
   sampler::SampleResult result =
       naming_file(o.mesh, [&] { return sample_with_progress(context, mesh, settings); });
+  const auto write_start = std::chrono::steady_clock::now();
   body::ParticleBody& body = result.body;
   body.source_path = o.mesh;
   body.source_sha256 = sha256_file(o.mesh);
   const std::string name = std::filesystem::path(o.mesh).stem().string();
   const std::filesystem::path json = body::write_body(o.output, name, body);
+  seconds.write = since(write_start);
+  seconds.total = since(start) + seconds.context;
   row.status = "ok", row.body_json = json.string(), row.particles = body.positions.size();
   row.quality = body.quality, row.radius = body.particle_radius;
   const sampler::BodyVerdict verdict = sampler::judge_body(body, result.thin);
   row.verdict = sampler::verdict_name(verdict.verdict), row.verdict_reasons = verdict.reasons;
   if (o.json) {
-    print_json(json, verdict, result.thin, o.batch);
+    print_json(json, verdict, result.thin, run_json(result, seconds, context), o.batch);
   } else {
     print_body_report(o, result, json, context);
   }
@@ -415,6 +503,7 @@ int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
                f.host_bytes / 1048576.0, static_cast<double>(f.host_bytes) * per_voxel,
                f.scan_peak_gpu_bytes / 1048576.0, f.readback_bytes / 1048576.0);
     fmt::print("{}", result.timing_report);
+    print_stage_table(result, seconds);
   }
   if (o.preview) {
     const std::filesystem::path png = std::filesystem::path(o.output) / (name + ".preview.png");
@@ -435,6 +524,7 @@ int run_batch(const Options& o, const std::vector<std::string>& meshes, gpu::Con
   for (const std::string& path : meshes) {
     Options one = o;
     one.mesh = path;
+    if (!rows.empty()) one.context_seconds = 0.0;  // the batch's one context counts with its first mesh
     BatchRow r;
     r.mesh = path;
     try {
@@ -471,7 +561,9 @@ int run_sample(Options& o, const GlobalOptions& global) {
   const std::vector<std::string> meshes = expand_inputs(o);
   o.batch = meshes.size() > 1 || !o.list.empty() || !o.shard.empty() || !o.summary.empty() ||
             (!o.inputs.empty() && o.inputs[0].rfind('@', 0) == 0);
+  const auto start = std::chrono::steady_clock::now();
   gpu::Context context(context_options(global));  // one context for the whole batch
+  o.context_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (o.batch) return run_batch(o, meshes, context);
   o.mesh = meshes.front();
   BatchRow row;

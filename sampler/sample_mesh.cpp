@@ -243,24 +243,54 @@ SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& e
                                spec.voxel_size, band_voxels, bytes / 1048576.0, settings.max_sdf_bytes >> 20, remedy));
 }
 
-// The SDF on the GPU for the relaxation: scan conversion straight into the band, an index-space level
-// set (any voxel size), a sparse NanoVDB field. The field's size is checked against the budget before
-// it is uploaded; it grows as the particle count (band voxels ~ area / voxel^2 ~ count).
-sdf::SparseField scan_field(gpu::Context& context, const TriangleMesh& mesh, const sdf::GridSpec& spec,
-                            const SamplingPlan& plan, const SampleSettings& settings, SampleResult& result) {
+bool sdf_on_cpu(const gpu::Context& context, const sdf::GridSpec& spec, const SampleSettings& settings) {
+  switch (settings.sdf_backend) {
+    case SdfBackend::Cpu:
+      return true;
+    case SdfBackend::Gpu:
+      return false;
+    case SdfBackend::Auto:
+      break;
+  }
+  return context.software() && spec.voxel_count() <= kCpuSdfMaxVoxels;
+}
+
+// The level set of the band in index space: by GPU scan conversion, or by exact distance on the CPU
+// (both signed by pseudonormals, as the relaxation expects).
+openvdb::FloatGrid::Ptr band_level_set(gpu::Context& context, const TriangleMesh& mesh,
+                                       const sdf::ExactDistance& exact, const sdf::GridSpec& spec,
+                                       const SampleSettings& settings, SampleResult& result) {
+  FieldStats& f = result.field;
+  if (result.sdf_on_cpu) {
+    openvdb::FloatGrid::Ptr grid =
+        sdf::exact_sdf_grid(exact, mesh, spec, kBandVoxels, sdf::SignMethod::Pseudonormal, true);
+    f.band_voxels = grid->activeVoxelCount();
+    return grid;
+  }
   const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
   sdf::ScanConvertOptions scan;
   scan.band = kBandVoxels;
   scan.index_space_grid = true;
   scan.timings = settings.timings;
   const sdf::ScanConvertResult converted = sdf::scan_convert(context, mesh, normals, spec, scan);
-  sdf::NanoGrid nano = sdf::to_nanovdb(*converted.grid);
-  FieldStats& f = result.field;
   f.band_voxels = converted.stats.band_voxels;
-  f.host_bytes = converted.grid->memUsage() + nano.size();
   f.readback_bytes = converted.stats.readback_bytes;
   f.scan_peak_gpu_bytes = converted.stats.peak_gpu_bytes;
   result.timing_report = converted.stats.timing_report;
+  return converted.grid;
+}
+
+// The SDF on the GPU for the relaxation: the band as an index-space level set (any voxel size), a
+// sparse NanoVDB field. The field's size is checked against the budget before it is uploaded; it
+// grows as the particle count (band voxels ~ area / voxel^2 ~ count).
+sdf::SparseField scan_field(gpu::Context& context, const TriangleMesh& mesh, const sdf::ExactDistance& exact,
+                            const sdf::GridSpec& spec, const SamplingPlan& plan,
+                            const SampleSettings& settings, SampleResult& result) {
+  result.sdf_on_cpu = sdf_on_cpu(context, spec, settings);
+  const openvdb::FloatGrid::Ptr grid = band_level_set(context, mesh, exact, spec, settings, result);
+  sdf::NanoGrid nano = sdf::to_nanovdb(*grid);
+  FieldStats& f = result.field;
+  f.host_bytes = grid->memUsage() + nano.size();
   if (nano.size() > settings.max_sdf_bytes) throw_over_budget(spec, nano.size(), f.band_voxels, plan, settings);
   sdf::SparseField field(std::move(nano), spec, kBandVoxels);
   f.gpu_bytes = field.gpu_bytes();
@@ -269,6 +299,14 @@ sdf::SparseField scan_field(gpu::Context& context, const TriangleMesh& mesh, con
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Runs `work` and adds its wall time to `total` [s].
+template <class Work>
+void timed(double& total, Work&& work) {
+  const auto start = std::chrono::steady_clock::now();
+  work();
+  total += seconds_since(start);
 }
 
 // The particles as a body stores them (float, mesh coordinates): what the certificate and the probes judge.
@@ -286,6 +324,7 @@ struct Arrangement {
   CoverageCertificate certificate;         // of the last round, at the target covering radius
   int certificates = 0;                    // computed, all rounds
   double certificate_seconds = 0.0;        // s, their wall time
+  double relax_seconds = 0.0, projection_seconds = 0.0, injection_seconds = 0.0;  // s, all rounds
   int iterations = 0, rounds = 0;
   bool converged = true;                   // the global (first) relaxation's verdict
 };
@@ -315,15 +354,17 @@ class HoleClosing {
     mobile_.assign(out_.particles.size(), 1);
     bool relax_round = true;
     for (;;) {
-      if (relax_round) relax();
-      project_and_thin();
+      if (relax_round) timed(out_.relax_seconds, [&] { relax(); });
+      timed(out_.projection_seconds, [&] { project_and_thin(); });
       certify();
       if (out_.certificate.covered || out_.rounds >= settings_.max_rounds) break;
       // The first rounds relax the new particles with their neighbours (better spacing). Later ones
       // only place them: a particle at an uncovered point, on the surface and about r or more from
       // every other one, can only shrink holes, never open one elsewhere, so the rounds converge.
       relax_round = out_.rounds < kNeighbourRounds;
-      if (!inject()) break;
+      bool injected = false;
+      timed(out_.injection_seconds, [&] { injected = inject(); });
+      if (!injected) break;
     }
     return std::move(out_);
   }
@@ -417,7 +458,7 @@ CoverageFigures measure_coverage_figures(CoverageCertifier& certifier, const Tri
   f.certificate_seconds = a.certificate_seconds + seconds_since(start);
   start = std::chrono::steady_clock::now();
   CoverageSettings probe;
-  probe.probes = std::max<std::size_t>(settings.probes, 1);
+  probe.probes = probe_count(a.particles.size(), settings);
   probe.seed = settings.seed + 1000u * static_cast<unsigned>(a.rounds + 1) + 500u;
   f.probes = measure_coverage(mesh, std::span<const Eigen::Vector3f>(stored), probe);
   f.probe_seconds = seconds_since(start);
@@ -527,31 +568,56 @@ std::string round_trip_report(const gpu::HostSyncCounts& scan, const GpuRelaxer&
 
 }  // namespace
 
+std::size_t probe_count(std::size_t particles, const SampleSettings& settings) {
+  const std::size_t cap = std::max<std::size_t>(settings.probes, 1);
+  if (settings.probes_per_particle == 0) return cap;
+  const std::size_t wanted = particles > cap / settings.probes_per_particle
+                                 ? cap
+                                 : std::max(kMinProbes, settings.probes_per_particle * particles);
+  return std::min(cap, wanted);
+}
+
 SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const SampleSettings& settings,
                          const std::function<void(const SampleProgress&)>& progress) {
   const auto start = std::chrono::steady_clock::now();
   const gpu::HostSyncCounts syncs_at_start = gpu::host_sync_counts();
   SampleResult result;
+  StageSeconds& t = result.stages;
+  auto lap = std::chrono::steady_clock::now();
+  const auto stage = [&lap](double& total) {
+    total += seconds_since(lap);
+    lap = std::chrono::steady_clock::now();
+  };
   // Validate and size (every check before the GPU work).
   if (!(surface_area(mesh) > 0.0)) throw InputError("the mesh has no surface area");
   const sdf::ExactDistance exact(mesh);
   const SamplingPlan plan = plan_sampling(mesh, exact, settings, result);
+  stage(t.plan);
   // The field, and seeds spread over the surface.
   const sdf::GridSpec spec = choose_grid(mesh, plan.z.radius, settings);
-  sdf::SparseField field = scan_field(context, mesh, spec, plan, settings, result);
+  sdf::SparseField field = scan_field(context, mesh, exact, spec, plan, settings, result);
   const gpu::HostSyncCounts scan_syncs = gpu::host_sync_counts() - syncs_at_start;
+  stage(t.sdf);
   std::mt19937_64 rng(settings.seed);
   std::vector<Eigen::Vector3d> seeds = sample_surface_points(mesh, plan.z.count, rng).positions;
   // Relax and close holes.
   GpuRelaxer relaxer(context, std::move(field), settings.timings);
   CoverageCertifier certifier(context, mesh, settings.timings);
+  stage(t.setup);
   Arrangement a =
       HoleClosing(relaxer, certifier, exact, spec, plan, settings, progress).run(std::move(seeds));
+  t.relaxation = a.relax_seconds, t.projection = a.projection_seconds, t.injection = a.injection_seconds;
+  lap = std::chrono::steady_clock::now();
   // Measure and make the body.
   CoverageFigures coverage = measure_coverage_figures(certifier, mesh, a, plan, settings);
+  t.certificate = coverage.certificate_seconds, t.probes = coverage.probe_seconds;
+  result.probes = coverage.probes.probes;
+  lap = std::chrono::steady_clock::now();
   body::ParticleBody& body = result.body;
   body.quality = measure_quality(a, coverage, mesh, plan, settings);
+  const auto thin_start = std::chrono::steady_clock::now();
   result.thin = find_thin_features(mesh, exact, plan.z.spacing, plan.z.radius);
+  t.thin_features = seconds_since(thin_start);
   result.holes = deepest_holes(coverage.certificate, as_stored(a.particles), kReportedHoles);
   warn_about_quality(coverage, a.rounds, plan, settings, result);
   result.certificate = std::move(coverage.certificate);
@@ -561,6 +627,8 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   if (settings.sign == sdf::SignMethod::Winding) orient_normals_by_winding(exact, a.particles, a.normals, plan.z.radius);
   fill_body(a, exact, mesh, plan, settings, body);
   body.sdf_voxel_size = spec.voxel_size;
+  stage(t.body);
+  t.body -= t.thin_features;
   body.quality.seconds = seconds_since(start);
   if (settings.timings) {
     result.timing_report += relaxer.timing_report() + certifier.timing_report();

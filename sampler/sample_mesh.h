@@ -1,6 +1,7 @@
 #pragma once
 // The main job: a closed mesh becomes a particle rigid body (thesis 6.3; Bell, Yu & Mucha 2005).
-//   1. SDF by GPU scan conversion, voxel = r / 2 unless set (see SampleSettings::voxel_size);
+//   1. SDF by GPU scan conversion (or exact CPU distance: SdfBackend), voxel = r / 2 unless set
+//      (see SampleSettings::voxel_size);
 //   2. seeds spread area-uniformly with the injected seed, as many as the coverage target needs;
 //   3. GPU relaxation (attraction to the zero level set + Gaussian repulsion);
 //   4. exact projection onto the mesh, crowded pairs (closer than 0.6 spacing) thinned, coverage
@@ -25,6 +26,13 @@
 
 namespace ts::sampler {
 
+// Where the SDF is built: by GPU scan conversion (sdf/scan_convert.h) or on the CPU by exact distance
+// (sdf::exact_sdf_grid: CGAL AABB tree, TBB). Auto: the CPU on a software renderer (llvmpipe runs
+// the scan conversion's geometry and fragment work on the same cores, slower than the exact path up
+// to grids of kCpuSdfMaxVoxels; docs/benchmarks.md, "sample fixed costs"), the GPU otherwise.
+enum class SdfBackend { Auto, Gpu, Cpu };
+inline constexpr std::size_t kCpuSdfMaxVoxels = std::size_t{1} << 23;
+
 struct SampleSettings {
   double radius = 0.0;         // particle radius r [m]; 0: from `count`, else about 4000 particles
   std::size_t count = 0;       // particle count instead of a radius
@@ -34,7 +42,12 @@ struct SampleSettings {
   double density = 1000.0;     // kg/m^3
   std::uint64_t seed = 1;
   int max_rounds = 12;                 // coverage repair rounds
-  std::size_t probes = 1'000'000;      // random surface points of the statistical covering radius
+  // Random surface points of the statistical covering radius: probes_per_particle per particle, at
+  // least kMinProbes, at most `probes` (sampler::probe_count; the miss bound is in
+  // docs/coverage-certificate.md, "The probe pass"). probes_per_particle 0: always `probes`.
+  std::size_t probes = 1'000'000;
+  std::size_t probes_per_particle = 256;
+  SdfBackend sdf_backend = SdfBackend::Auto;
   // The coverage certificate that steers the rounds and is reported (floor: r / floor_divisor).
   CertificateSettings certificate;
   std::size_t max_particles = 20'000'000;
@@ -61,6 +74,25 @@ struct SampleProgress {
   double residual = 0.0;       // mean displacement per step / spacing
 };
 
+// The probe pass's size for `particles` surface particles: min(probes, max(kMinProbes,
+// probes_per_particle * particles)), or `probes` when probes_per_particle is 0.
+inline constexpr std::size_t kMinProbes = std::size_t{1} << 16;
+std::size_t probe_count(std::size_t particles, const SampleSettings& settings);
+
+// Wall time of each stage of sample_mesh [s] (the --timings table and --json's "stages").
+struct StageSeconds {
+  double plan = 0.0;           // validation, the exact-distance tree, sizing, mass properties
+  double sdf = 0.0;            // the field: scan conversion (or exact CPU distance), NanoVDB, upload
+  double setup = 0.0;          // seeds, the relaxer's and the certifier's programs and buffers
+  double relaxation = 0.0;     // every relax() call, all rounds
+  double projection = 0.0;     // exact projection and thinning, all rounds
+  double certificate = 0.0;    // every certificate pass
+  double injection = 0.0;      // choosing the holes' new particles, all rounds
+  double probes = 0.0;         // the statistical probe pass
+  double thin_features = 0.0;  // find_thin_features
+  double body = 0.0;           // quality figures, holes, normals, interior fill, mass properties
+};
+
 // Most holes a SampleResult lists (the deepest; a certificate may prove more).
 inline constexpr std::size_t kReportedHoles = 20;
 
@@ -83,6 +115,9 @@ struct SampleResult {
   int certificate_passes = 0;         // certificates computed, all rounds
   double certificate_seconds = 0.0;   // s, wall time of those
   double probe_seconds = 0.0;         // s, wall time of the statistical probe pass
+  std::size_t probes = 0;             // surface points of that pass (probe_count)
+  bool sdf_on_cpu = false;            // the field came from the exact CPU path (SdfBackend)
+  StageSeconds stages;
   std::vector<std::string> warnings;
   FieldStats field;
   std::string timing_report;

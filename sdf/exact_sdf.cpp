@@ -167,17 +167,29 @@ std::vector<BandVoxel> slice_band(const ExactDistance& exact, const TriangleMesh
   return out;
 }
 
+openvdb::FloatGrid::Ptr empty_level_set(const GridSpec& spec, double band, bool index_space) {
+  auto grid = openvdb::FloatGrid::create(static_cast<float>(band));
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(index_space ? 1.0 : spec.voxel_size));
+  grid->setGridClass(openvdb::GRID_LEVEL_SET);
+  grid->setName("surface");
+  return grid;
+}
+
 }  // namespace
 
 openvdb::FloatGrid::Ptr exact_sdf_grid(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels,
                                        SignMethod sign) {
-  const double band = band_voxels * spec.voxel_size;
-  auto grid = openvdb::FloatGrid::create(static_cast<float>(band));
-  grid->setTransform(openvdb::math::Transform::createLinearTransform(spec.voxel_size));
-  grid->setGridClass(openvdb::GRID_LEVEL_SET);
-  grid->setName("surface");
-  if (mesh.empty()) return grid;
+  if (mesh.empty()) return empty_level_set(spec, band_voxels * spec.voxel_size, false);
   const ExactDistance exact(mesh);
+  return exact_sdf_grid(exact, mesh, spec, band_voxels, sign);
+}
+
+openvdb::FloatGrid::Ptr exact_sdf_grid(const ExactDistance& exact, const TriangleMesh& mesh,
+                                       const GridSpec& spec, double band_voxels, SignMethod sign,
+                                       bool index_space) {
+  const double band = band_voxels * spec.voxel_size;
+  auto grid = empty_level_set(spec, band, index_space);
+  if (mesh.empty()) return grid;
   const auto slices = triangles_per_slice(mesh, spec, band);
   std::vector<std::vector<BandVoxel>> voxels(slices.size());
   tbb::parallel_for(0, spec.dims.z(), [&](int k) {

@@ -57,6 +57,12 @@ class ExactDistance {
 // outside the band get +-band by a signed flood fill. TBB-parallel over z slices.
 openvdb::FloatGrid::Ptr exact_sdf_grid(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels,
                                        SignMethod sign);
+// The same from a tree already built over `mesh` (`exact`'s own mesh). index_space: transform of voxel
+// size 1, values still in world units (any voxel size; what sdf::SparseField reads, as
+// ScanConvertOptions::index_space_grid).
+openvdb::FloatGrid::Ptr exact_sdf_grid(const ExactDistance& exact, const TriangleMesh& mesh,
+                                       const GridSpec& spec, double band_voxels, SignMethod sign,
+                                       bool index_space = false);
 
 // Re-signs every active voxel of a level set (world units) by the generalised winding number of
 // `exact`'s mesh, |w| >= 1/2 inside, and floods the signs outward again (OpenVDB signedFloodFill):

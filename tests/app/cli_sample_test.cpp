@@ -339,6 +339,50 @@ TEST(CliSample, ReportPrintsTheCertificateAndTheHolesItLeaves) {
   }
 }
 
+// The report names the device and the SDF path, with the scan conversion's, the relaxation's and the
+// certificate's seconds; --json carries the same figures under "run", and --timings a stage table.
+TEST(CliSample, ReportNamesTheDeviceAndTheStageTimes) {
+  const std::string sphere = quoted(test::asset("sphere.obj"));
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sample " + sphere + " -o " + quoted(test::temp_dir()) + kFast +
+                                    "--sdf-backend gpu --timings",
+                                &out),
+            0)
+      << out;
+  EXPECT_TRUE(std::regex_search(
+      out,
+      std::regex(
+          R"(  device           .*\(device \d+, (software|hardware)\): SDF by GPU scan conversion [0-9.]+ s, )"
+          R"(relaxation [0-9.]+ s, certificate [0-9.]+ s)")))
+      << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(relaxation \(all rounds\) +[0-9.]+ +[0-9.]+%)"))) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(probe pass \(20000 probes\))"))) << out;
+  ASSERT_EQ(test::run_tetrasand("-q sample " + sphere + " -o " + quoted(test::temp_dir()) + kFast +
+                                    "--sdf-backend cpu --json",
+                                &out),
+            0)
+      << out;
+  const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
+  const auto& run = json.at("run");
+  EXPECT_EQ(run.at("sdf_backend"), "cpu");
+  EXPECT_EQ(run.at("probes"), 20000);
+  EXPECT_FALSE(run.at("device").get<std::string>().empty());
+  const auto& t = run.at("seconds");
+  double stages = 0.0;
+  for (const char* key : {"context", "load", "plan", "sdf", "setup", "relaxation", "projection",
+                          "certificate", "injection", "probes", "thin_features", "body", "write"}) {
+    EXPECT_GE(t.at(key).get<double>(), 0.0) << key;
+    stages += t.at(key).get<double>();
+  }
+  EXPECT_GT(t.at("sdf").get<double>(), 0.0);
+  EXPECT_GT(t.at("relaxation").get<double>(), 0.0);
+  EXPECT_LE(stages, t.at("total").get<double>() * 1.001 + 1e-3);  // the stages do not overlap
+  EXPECT_GE(stages, 0.5 * t.at("total").get<double>());           // and are most of the run
+  EXPECT_NE(test::run_tetrasand(
+                "sample " + sphere + " -o " + quoted(test::temp_dir()) + kFast + "--sdf-backend cuda", &out),
+            0);
+}
+
 TEST(CliSample, FillCountsTheInteriorParticlesInTheJsonAndThePly) {
   const auto dir = test::temp_dir();
   std::string out;

@@ -7,9 +7,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "core/mass_properties.h"
@@ -202,8 +205,9 @@ TEST(SampleMesh, FillPutsInteriorParticlesOnALatticeInsideTheSphere) {
   expect_a_valid_fill(mesh, result);
   // Lattice estimate of the inner ball of radius R - r (R from the mesh's volume).
   const double r = result.body.particle_radius;
-  const double big = std::cbrt(3.0 * compute_mass_properties(mesh, 1.0).volume / (4.0 * M_PI));
-  const double estimate = 4.0 / 3.0 * M_PI * std::pow(big - r, 3) / (4.0 * std::sqrt(2.0) * r * r * r);
+  const double big = std::cbrt(3.0 * compute_mass_properties(mesh, 1.0).volume / (4.0 * std::numbers::pi));
+  const double estimate =
+      4.0 / 3.0 * std::numbers::pi * std::pow(big - r, 3) / (4.0 * std::sqrt(2.0) * r * r * r);
   std::printf("sphere: %zu interior particles, ball estimate %.1f, V - A r estimate %.1f\n", result.body.interior_count,
               estimate, result.estimated_interior);
   EXPECT_NEAR(static_cast<double>(result.body.interior_count), estimate, 0.05 * estimate);
@@ -305,6 +309,78 @@ TEST(SampleMesh, FillOverTheMemoryCapNamesTheSmallestRadiusThatFits) {
     const std::string what = e.what();
     EXPECT_NE(what.find("cap of 400"), std::string::npos) << what;
     EXPECT_NE(what.find("smallest radius whose filled body fits"), std::string::npos) << what;
+  }
+}
+
+// The probe pass's size: probes_per_particle per surface particle, at least kMinProbes, at most
+// `probes` (docs/coverage-certificate.md, "The probe pass").
+TEST(SampleMesh, ProbeCountFollowsTheStatedFormula) {
+  SampleSettings s;  // 256 per particle, at least 65536, at most 1M
+  EXPECT_EQ(probe_count(10, s), kMinProbes);
+  EXPECT_EQ(probe_count(256, s), kMinProbes);
+  EXPECT_EQ(probe_count(1002, s), 256u * 1002u);
+  EXPECT_EQ(probe_count(3906, s), 256u * 3906u);
+  EXPECT_EQ(probe_count(3907, s), 1'000'000u);
+  EXPECT_EQ(probe_count(10'000'000'000'000'000ull, s), 1'000'000u);  // no overflow
+  s.probes = 20'000;                                                 // the cap wins over the floor
+  EXPECT_EQ(probe_count(1000, s), 20'000u);
+  s.probes = 5'000'000, s.probes_per_particle = 0;  // 0: always the cap
+  EXPECT_EQ(probe_count(10, s), 5'000'000u);
+}
+
+// The miss bound of the probe pass, on a case whose covering radius is known: a hexagonal lattice of
+// spacing h over a square with one centre removed has c = h (the removed centre's six neighbours).
+// Every surface point within delta of the hole's centre lies deeper than c - delta, and that disc
+// has area pi delta^2, so probe_count(N) area-uniform probes miss it with probability at most
+// exp(-P pi delta^2 / A): delta is chosen so that this bound is 1e-6, and the pass must find the hole
+// to within it.
+TEST(SampleMesh, ProportionalProbesFindAKnownHoleWithinTheStatedBound) {
+  const double side = 1.0, h = 0.05;
+  TriangleMesh square;
+  square.vertices = {{0, 0, 0}, {side, 0, 0}, {side, side, 0}, {0, side, 0}};
+  square.triangles = {{0, 1, 2}, {0, 2, 3}};
+  std::vector<Eigen::Vector3d> centres;  // beyond the square too, so its rim has no deeper holes
+  const double row = h * std::sqrt(3.0) / 2.0;
+  for (int j = -2; j * row <= side + 2 * h; ++j)
+    for (int i = -2; i * h <= side + 2 * h; ++i) {
+      const Eigen::Vector3d p((i + 0.5 * (j & 1)) * h, j * row, 0.0);
+      if ((p - Eigen::Vector3d(0.5 * side, 0.5 * side, 0.0)).norm() < 0.7 * row) continue;  // the hole
+      centres.push_back(p);
+    }
+  const std::size_t n = centres.size();
+  const std::size_t probes = probe_count(n, SampleSettings{});
+  EXPECT_EQ(probes, std::max(kMinProbes, 256 * n));
+  const double delta =
+      std::sqrt(std::log(1e6) * side * side / (std::numbers::pi * static_cast<double>(probes)));
+  // The removed centre sat at a lattice point near the middle: c = h there.
+  for (const std::uint64_t seed : {1ull, 2ull, 3ull}) {
+    CoverageSettings c;
+    c.probes = probes;
+    c.seed = seed;
+    const CoverageResult result = measure_coverage(square, centres, c);
+    EXPECT_LE(result.covering_radius, h * (1.0 + 1e-9));
+    EXPECT_GE(result.covering_radius, h - delta) << "seed " << seed << ", delta " << delta / h << " h";
+  }
+  EXPECT_LT(delta, 0.15 * h);  // the bound is worth having at this count: 0.1 h
+}
+
+// Both SDF paths give a body that meets the targets: the exact CPU field (the default on a software
+// renderer, SdfBackend::Auto) and the GPU scan conversion; the result says which one ran.
+TEST(SampleMesh, CpuAndGpuSdfBothMeetTheTargets) {
+  const TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));
+  for (const SdfBackend backend : {SdfBackend::Cpu, SdfBackend::Gpu, SdfBackend::Auto}) {
+    SampleSettings settings;
+    settings.count = 300;
+    settings.sdf_backend = backend;
+    const SampleResult result = sample_mesh(shared_context(), mesh, settings);
+    const bool cpu =
+        backend == SdfBackend::Cpu || (backend == SdfBackend::Auto && shared_context().software());
+    EXPECT_EQ(result.sdf_on_cpu, cpu);
+    EXPECT_GT(result.field.band_voxels, 0u);
+    EXPECT_GT(result.stages.sdf, 0.0);
+    EXPECT_GT(result.stages.relaxation, 0.0);
+    EXPECT_EQ(result.probes, probe_count(result.body.positions.size(), settings));
+    expect_meets_quality_targets(mesh, result, settings.density);
   }
 }
 
