@@ -10,7 +10,7 @@ two measures of the criteria.
 Usage: bench/validation/spring_heap.py BUILD_BIN_DIR WORK_DIR [RUN ...] [--set KEY=VALUE ...]
   RUN: tetrasand_viscous tetrasand_spring lammps_viscous lammps_mindlin lammps_linear_history (default: all)
   --set KEY=VALUE adds KEY = VALUE to the scene's [simulation] table for every run (a controlled run);
-  --material KEY=VALUE sets a key of the material (e.g. gamma_s=8.0).
+  --scene KEY=VALUE replaces the scene file's first line `KEY = ...` (e.g. gamma_s=8.0, seed=12).
 Prints one line per run and a markdown table at the end; writes WORK_DIR/spring_heap.json.
 """
 import json
@@ -36,10 +36,11 @@ def scene_text(tangential, sim_sets, material_sets):
     text = open(SCENE).read()
     extra = "".join(f"{k} = {v}\n" for k, v in sim_sets) + f'tangential = "{tangential}"\n'
     text = text.replace("[simulation]\n", "[simulation]\n" + extra, 1)
+    text = text.replace("[output]\nevery = 500\n", "[output]\nevery = 500\nply = true\n", 1)  # the final state
     for k, v in material_sets:
         text, n = re.subn(rf"^{k} = .*$", f"{k} = {v}", text, count=1, flags=re.M)
         if n != 1:
-            sys.exit(f"spring_heap: material key {k} not in {SCENE}")
+            sys.exit(f"spring_heap: key {k} not in {SCENE}")
     return text
 
 
@@ -113,7 +114,7 @@ def main():
     sim_sets, material_sets, runs = [], [], []
     i = 0
     while i < len(rest):
-        if rest[i] in ("--set", "--material"):
+        if rest[i] in ("--set", "--scene"):
             k, v = rest[i + 1].split("=", 1)
             (sim_sets if rest[i] == "--set" else material_sets).append((k, v))
             i += 2
