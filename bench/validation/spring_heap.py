@@ -8,7 +8,8 @@ mindlin, and mindlin's deck with linear_history at the reference contact's k_t);
 two measures of the criteria.
 
 Usage: bench/validation/spring_heap.py BUILD_BIN_DIR WORK_DIR [RUN ...] [--set KEY=VALUE ...]
-  RUN: tetrasand_viscous tetrasand_spring lammps_viscous lammps_mindlin lammps_linear_history (default: all)
+  RUN: tetrasand_viscous tetrasand_spring lammps_viscous lammps_mindlin lammps_linear_history (default: these),
+       lammps_mindlin_rescale lammps_mindlin_force
   --set KEY=VALUE adds KEY = VALUE to the scene's [simulation] table for every run (a controlled run);
   --scene KEY=VALUE replaces the scene file's first line `KEY = ...` (e.g. gamma_s=8.0, seed=12).
 Prints one line per run and a markdown table at the end; writes WORK_DIR/spring_heap.json.
@@ -30,6 +31,8 @@ SCENE = os.path.join(ROOT, "assets", "scenes", "reference", "coarse_pile.toml")
 RADIUS = 5.0e-3  # m, the pile's sphere radius
 BOUND = RADIUS * (1 + math.sqrt(6) / 2)  # bounding radius of a tetrahedron of touching spheres
 RUNS = ["tetrasand_viscous", "tetrasand_spring", "lammps_viscous", "lammps_mindlin", "lammps_linear_history"]
+# Further LAMMPS variants of the mindlin deck (criteria, addendum 2): run name -> tangential model.
+VARIANTS = {"lammps_mindlin_rescale": "mindlin/rescale", "lammps_mindlin_force": "mindlin/force"}
 
 
 def scene_text(tangential, sim_sets, material_sets):
@@ -90,8 +93,14 @@ def tetrasand_run(bin_dir, scene_file, out):
     return xyz[-300:], wall, dict(steps=int(m.group(1)), dt=float(m.group(2))) if m else {}, text
 
 
-def lammps_run(bin_dir, scene_file, deck, linear_history=None):
+def lammps_run(bin_dir, scene_file, deck, linear_history=None, variant=None):
     run([os.path.join(bin_dir, "tetrasand"), "export", "lammps", scene_file, "-o", deck])
+    if variant is not None:
+        path = os.path.join(deck, "in.tetrasand")
+        text, n = re.subn(r"tangential mindlin ", f"tangential {variant} ", open(path).read())
+        if n == 0:
+            sys.exit("spring_heap: no mindlin in the exported deck")
+        open(path, "w").write(text)
     if linear_history is not None:
         path = os.path.join(deck, "in.tetrasand")
         text = open(path).read()
@@ -137,7 +146,8 @@ def main():
         if code == "tetrasand":
             xyz, wall, info, _ = tetrasand_run(bin_dir, scene_file, out)
         else:
-            xyz, wall, info, _ = lammps_run(bin_dir, scene_file, out, kt if model == "linear_history" else None)
+            xyz, wall, info, _ = lammps_run(bin_dir, scene_file, out, kt if model == "linear_history" else None,
+                                            VARIANTS.get(name))
         if len(xyz) != 300:
             sys.exit(f"spring_heap: {name}: {len(xyz)} grains in the final state, 300 expected")
         a = repose_angle(xyz, ring_width=RADIUS)
