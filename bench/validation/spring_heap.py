@@ -32,7 +32,7 @@ RADIUS = 5.0e-3  # m, the pile's sphere radius
 BOUND = RADIUS * (1 + math.sqrt(6) / 2)  # bounding radius of a tetrahedron of touching spheres
 RUNS = ["tetrasand_viscous", "tetrasand_spring", "lammps_viscous", "lammps_mindlin", "lammps_linear_history"]
 # Further LAMMPS variants of the mindlin deck (criteria, addendum 2): run name -> tangential model.
-VARIANTS = {"lammps_mindlin_rescale": "mindlin/rescale", "lammps_mindlin_force": "mindlin/force"}
+VARIANTS = {"lammps_mindlin_rescale": "mindlin_rescale", "lammps_mindlin_force": "mindlin/force"}
 
 
 def scene_text(tangential, sim_sets, material_sets):
