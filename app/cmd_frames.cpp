@@ -45,6 +45,7 @@ void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option("--tile-width", o.sheet.tile_width, "Width of a contact sheet's tiles [pixels]")
       ->check(CLI::Range(16, 4096))
       ->capture_default_str();
+  cmd->add_flag("!--no-labels", o.sheet.labels, "No frame numbers on a contact sheet's tiles");
 }
 
 // Runs ffmpeg on DIR/frame_*.png into `target` (written atomically); ts::Error when it fails.

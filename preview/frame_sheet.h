@@ -36,10 +36,11 @@ struct SheetSettings {
   std::size_t tiles = 12;  // frames on the sheet
   int columns = 4;         // tiles per row
   int tile_width = 320;    // pixels
+  bool labels = true;      // each tile's frame number in its top left corner
 };
 
 // A contact sheet of `frames` chosen evenly, each shrunk to the tile width and labelled with its
-// frame number. ts::InputError when the frames differ in size or one cannot be read.
+// frame number (unless settings.labels is false). ts::InputError when the frames differ in size or one cannot be read.
 Image frame_sheet(const std::vector<FrameFile>& frames, const SheetSettings& settings,
                   std::size_t* shown = nullptr);
 

@@ -74,6 +74,19 @@ TEST(CliFrames, PngOutputIsASheetShrunkToTheTileWidth) {
   EXPECT_EQ(sheet.width, 4 * 20);  // seven tiles, four to a row
   EXPECT_EQ(sheet.height, 2 * 15);
   EXPECT_NE(out.find("contact sheet of 7 of 7 frames"), std::string::npos) << out;
+  // White pixels in the first tile (frame 0, black) are its label's digits.
+  const auto lit = [](const preview::Image& image) {
+    std::size_t n = 0;
+    for (int y = 0; y < 15; ++y)
+      for (int x = 0; x < 20; ++x) n += image.pixel(x, y)[0] == 255 ? 1 : 0;
+    return n;
+  };
+  EXPECT_GT(lit(sheet), 0u);
+  ASSERT_EQ(test::run_tetrasand("frames " + q(dir) + " -o " + q(dir / "plain.png") + " --tile-width 20 --no-labels",
+                                &out),
+            0)
+      << out;
+  EXPECT_EQ(lit(preview::read_png(dir / "plain.png")), 0u) << "no label with --no-labels";
 }
 
 TEST(CliFrames, FfmpegOnThePathMakesTheFilm) {

@@ -188,6 +188,24 @@ TEST(SimFrames, DefaultCameraFramesTheGrainsAgainWhenTheySpread) {
   EXPECT_LT(distance(), 1.1 * close) << "and end framing the gathered grains";
 }
 
+// follow = "prop cube": the camera looks at the prop's centre of mass wherever it goes, from the same
+// distance.
+TEST(SimFrames, FollowedPropStaysAtTheImageCentre) {
+  const auto dir = test::temp_dir();
+  const sim::Scene scene = parse(
+      scene_with_output(test::box_emitter("fill", "[-0.06, -0.06, 0.0]", "[0.06, 0.06, 0.06]", 20, "seed = 3\n") +
+                        "[output]\nframes = true\n[output.camera]\nfollow = \"prop cube\"\nsize = [64, 48]\n"));
+  sim::World world = sim::make_world(scene);
+  preview::SimFrameWriter writer(context(), scene);
+  writer.write(world, 0, dir);
+  EXPECT_TRUE(writer.camera().target.isApprox(world.bodies.position[0]));  // the prop is the first body
+  const double distance = (writer.camera().eye - writer.camera().target).norm();
+  world.bodies.position[0] += Eigen::Vector3d(0.5, -0.2, 0.1);
+  writer.write(world, 1, dir);
+  EXPECT_TRUE(writer.camera().target.isApprox(world.bodies.position[0]));
+  EXPECT_NEAR((writer.camera().eye - writer.camera().target).norm(), distance, 1e-9);
+}
+
 // Every colouring draws the grains; a fixed camera stays where the scene puts it.
 TEST(SimFrames, ColoringsAndAFixedCameraRender) {
   const auto dir = test::temp_dir();
