@@ -148,7 +148,7 @@ Image frame_sheet(const std::vector<FrameFile>& frames, const SheetSettings& set
     }
     Image tile = shrink(frame, settings.tile_width);
     tile.alpha = false;
-    const int scale = std::max(1, tile.height / 80);
+    const int scale = std::max(1, tile.height / 60);
     if (settings.labels) draw_label(tile, std::to_string(frames[i].number), scale, scale, scale);
     tiles.push_back(std::move(tile));
   }

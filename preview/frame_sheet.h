@@ -40,7 +40,8 @@ struct SheetSettings {
 };
 
 // A contact sheet of `frames` chosen evenly, each shrunk to the tile width and labelled with its
-// frame number (unless settings.labels is false). ts::InputError when the frames differ in size or one cannot be read.
+// frame number (unless settings.labels is false). ts::InputError when the frames differ in size or one cannot
+// be read.
 Image frame_sheet(const std::vector<FrameFile>& frames, const SheetSettings& settings,
                   std::size_t* shown = nullptr);
 

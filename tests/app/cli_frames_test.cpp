@@ -82,8 +82,8 @@ TEST(CliFrames, PngOutputIsASheetShrunkToTheTileWidth) {
     return n;
   };
   EXPECT_GT(lit(sheet), 0u);
-  ASSERT_EQ(test::run_tetrasand("frames " + q(dir) + " -o " + q(dir / "plain.png") + " --tile-width 20 --no-labels",
-                                &out),
+  ASSERT_EQ(test::run_tetrasand(
+                "frames " + q(dir) + " -o " + q(dir / "plain.png") + " --tile-width 20 --no-labels", &out),
             0)
       << out;
   EXPECT_EQ(lit(preview::read_png(dir / "plain.png")), 0u) << "no label with --no-labels";

@@ -192,9 +192,9 @@ TEST(SimFrames, DefaultCameraFramesTheGrainsAgainWhenTheySpread) {
 // distance.
 TEST(SimFrames, FollowedPropStaysAtTheImageCentre) {
   const auto dir = test::temp_dir();
-  const sim::Scene scene = parse(
-      scene_with_output(test::box_emitter("fill", "[-0.06, -0.06, 0.0]", "[0.06, 0.06, 0.06]", 20, "seed = 3\n") +
-                        "[output]\nframes = true\n[output.camera]\nfollow = \"prop cube\"\nsize = [64, 48]\n"));
+  const sim::Scene scene = parse(scene_with_output(
+      test::box_emitter("fill", "[-0.06, -0.06, 0.0]", "[0.06, 0.06, 0.06]", 20, "seed = 3\n") +
+      "[output]\nframes = true\n[output.camera]\nfollow = \"prop cube\"\nsize = [64, 48]\n"));
   sim::World world = sim::make_world(scene);
   preview::SimFrameWriter writer(context(), scene);
   writer.write(world, 0, dir);
