@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/error.h"
 #include "preview/colors.h"
 #include "preview/image.h"
 
@@ -64,7 +65,11 @@ SimFrameWriter::SimFrameWriter(gpu::Context& context, const sim::Scene& scene, c
       walls_(scene),
       props_(scene.props.size()),
       gravity_(scene.gravity.norm()) {
-  renderer_.check_image_size(settings_.width, settings_.height);
+  try {
+    renderer_.check_image_size(settings_.width, settings_.height);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", sim::scene_location(scene, "output.camera.size"), e.what()));
+  }
   for (const auto& p : scene.props) dynamic_props_ += p.motion == sim::MotionType::Dynamic ? 1 : 0;
   for (const auto& e : scene.emitters) {
     if (e.type != sim::EmitterType::Pour) continue;  // fill and column grains are there from the start
