@@ -28,6 +28,7 @@ std::unique_ptr<CommandLine> make_command_line() {
   add(add_sample_command(app, global));
   add(add_preview_command(app, global));
   add(add_sim_command(app, global));
+  add(add_frames_command(app, global));
   add(add_export_command(app, global));
   return cli;
 }

@@ -54,6 +54,7 @@ auto naming_file(const std::string& file, Step&& step) -> decltype(step()) {
 
 Runner add_devices_command(CLI::App& app, const GlobalOptions& global);
 Runner add_export_command(CLI::App& app, const GlobalOptions& global);
+Runner add_frames_command(CLI::App& app, const GlobalOptions& global);
 Runner add_info_command(CLI::App& app, const GlobalOptions& global);
 Runner add_preview_command(CLI::App& app, const GlobalOptions& global);
 Runner add_sample_command(CLI::App& app, const GlobalOptions& global);

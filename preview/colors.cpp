@@ -34,6 +34,28 @@ std::uint32_t pack_rgba8(const Eigen::Vector3f& srgb) {
   return out;
 }
 
+Eigen::Vector3f categorical(std::uint32_t key) {
+  const double hue = std::fmod(0.61803398875 * key, 1.0) * 6.0;  // sextants of the colour wheel
+  const float s = key % 2 ? 0.55f : 0.75f, v = key % 3 == 1 ? 0.78f : 0.92f;
+  const int sextant = static_cast<int>(hue) % 6;
+  const float f = static_cast<float>(hue - std::floor(hue));
+  const float p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+  switch (sextant) {
+    case 0:
+      return {v, t, p};
+    case 1:
+      return {q, v, p};
+    case 2:
+      return {p, v, t};
+    case 3:
+      return {p, q, v};
+    case 4:
+      return {t, p, v};
+    default:
+      return {v, p, q};
+  }
+}
+
 Eigen::Vector3f vary(const Eigen::Vector3f& srgb, std::uint32_t key, float amount) {
   // Integer hash (lowbias32, Wellons 2018): neighbouring keys get unrelated shades.
   std::uint32_t h = key;

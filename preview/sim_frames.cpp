@@ -3,68 +3,196 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
+#include "core/error.h"
 #include "preview/colors.h"
 #include "preview/image.h"
 
 namespace ts::preview {
+namespace {
+
+// Where each kind of body lies in the world: rough walls first, then the props in scene order, then
+// the grains (emitters only append them; grains are the dynamic bodies that are not props).
+struct BodyRanges {
+  std::size_t first_prop = 0, first_grain = 0;
+};
+
+BodyRanges body_ranges(const sim::World& world, std::size_t props, std::size_t dynamic_props) {
+  const auto dynamic = static_cast<std::size_t>(
+      std::count(world.bodies.motion.begin(), world.bodies.motion.end(), sim::MotionType::Dynamic));
+  const std::size_t grains = dynamic >= dynamic_props ? dynamic - dynamic_props : 0;
+  BodyRanges r;
+  r.first_grain = world.bodies.size() - std::min(grains, world.bodies.size());
+  r.first_prop = r.first_grain - std::min(props, r.first_grain);
+  return r;
+}
+
+// The box `from` moves to towards `to`: at once where `to` is wider, by `rate` of the gap where narrower.
+Aabb widen_at_once_narrow_slowly(const Aabb& from, const Aabb& to, double rate) {
+  Aabb out = from;
+  for (int k = 0; k < 3; ++k) {
+    out.min[k] = to.min[k] < from.min[k] ? to.min[k] : from.min[k] + rate * (to.min[k] - from.min[k]);
+    out.max[k] = to.max[k] > from.max[k] ? to.max[k] : from.max[k] + rate * (to.max[k] - from.max[k]);
+  }
+  return out;
+}
+
+}  // namespace
+
+FrameSettings frame_settings(const sim::OutputSettings& output) {
+  FrameSettings s;
+  const sim::FrameCamera& c = output.camera;
+  s.width = c.width;
+  s.height = c.height;
+  s.eye = c.eye;
+  s.target = c.target;
+  s.up = c.up;
+  s.fov = c.fov;
+  s.follow_prop = c.follow_prop;
+  s.color_by = output.color_by;
+  s.walls = output.walls;
+  return s;
+}
+
+SimFrameWriter::SimFrameWriter(gpu::Context& context, const sim::Scene& scene)
+    : SimFrameWriter(context, scene, frame_settings(scene.output)) {}
 
 SimFrameWriter::SimFrameWriter(gpu::Context& context, const sim::Scene& scene, const FrameSettings& settings)
-    : renderer_(context), settings_(settings) {
+    : renderer_(context),
+      settings_(settings),
+      walls_(scene),
+      props_(scene.props.size()),
+      gravity_(scene.gravity.norm()) {
+  try {
+    renderer_.check_image_size(settings_.width, settings_.height);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", sim::scene_location(scene, "output.camera.size"), e.what()));
+  }
+  for (const auto& p : scene.props) dynamic_props_ += p.motion == sim::MotionType::Dynamic ? 1 : 0;
   for (const auto& e : scene.emitters) {
-    if (e.type == sim::EmitterType::Column) {
-      emitter_box_.extend(e.centre - Eigen::Vector3d(e.radius, e.radius, 0.0));
-      emitter_box_.extend(e.centre + Eigen::Vector3d(e.radius, e.radius, 0.0));
-    } else {
-      emitter_box_.extend(e.min);
-      emitter_box_.extend(e.max);
-    }
+    if (e.type != sim::EmitterType::Pour) continue;  // fill and column grains are there from the start
+    emitter_box_.extend(e.min);
+    emitter_box_.extend(e.max);
   }
 }
 
 Particles SimFrameWriter::particles_of(const sim::World& world) {
   const Eigen::Vector3f sand(0.86f, 0.68f, 0.42f), wall(0.62f, 0.63f, 0.66f), prop(0.45f, 0.58f, 0.75f);
+  const BodyRanges ranges = body_ranges(world, props_, dynamic_props_);
   Particles out;
   out.centers = sim::particle_positions(world);
   const std::size_t n = world.particles.size();
   out.radii.resize(n);
   out.colors.resize(n);
+  // The field's range: heights over the grains (all particles when there is none), speeds from 0 to
+  // the free-fall speed over the first frame's height.
+  double z_min = std::numeric_limits<double>::max(), z_max = std::numeric_limits<double>::lowest();
+  std::vector<double> speed(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t b = world.particles.body[i];
-    const bool is_static = world.bodies.motion[b] == sim::MotionType::Static;
-    const bool grain = world.bodies.particle_count[b] == 4 && world.bodies.motion[b] == sim::MotionType::Dynamic;
+    if (b >= ranges.first_grain || ranges.first_grain == world.bodies.size()) {
+      z_min = std::min(z_min, out.centers[i].z());
+      z_max = std::max(z_max, out.centers[i].z());
+    }
+    const Eigen::Vector3d arm = world.bodies.orientation[b] * world.particles.offset[i];
+    speed[i] = (world.bodies.linear_velocity[b] + world.bodies.angular_velocity[b].cross(arm)).norm();
+  }
+  if (speed_scale_ == 0) {
+    const double from_height = std::sqrt(2.0 * gravity_ * std::max(z_max - z_min, 0.0));
+    speed_scale_ =
+        from_height > 1e-6 ? from_height : std::max(*std::max_element(speed.begin(), speed.end()), 1.0);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t b = world.particles.body[i];
     out.radii[i] = static_cast<float>(world.particles.radius[i]);
-    out.colors[i] = pack_rgba8(is_static ? wall : grain ? vary(sand, b, 0.12f) : prop);
+    Eigen::Vector3f c;
+    if (b < ranges.first_prop) {
+      c = wall;
+    } else {
+      switch (settings_.color_by) {
+        case sim::FrameColoring::Sand:
+          c = b >= ranges.first_grain ? vary(sand, b, 0.12f) : prop;
+          break;
+        case sim::FrameColoring::Height:
+          c = viridis((out.centers[i].z() - z_min) / std::max(z_max - z_min, 1e-12));
+          break;
+        case sim::FrameColoring::Speed:
+          c = viridis(speed[i] / speed_scale_);
+          break;
+        case sim::FrameColoring::Body:
+          c = categorical(b);
+          break;
+      }
+    }
+    out.colors[i] = pack_rgba8(c);
   }
   return out;
 }
 
-void SimFrameWriter::write(const sim::World& world, std::int64_t frame, const std::filesystem::path& dir) {
-  const Particles particles = particles_of(world);
-  if (particles.centers.empty()) return;  // nothing emitted yet
-  renderer_.set_particles(particles);
-  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-  if (!camera_) {
-    Aabb box = renderer_.content_box();
-    ground_level_ = box.min.z();
-    if (emitter_box_.valid()) {
-      box.extend(emitter_box_.min);
-      box.extend(emitter_box_.max);
-    }
-    for (const auto& plane : world.walls.planes) {
-      box.extend(plane.point);
-      if (plane.normal.z() > 0.9) ground_level_ = std::min(ground_level_, plane.point.z());
-    }
-    camera_ = frame_box(box, view_direction(settings_.view, up), view_image_up(settings_.view, up),
-                        static_cast<double>(settings_.width) / settings_.height, false, 30.0);
+Camera SimFrameWriter::follow(const sim::World& world) {
+  const BodyRanges ranges = body_ranges(world, props_, dynamic_props_);
+  const std::size_t body = ranges.first_prop + static_cast<std::size_t>(settings_.follow_prop);
+  const Eigen::Vector3d centre = world.bodies.position[body];
+  if (settings_.eye) {
+    if (!follow_offset_) follow_offset_ = *settings_.eye - centre;
+    return Camera{centre + *follow_offset_, centre, settings_.up, settings_.fov};
   }
+  const double reach = 2.5 * world.bodies.bounding_radius[body];
+  Aabb box;
+  box.extend(centre - Eigen::Vector3d::Constant(reach));
+  box.extend(centre + Eigen::Vector3d::Constant(reach));
+  return frame_box(box, view_direction(settings_.view, settings_.up),
+                   view_image_up(settings_.view, settings_.up),
+                   static_cast<double>(settings_.width) / settings_.height, false, settings_.fov);
+}
+
+Camera SimFrameWriter::camera_for(const sim::World& world, const Aabb& grains) {
+  if (settings_.follow_prop >= 0) return follow(world);
+  if (settings_.eye && settings_.target)
+    return Camera{*settings_.eye, *settings_.target, settings_.up, settings_.fov};
+  Aabb wanted = grains;
+  const Aabb walls = walls_.framing_box(grains);
+  for (const Aabb& b : {walls, emitter_box_}) {
+    if (!b.valid()) continue;
+    wanted.extend(b.min);
+    wanted.extend(b.max);
+  }
+  framed_ = framed_ ? widen_at_once_narrow_slowly(*framed_, wanted, settings_.narrowing) : wanted;
+  return frame_box(*framed_, view_direction(settings_.view, settings_.up),
+                   view_image_up(settings_.view, settings_.up),
+                   static_cast<double>(settings_.width) / settings_.height, false, settings_.fov);
+}
+
+Aabb SimFrameWriter::grain_box(const sim::World& world, const Particles& particles) const {
+  const BodyRanges ranges = body_ranges(world, props_, dynamic_props_);
+  Aabb box;
+  for (std::size_t i = 0; i < particles.centers.size(); ++i) {
+    if (world.particles.body[i] < ranges.first_grain) continue;
+    box.extend(particles.centers[i] - Eigen::Vector3d::Constant(particles.radii[i]));
+    box.extend(particles.centers[i] + Eigen::Vector3d::Constant(particles.radii[i]));
+  }
+  return box.valid() ? box : renderer_.content_box();  // no grain yet: what there is
+}
+
+void SimFrameWriter::write(const sim::World& world, std::int64_t frame, const std::filesystem::path& dir) {
+  if (world.particles.size() == 0) return;  // nothing emitted yet
+  const Particles particles = particles_of(world);
+  renderer_.set_particles(particles);
+  const Aabb drawn = renderer_.content_box(), grains = grain_box(world, particles);
+  if (!ground_level_) ground_level_ = std::min(drawn.min.z(), walls_.floor_level().value_or(drawn.min.z()));
+  camera_ = camera_for(world, grains);
   RenderSettings s;
   s.width = settings_.width;
   s.height = settings_.height;
-  s.camera = *camera_;
-  s.up = up;
+  s.camera = camera_;
+  s.up = Eigen::Vector3d::UnitZ();  // the ground's normal: the scene's up, whatever the image's
   s.ground_level = ground_level_;
-  write_png(dir / fmt::format("frame_{:06d}.png", frame), renderer_.render(s).image);
+  s.keep_buffers = settings_.walls && !walls_.empty();
+  RenderResult result = renderer_.render(s);
+  if (settings_.walls) draw_walls(result.image, result.layers, camera_, walls_, grains, ground_level_);
+  write_png(dir / fmt::format("frame_{:06d}.png", frame), result.image);
 }
 
 }  // namespace ts::preview

@@ -1,13 +1,23 @@
 #pragma once
 // PNG frames of `tetrasand sim` ([output] frames = true): every particle of the world as a sphere
 // impostor, lit by one directional light with shadow mapping (thesis 5.2), over a ground plane at
-// the lowest floor. The camera frames the scene once, at the first frame (the particles, the
-// emitters' regions and the floors' points), and keeps still after, so frames make a film.
+// the lowest floor, with the scene's walls drawn faintly over them (preview/frame_walls.h).
+// The camera ([output.camera], sim/scene.h) is one of:
+//   fixed       eye and target given: the camera never moves;
+//   follow prop the prop's centre of mass stays at the image centre (eye, if given, keeps its offset
+//               from it; else the prop and 2.5 times its bounding radius around it are framed);
+//   default     the iso view of the grains and the walls around them (FrameWalls::framing_box) and the
+//               pour emitters' regions, framed again at every frame: the framing box widens at once
+//               when the grains spread and narrows by `narrowing` of the gap per frame when they gather,
+//               so a film neither loses grains nor jitters. Props are not framed: they show where they
+//               meet the grains, and follow = "prop NAME" keeps one in view.
+#include <Eigen/Core>
 #include <filesystem>
 #include <optional>
 
 #include "gpu/context.h"
 #include "preview/camera.h"
+#include "preview/frame_walls.h"
 #include "preview/renderer.h"
 #include "sim/scene.h"
 #include "sim/world.h"
@@ -15,27 +25,55 @@
 namespace ts::preview {
 
 struct FrameSettings {
-  int width = 640, height = 480;  // pixels
-  View view = View::Iso;          // relative to +z up (the scene convention)
+  int width = 960, height = 720;                  // pixels
+  View view = View::Iso;                          // the default camera's direction, relative to `up`
+  std::optional<Eigen::Vector3d> eye, target;     // m, world: a fixed camera (eye alone: following a prop)
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // image up (+z: the scene convention)
+  double fov = 30.0;                              // degrees, vertical
+  int follow_prop = -1;                           // the [[prop]] (scene order) kept in view; -1: none
+  sim::FrameColoring color_by = sim::FrameColoring::Sand;
+  bool walls = true;        // draw the boundaries (preview/frame_walls.h)
+  double narrowing = 0.10;  // share of the gap the default framing closes per frame when content shrinks
 };
+
+// The frame settings a scene's [output] and [output.camera] ask for.
+FrameSettings frame_settings(const sim::OutputSettings& output);
 
 class SimFrameWriter {
  public:
-  SimFrameWriter(gpu::Context& context, const sim::Scene& scene, const FrameSettings& settings = {});
+  // With the scene's own settings (frame_settings(scene.output)), or with `settings`.
+  SimFrameWriter(gpu::Context& context, const sim::Scene& scene);
+  SimFrameWriter(gpu::Context& context, const sim::Scene& scene, const FrameSettings& settings);
 
-  // Writes dir/frame_NNNNNN.png (NNNNNN = frame) atomically.
+  // Writes dir/frame_NNNNNN.png (NNNNNN = frame) atomically; nothing while the world has no particle.
   void write(const sim::World& world, std::int64_t frame, const std::filesystem::path& dir);
 
-  // The world's particles: grains in sand colours varied grain by grain, static bodies (rough
-  // walls) grey, other bodies (props) steel blue.
-  static Particles particles_of(const sim::World& world);
+  // The world's particles coloured by settings.color_by: grains and props by the field (sand: grains
+  // in sand colours varied grain by grain, props steel blue), static bodies (rough walls) grey.
+  Particles particles_of(const sim::World& world);
+
+  // The camera of the last frame written, and the box the default camera framed (tests).
+  const Camera& camera() const { return camera_; }
+  const std::optional<Aabb>& framed_box() const { return framed_; }
 
  private:
+  Camera camera_for(const sim::World& world, const Aabb& grains);
+  // The box of the grains' spheres (m); all particles' before there is any grain.
+  Aabb grain_box(const sim::World& world, const Particles& particles) const;
+  Camera follow(const sim::World& world);
+
   Renderer renderer_;
   FrameSettings settings_;
-  Aabb emitter_box_;           // where emitters put grains [m]
-  std::optional<Camera> camera_;
-  double ground_level_ = 0.0;  // m along +z, fixed at the first frame
+  FrameWalls walls_;
+  Aabb emitter_box_;       // m: where pour emitters release grains
+  std::size_t props_ = 0;  // the scene's [[prop]] count
+  std::size_t dynamic_props_ = 0;
+  double gravity_ = 0;                            // m/s^2, |g|
+  std::optional<double> ground_level_;            // m along +z, fixed at the first frame
+  std::optional<Aabb> framed_;                    // the default camera's smoothed framing box
+  std::optional<Eigen::Vector3d> follow_offset_;  // m, eye - prop centre (follow with an eye)
+  double speed_scale_ = 0;  // m/s, the top of the speed colour map (fixed at the first frame)
+  Camera camera_;
 };
 
 }  // namespace ts::preview

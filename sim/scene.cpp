@@ -603,6 +603,75 @@ void read_simulation(TableReader& root, const fs::path& file, Scene& scene) {
   r.reject_unknown_keys();
 }
 
+// A prop's name in follow = "prop NAME": its body file without ".body.json" ("cube").
+std::string prop_name(const Prop& p) {
+  std::string name = p.body_file.filename().string();
+  for (const std::string_view suffix : {".body.json", ".json"}) {
+    if (name.size() > suffix.size() && name.ends_with(suffix))
+      return name.substr(0, name.size() - suffix.size());
+  }
+  return name;
+}
+
+// follow = "scene" | "prop NAME" | "prop INDEX" (the [[prop]] tables in order, from 0): -1 for the
+// scene, else the prop's index.
+int read_follow(TableReader& r, const Scene& scene) {
+  const auto text = r.optional_string("follow");
+  if (!text || *text == "scene") return -1;
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < scene.props.size(); ++i)
+    names.push_back(fmt::format("\"prop {}\" or \"prop {}\"", prop_name(scene.props[i]), i));
+  const std::string available =
+      names.empty() ? "the scene has no [[prop]]" : fmt::format("have: {}", fmt::join(names, ", "));
+  if (!text->starts_with("prop "))
+    r.fail("follow", fmt::format("\"{}\" is not \"scene\" or \"prop NAME\" ({})", *text, available));
+  const std::string wanted = text->substr(5);
+  for (std::size_t i = 0; i < scene.props.size(); ++i) {
+    if (prop_name(scene.props[i]) == wanted || std::to_string(i) == wanted) return static_cast<int>(i);
+  }
+  r.fail("follow", fmt::format("no [[prop]] \"{}\" ({})", wanted, available));
+}
+
+// [output.camera]: eye, target, up (m, world), fov (degrees), size ([width, height] pixels), follow.
+void read_camera(TableReader& output, const fs::path& file, Scene& scene) {
+  const toml::node* n = output.node("camera");
+  if (!n) return;
+  if (!n->is_table()) output.fail("camera", "must be an [output.camera] table");
+  TableReader r(*n->as_table(), "output.camera", file, &scene.key_lines);
+  FrameCamera& c = scene.output.camera;
+  c.follow_prop = read_follow(r, scene);
+  c.eye = r.optional_vector<3>("eye");
+  c.target = r.optional_vector<3>("target");
+  c.up = r.unit_vector("up", c.up);
+  c.fov = r.positive("fov", c.fov);
+  if (!(c.fov < 180.0)) r.fail("fov", fmt::format("must be < 180 degrees (got {})", c.fov));
+  if (const toml::node* size = r.node("size")) {
+    const toml::array* a = size->as_array();
+    const char* form = "must be [width, height] in pixels, two integers";
+    if (!a || a->size() != 2 || !a->get(0)->is_integer() || !a->get(1)->is_integer()) r.fail("size", form);
+    const std::int64_t w = *a->get(0)->value<std::int64_t>(), h = *a->get(1)->value<std::int64_t>();
+    constexpr std::int64_t kMin = 16, kMax = 8192;
+    if (w < kMin || h < kMin || w > kMax || h > kMax)
+      r.fail("size", fmt::format("{} x {} pixels: each side must be {} to {} pixels", w, h, kMin, kMax));
+    c.width = static_cast<int>(w);
+    c.height = static_cast<int>(h);
+  }
+  if (c.follow_prop >= 0 && c.target)
+    r.fail("target",
+           "a camera following a prop looks at the prop's centre: remove target (eye alone sets where "
+           "the eye starts)");
+  if (c.follow_prop < 0 && c.eye.has_value() != c.target.has_value())
+    r.fail(c.eye ? "eye" : "target",
+           "a fixed camera needs both eye and target (m); without either, the default "
+           "camera frames the scene");
+  if (c.eye && c.target) {
+    const Eigen::Vector3d view = *c.target - *c.eye;
+    if (view.norm() < 1e-9) r.fail("target", "must differ from eye");
+    if (view.normalized().cross(c.up).norm() < 1e-6) r.fail("up", "must not be parallel to target - eye");
+  }
+  r.reject_unknown_keys();
+}
+
 void read_output(TableReader& root, const fs::path& file, Scene& scene) {
   const toml::node* n = root.node("output");
   if (!n) return;
@@ -611,6 +680,10 @@ void read_output(TableReader& root, const fs::path& file, Scene& scene) {
   OutputSettings& o = scene.output;
   o.every = r.integer("every", o.every, 1);
   o.frames = r.boolean("frames", o.frames);
+  o.color_by = static_cast<FrameColoring>(
+      r.choice("color_by", {"sand", "height", "speed", "body"}, static_cast<std::size_t>(o.color_by)));
+  o.walls = r.boolean("walls", o.walls);
+  read_camera(r, file, scene);
   o.ply = r.boolean("ply", o.ply);
   o.vtp = r.boolean("vtp", o.vtp);
   o.csv = r.boolean("csv", o.csv);

@@ -128,9 +128,31 @@ struct SimulationSettings {
   StepSettings step{.integrator = Integrator::SemiImplicitEuler};
 };
 
+// How grains are coloured in the PNG frames ([output] color_by).
+enum class FrameColoring {
+  Sand,    // sand colours varied grain by grain; props steel blue
+  Height,  // height of each sphere along +z, viridis from the grains' lowest to highest point
+  Speed,   // speed of each sphere, viridis from 0 to the free-fall speed over the first frame's height
+  Body,    // one colour per body (grains and props), hashed from its index
+};
+
+// The camera of the PNG frames ([output.camera]). Without eye/target a default camera frames the
+// walls and the grains at every frame (preview/sim_frames.h).
+struct FrameCamera {
+  std::optional<Eigen::Vector3d> eye, target;     // m, world; eye alone only when following a prop
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // image up (+z: the scene convention)
+  double fov = 30.0;                              // degrees, vertical field of view
+  int width = 960, height = 720;                  // pixels
+  // follow = "prop NAME": the body of this [[prop]] (scene order) stays at the image centre; -1: "scene".
+  int follow_prop = -1;
+};
+
 struct OutputSettings {
   std::int64_t every = 1000;  // steps between outputs
   bool frames = false;        // PNG frames through the preview renderer
+  FrameColoring color_by = FrameColoring::Sand;
+  bool walls = true;          // frames: draw the boundaries faintly
+  FrameCamera camera;         // [output.camera]
   bool ply = false;           // particle positions per output
   bool vtp = false;           // VTK PolyData per output
   bool csv = true;            // metrics.csv: one row per output

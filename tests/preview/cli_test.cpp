@@ -194,8 +194,8 @@ TEST(CliPreview, SimulationFramesArePngs) {
       << out;
   ASSERT_TRUE(std::filesystem::exists(dir / "out" / "frame_000000.png")) << out;
   const preview::Image frame = preview::read_png(dir / "out" / "frame_000000.png");
-  EXPECT_EQ(frame.width, 640);
-  EXPECT_EQ(frame.height, 480);
+  EXPECT_EQ(frame.width, 960);  // the default [output.camera] size
+  EXPECT_EQ(frame.height, 720);
   EXPECT_EQ(out.find("no frame renderer"), std::string::npos) << out;
 }
 
