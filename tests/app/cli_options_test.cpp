@@ -75,8 +75,10 @@ TEST(CliOptions, EveryNumericOptionRejectsNanAndInfinity) {
     for (const CLI::Option* option : sub->get_options()) {
       if (option->get_positional() || !is_numeric(*option)) continue;
       const std::string command = sub->get_name();
-      // The value 1 is accepted (so the line is right but for the value under test)...
-      const auto fine = command_line(command, *sub, *option, "1");
+      // A plain value is accepted (so the line is right but for the value under test): 1, or a tile
+      // width of frames' contact sheet, which must be at least 16 pixels...
+      const char* plain = option->check_lname("tile-width") ? "64" : "1";
+      const auto fine = command_line(command, *sub, *option, plain);
       EXPECT_EQ(parse_error(fine), "") << joined(fine);
       // ... NaN and infinity are not.
       for (const char* bad : {"nan", "NaN", "inf", "-inf", "1e999"}) {

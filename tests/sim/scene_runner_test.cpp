@@ -165,8 +165,9 @@ TEST(SimCommand, GpuRunWithSpringsAndTimingsReportsBoth) {
   const std::filesystem::path dir = test::temp_dir();
   write_file_atomically(dir / "springs.toml", scene);
   std::string output;
-  const int code = test::run_tetrasand(
-      fmt::format("sim '{}' -o '{}' --timings", (dir / "springs.toml").string(), (dir / "out").string()), &output);
+  const int code = test::run_tetrasand(fmt::format("sim '{}' -o '{}' --backend gpu --timings",
+                                                   (dir / "springs.toml").string(), (dir / "out").string()),
+                                       &output);
   EXPECT_EQ(code, 0) << output;
   EXPECT_NE(output.find("sim/contact_forces.comp"), std::string::npos) << output;
   EXPECT_NE(output.find("spring slots: 0 overflows"), std::string::npos) << output;
