@@ -51,6 +51,13 @@ std::filesystem::path temp_dir() {
   return dir;
 }
 
+std::string quoted(const std::filesystem::path& p) {
+  std::string out(1, '\'');  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + s + "'"
+  out += p.string();
+  out += '\'';
+  return out;
+}
+
 int run_tetrasand(const std::string& args, std::string* output) {
   const std::string cmd = std::string("'") + TETRASAND_BINARY + "' " + args + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");

@@ -21,4 +21,7 @@ std::filesystem::path temp_dir();
 // Runs the tetrasand executable with `args`; returns the exit code, stdout+stderr in *output.
 int run_tetrasand(const std::string& args, std::string* output = nullptr);
 
+// `p` in single quotes, for a run_tetrasand command line (test paths hold no quote).
+std::string quoted(const std::filesystem::path& p);
+
 }  // namespace ts::test

@@ -16,12 +16,7 @@
 namespace ts {
 namespace {
 
-std::string quoted(const std::filesystem::path& p) {
-  std::string out(1, '\'');  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + s + "'"
-  out += p.string();
-  out += '\'';
-  return out;
-}
+using test::quoted;
 
 // `--device N` of the first software EGL device (llvmpipe), so the choice is tested on a machine
 // with a GPU too; nullopt when EGL lists none.

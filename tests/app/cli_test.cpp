@@ -106,12 +106,7 @@ TEST(CliInfo, ReportsTheTallestAxisAndHowToStandTheMeshOnZ) {
 namespace ts {
 namespace {
 
-std::string quoted(const std::filesystem::path& p) {
-  std::string out(1, '\'');  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + s + "'"
-  out += p.string();
-  out += '\'';
-  return out;
-}
+using test::quoted;
 
 TEST(CliSdf, CompareOpenVdbPrintsTheThreeWayStatisticsOnARealMesh) {
   const auto dir = test::temp_dir();
