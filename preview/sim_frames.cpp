@@ -43,14 +43,7 @@ Aabb widen_at_once_narrow_slowly(const Aabb& from, const Aabb& to, double rate) 
 
 FrameSettings frame_settings(const sim::OutputSettings& output) {
   FrameSettings s;
-  const sim::FrameCamera& c = output.camera;
-  s.width = c.width;
-  s.height = c.height;
-  s.eye = c.eye;
-  s.target = c.target;
-  s.up = c.up;
-  s.fov = c.fov;
-  s.follow_prop = c.follow_prop;
+  s.camera = output.camera;
   s.color_by = output.color_by;
   s.walls = output.walls;
   return s;
@@ -66,7 +59,7 @@ SimFrameWriter::SimFrameWriter(gpu::Context& context, const sim::Scene& scene, c
       props_(scene.props.size()),
       gravity_(scene.gravity.norm()) {
   try {
-    renderer_.check_image_size(settings_.width, settings_.height);
+    renderer_.check_image_size(settings_.camera.width, settings_.camera.height);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", sim::scene_location(scene, "output.camera.size"), e.what()));
   }
@@ -133,25 +126,26 @@ Particles SimFrameWriter::particles_of(const sim::World& world) {
 
 Camera SimFrameWriter::follow(const sim::World& world) {
   const BodyRanges ranges = body_ranges(world, props_, dynamic_props_);
-  const std::size_t body = ranges.first_prop + static_cast<std::size_t>(settings_.follow_prop);
+  const std::size_t body = ranges.first_prop + static_cast<std::size_t>(settings_.camera.follow_prop);
   const Eigen::Vector3d centre = world.bodies.position[body];
-  if (settings_.eye) {
-    if (!follow_offset_) follow_offset_ = *settings_.eye - centre;
-    return Camera{centre + *follow_offset_, centre, settings_.up, settings_.fov};
+  if (settings_.camera.eye) {
+    if (!follow_offset_) follow_offset_ = *settings_.camera.eye - centre;
+    return Camera{centre + *follow_offset_, centre, settings_.camera.up, settings_.camera.fov};
   }
   const double reach = 2.5 * world.bodies.bounding_radius[body];
   Aabb box;
   box.extend(centre - Eigen::Vector3d::Constant(reach));
   box.extend(centre + Eigen::Vector3d::Constant(reach));
-  return frame_box(box, view_direction(settings_.view, settings_.up),
-                   view_image_up(settings_.view, settings_.up),
-                   static_cast<double>(settings_.width) / settings_.height, false, settings_.fov);
+  return frame_box(box, view_direction(settings_.view, settings_.camera.up),
+                   view_image_up(settings_.view, settings_.camera.up),
+                   static_cast<double>(settings_.camera.width) / settings_.camera.height, false,
+                   settings_.camera.fov);
 }
 
 Camera SimFrameWriter::camera_for(const sim::World& world, const Aabb& grains) {
-  if (settings_.follow_prop >= 0) return follow(world);
-  if (settings_.eye && settings_.target)
-    return Camera{*settings_.eye, *settings_.target, settings_.up, settings_.fov};
+  if (settings_.camera.follow_prop >= 0) return follow(world);
+  if (settings_.camera.eye && settings_.camera.target)
+    return Camera{*settings_.camera.eye, *settings_.camera.target, settings_.camera.up, settings_.camera.fov};
   Aabb wanted = grains;
   const Aabb walls = walls_.framing_box(grains);
   for (const Aabb& b : {walls, emitter_box_}) {
@@ -160,9 +154,10 @@ Camera SimFrameWriter::camera_for(const sim::World& world, const Aabb& grains) {
     wanted.extend(b.max);
   }
   framed_ = framed_ ? widen_at_once_narrow_slowly(*framed_, wanted, settings_.narrowing) : wanted;
-  return frame_box(*framed_, view_direction(settings_.view, settings_.up),
-                   view_image_up(settings_.view, settings_.up),
-                   static_cast<double>(settings_.width) / settings_.height, false, settings_.fov);
+  return frame_box(*framed_, view_direction(settings_.view, settings_.camera.up),
+                   view_image_up(settings_.view, settings_.camera.up),
+                   static_cast<double>(settings_.camera.width) / settings_.camera.height, false,
+                   settings_.camera.fov);
 }
 
 Aabb SimFrameWriter::grain_box(const sim::World& world, const Particles& particles) const {
@@ -184,8 +179,8 @@ void SimFrameWriter::write(const sim::World& world, std::int64_t frame, const st
   if (!ground_level_) ground_level_ = std::min(drawn.min.z(), walls_.floor_level().value_or(drawn.min.z()));
   camera_ = camera_for(world, grains);
   RenderSettings s;
-  s.width = settings_.width;
-  s.height = settings_.height;
+  s.width = settings_.camera.width;
+  s.height = settings_.camera.height;
   s.camera = camera_;
   s.up = Eigen::Vector3d::UnitZ();  // the ground's normal: the scene's up, whatever the image's
   s.ground_level = ground_level_;

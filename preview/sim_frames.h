@@ -25,12 +25,8 @@
 namespace ts::preview {
 
 struct FrameSettings {
-  int width = 960, height = 720;                  // pixels
-  View view = View::Iso;                          // the default camera's direction, relative to `up`
-  std::optional<Eigen::Vector3d> eye, target;     // m, world: a fixed camera (eye alone: following a prop)
-  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // image up (+z: the scene convention)
-  double fov = 30.0;                              // degrees, vertical
-  int follow_prop = -1;                           // the [[prop]] (scene order) kept in view; -1: none
+  sim::FrameCamera camera;  // [output.camera]: size, eye/target, up, fov, the followed prop
+  View view = View::Iso;    // the default camera's direction, relative to camera.up
   sim::FrameColoring color_by = sim::FrameColoring::Sand;
   bool walls = true;        // draw the boundaries (preview/frame_walls.h)
   double narrowing = 0.10;  // share of the gap the default framing closes per frame when content shrinks

@@ -51,14 +51,14 @@ size = [320, 200]
 )"));
   const preview::FrameSettings s = preview::frame_settings(scene.output);
   EXPECT_EQ(s.color_by, sim::FrameColoring::Speed);
-  ASSERT_TRUE(s.eye && s.target);
-  EXPECT_EQ(*s.eye, Eigen::Vector3d(1.0, -2.0, 0.5));
-  EXPECT_EQ(*s.target, Eigen::Vector3d(0.0, 0.0, 0.1));
-  EXPECT_EQ(s.up, Eigen::Vector3d::UnitZ());
-  EXPECT_EQ(s.fov, 40.0);
-  EXPECT_EQ(s.width, 320);
-  EXPECT_EQ(s.height, 200);
-  EXPECT_EQ(s.follow_prop, -1);
+  ASSERT_TRUE(s.camera.eye && s.camera.target);
+  EXPECT_EQ(*s.camera.eye, Eigen::Vector3d(1.0, -2.0, 0.5));
+  EXPECT_EQ(*s.camera.target, Eigen::Vector3d(0.0, 0.0, 0.1));
+  EXPECT_EQ(s.camera.up, Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(s.camera.fov, 40.0);
+  EXPECT_EQ(s.camera.width, 320);
+  EXPECT_EQ(s.camera.height, 200);
+  EXPECT_EQ(s.camera.follow_prop, -1);
   for (const std::string follow : {"prop cube", "prop 0"}) {
     const sim::Scene f = parse(scene_with_output("[output.camera]\nfollow = \"" + follow + "\"\n"));
     EXPECT_EQ(f.output.camera.follow_prop, 0) << follow;
@@ -165,8 +165,8 @@ TEST(SimFrames, DefaultCameraFramesTheGrainsAgainWhenTheySpread) {
             test::box_emitter("fill", "[-0.06, -0.06, 0.0]", "[0.06, 0.06, 0.06]", 20, "seed = 3\n"));
   sim::World world = sim::make_world(scene);
   preview::FrameSettings settings;
-  settings.width = 64;
-  settings.height = 48;
+  settings.camera.width = 64;
+  settings.camera.height = 48;
   preview::SimFrameWriter writer(context(), scene, settings);
   const auto distance = [&] { return (writer.camera().eye - writer.camera().target).norm(); };
   writer.write(world, 0, dir);
