@@ -15,7 +15,11 @@ struct SdfSettings {
   double band = 3.0;         // half-width of the narrow band [voxels]
   int padding = -1;          // voxels beyond the bounding box; -1: ceil(band) + 1
   SignMethod sign = SignMethod::Pseudonormal;
-  std::size_t max_voxels = std::size_t{1} << 31;  // cap on the bounding grid (dims product)
+  // Cap on the bounding grid (dims product). Nothing allocates the box: scan conversion works in
+  // z-slabs bounded by --max-slab-mb and keeps only the band (the exact CPU path goes slice by slice),
+  // so the cap only stops a resolution typed by mistake; 2^37 (about 5120^3) admits the 4096-class
+  // grids of docs/benchmarks.md ("Sparse SDF memory") and the 2048-class previews.
+  std::size_t max_voxels = std::size_t{1} << 37;
 };
 
 }  // namespace ts::sdf

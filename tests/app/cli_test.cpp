@@ -174,7 +174,7 @@ TEST(CliSdf, GridOverTheCapNamesTheLargestGridThatFits) {
   const auto dir = test::temp_dir();
   std::string out;
   EXPECT_EQ(test::run_tetrasand("sdf " + quoted(test::asset("cube.obj")) + " -o " + quoted(dir / "a.vdb") +
-                                    " --resolution 2000",
+                                    " --resolution 6000",
                                 &out),
             1)
       << out;
