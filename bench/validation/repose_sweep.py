@@ -1,0 +1,197 @@
+#!/usr/bin/python3
+"""Repose magnitude (issue 18; docs/validation.md "Repose magnitude (issue 18)"; criteria in
+bench/validation/repose_criteria.md, written before the first run).
+
+The 3,000-grain heap of the "Angle of repose against friction" section at mu = 0.5, built as
+validation_runs.cpp's repose() builds it, with one factor changed per run (the thesis's gamma_s, the
+grain's edge / radius, spring friction, mu, the heap size, the pour seed), on tetrasand's CPU
+reference, and the same deck on LAMMPS through `tetrasand export lammps`. Every heap's angle is the
+one report.py gives those heaps (sim_peers.repose_angle, 10 mm rings about x = y = 0).
+
+Usage: bench/validation/repose_sweep.py BUILD_BIN_DIR WORK_DIR [RUN ...] [--plot PNG] [--plot-only]
+  RUN: a name of RUNS below (default: all, in the criteria's order). A run already in WORK_DIR/results.json
+  is not run again, so the sweep can be resumed; --plot PNG plots what results.json then holds, and with
+  --plot-only nothing is run.
+Prints one line per run and a markdown table; writes WORK_DIR/results.json (atomically).
+"""
+import json
+import os
+import re
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "peers"))
+from sim_peers import read_dump_frames, read_ply_bodies, repose_angle, run  # noqa: E402
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+SCENE = os.path.join(ROOT, "assets", "scenes", "reference", "coarse_pile.toml")
+RADIUS = 5.0e-3  # m, the pile's sphere radius
+D_EQ = 2 * RADIUS * 4 ** (1 / 3)  # m, report.py's COARSE_D_EQ (mass of four whole spheres, whatever the edge)
+RING = 2 * RADIUS  # m, the ring width report.py uses for these heaps
+BASE_GRAINS = 3000
+
+# name -> (code, what the run changes from the baseline: a dict of the edits scene_text() knows)
+RUNS = {
+    "base": ("tetrasand", {}),
+    "lammps_base": ("lammps", {}),
+    "gamma_s10": ("tetrasand", {"gamma_s": 10.0}),
+    "edge1.0": ("tetrasand", {"edge": 1.0}),
+    "spring": ("tetrasand", {"tangential": "spring"}),
+    "mu1.0": ("tetrasand", {"mu": 1.0}),
+    "base_seed12": ("tetrasand", {"seed": 12}),
+    "edge1.5": ("tetrasand", {"edge": 1.5}),
+    "grains6000": ("tetrasand", {"grains": 6000}),
+    "lammps_gamma_s10": ("lammps", {"gamma_s": 10.0}),
+    "lammps_spring": ("lammps", {"tangential": "spring"}),
+}
+
+
+def replace_once(text, old, new):
+    if text.count(old) != 1:
+        sys.exit(f"repose_sweep: expected one '{old.strip()}' in {SCENE}")
+    return text.replace(old, new)
+
+
+def scene_text(edits):
+    """validation_runs.cpp repose()'s heap (3,000 grains, 1,000 grains/s, 16 cm box 5-30 cm up, 0.8 m
+    floor, 4 s, symplectic Euler) with `edits` applied."""
+    grains = edits.get("grains", BASE_GRAINS)
+    pour_s = grains / 1000.0
+    t = open(SCENE).read()
+    t = replace_once(t, "min = [-0.04, -0.04, 0.05]", "min = [-0.08, -0.08, 0.05]")
+    t = replace_once(t, "max = [0.04, 0.04, 0.22]", "max = [0.08, 0.08, 0.30]")
+    t = replace_once(t, "count = 300\n", f"count = {grains}\n")
+    t = replace_once(t, "rate = 400.0", "rate = 1000.0")
+    t = replace_once(t, "size = [0.3, 0.3]", "size = [0.8, 0.8]")
+    sim = f'duration = {pour_s + 1.0}\nintegrator = "symplectic"\n'
+    if "tangential" in edits:
+        sim += f'tangential = "{edits["tangential"]}"\n'
+    t = replace_once(t, "duration = 1.6\n", sim)
+    t = replace_once(t, "[output]\nevery = 500\n", "[output]\nevery = 500\nply = true\n")
+    if "gamma_s" in edits:
+        t = replace_once(t, "gamma_s = 2.0\n", f"gamma_s = {edits['gamma_s']}\n")
+    if "mu" in edits:
+        t = replace_once(t, "mu = 0.5\n", f"mu = {edits['mu']}\n")
+    if "seed" in edits:
+        t = replace_once(t, "seed = 11\n", f"seed = {edits['seed']}\n")
+    if "edge" in edits:
+        t = replace_once(t, "[grain]\nradius = 5.0e-3\n", f"[grain]\nradius = 5.0e-3\nedge = {edits['edge'] * RADIUS:.6g}\n")
+    return t, grains, pour_s + 1.0
+
+
+def tetrasand_run(bin_dir, scene_file, out, grains, duration):
+    wall, text = run(["nice", "-n", "15", os.path.join(bin_dir, "tetrasand"), "sim", scene_file, "-o", out,
+                      "--backend", "cpu"])
+    plys = sorted(f for f in os.listdir(out) if f.startswith("particles_") and f.endswith(".ply"))
+    metrics = np.genfromtxt(os.path.join(out, "metrics.csv"), delimiter=",", names=True)
+    times = np.atleast_1d(metrics["time_s"])
+    if len(times) != len(plys):
+        sys.exit(f"repose_sweep: {out}: {len(plys)} PLYs against {len(times)} metrics rows")
+    final = read_ply_bodies(os.path.join(out, plys[-1]))[1][-grains:]
+    k = int(np.argmin(np.abs(times - (duration - 0.5))))
+    earlier = read_ply_bodies(os.path.join(out, plys[k]))[1][-grains:]
+    m = re.search(r": (\d+) steps of ([0-9.e+-]+) s", text)
+    overflows = int(np.atleast_1d(metrics["spring_overflows"]).sum())
+    kinetic = float(np.atleast_1d(metrics["kinetic_translational_J"])[-1])
+    return final, wall, dict(steps=int(m.group(1)), dt=float(m.group(2)), angle_earlier=repose_angle(earlier, RING),
+                             time_earlier=float(times[k]), spring_overflows=overflows, final_kinetic_J=kinetic)
+
+
+def lammps_run(bin_dir, scene_file, deck):
+    run([os.path.join(bin_dir, "tetrasand"), "export", "lammps", scene_file, "-o", deck])
+    wall, _ = run(["nice", "-n", "15", "lmp", "-in", "in.tetrasand", "-log", "log.lammps", "-screen", "none"], cwd=deck)
+    _, xyz = read_dump_frames(os.path.join(deck, "final.dump"))[-1]
+    pair = [l.strip() for l in open(os.path.join(deck, "in.tetrasand")) if l.startswith("pair_coeff")]
+    return xyz, wall, dict(pair_coeff=pair)
+
+
+def save_json(path, data):
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(data, f, indent=1)
+    os.replace(tmp, path)
+
+
+def plot(results, png):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    names = [n for n in RUNS if n in results]
+    angles = [results[n]["angle"] for n in names]
+    colours = ["tab:orange" if n.startswith("lammps") else "tab:grey" if n.startswith("base") else "tab:blue"
+               for n in names]
+    fig, ax = plt.subplots(figsize=(8, 4))
+    ax.axhspan(30, 40, color="tab:green", alpha=0.15, label="30-40 deg")
+    ax.bar(range(len(names)), angles, color=colours)
+    for i, n in enumerate(names):
+        ax.text(i, angles[i] + 0.4, f"{angles[i]:.1f}", ha="center", fontsize=8)
+    ax.set_xticks(range(len(names)))
+    ax.set_xticklabels(names, rotation=30, ha="right")
+    ax.set_ylabel("angle of repose (deg)")
+    ax.set_ylim(0, 42)
+    ax.set_title("3,000-grain heap (mu 0.5, viscous, edge 2r): one factor changed per bar")
+    ax.legend(loc="upper left")
+    fig.tight_layout()
+    tmp = png + ".tmp.png"
+    fig.savefig(tmp, dpi=110)
+    os.replace(tmp, png)
+
+
+def main():
+    args = sys.argv[1:]
+    if len(args) < 2:
+        sys.exit(__doc__)
+    bin_dir, work = os.path.abspath(args[0]), os.path.abspath(args[1])
+    rest = args[2:]
+    png = None
+    if "--plot" in rest:
+        i = rest.index("--plot")
+        png = rest[i + 1]
+        del rest[i:i + 2]
+    for name in rest:
+        if name not in RUNS:
+            sys.exit(f"repose_sweep: unknown run '{name}' (known: {' '.join(RUNS)})")
+    os.makedirs(work, exist_ok=True)
+    path = os.path.join(work, "results.json")
+    results = json.load(open(path)) if os.path.exists(path) else {}
+    plot_only = "--plot-only" in rest
+    if plot_only:
+        rest.remove("--plot-only")
+    todo = [] if plot_only else (rest or list(RUNS))
+    for name in todo:
+        if name in results:
+            continue
+        code, edits = RUNS[name]
+        text, grains, duration = scene_text(edits)
+        scene_file = os.path.join(work, f"{name}.toml")
+        open(scene_file, "w").write(text)
+        start = time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())
+        load = os.getloadavg()
+        out = os.path.join(work, name)
+        if code == "tetrasand":
+            xyz, wall, info = tetrasand_run(bin_dir, scene_file, out, grains, duration)
+        else:
+            xyz, wall, info = lammps_run(bin_dir, scene_file, out)
+        if len(xyz) != grains:
+            sys.exit(f"repose_sweep: {name}: {len(xyz)} grains in the final state, {grains} expected")
+        angle = repose_angle(xyz, RING)
+        height = float(xyz[:, 2].max())
+        results[name] = dict(code=code, edits=edits, start=start, load_start=load, load_end=os.getloadavg(),
+                             wall_s=wall, angle=angle, height_m=height, height_d=height / D_EQ, grains=grains, **info)
+        save_json(path, results)
+        print(f"{name}: {angle:.1f} deg, H {height * 1e3:.1f} mm = {height / D_EQ:.1f} d, {wall:.0f} s "
+              f"({start}, load {load[0]:.1f})", flush=True)
+    if png:
+        plot(results, png)
+    print("\n| run | code | change | angle (deg) | H (d) | wall (s) |\n|---|---|---|---|---|---|")
+    for name in RUNS:
+        if name in results:
+            r = results[name]
+            print(f"| {name} | {r['code']} | {r['edits'] or '-'} | {r['angle']:.1f} | {r['height_d']:.1f} | "
+                  f"{r['wall_s']:.0f} |")
+
+
+if __name__ == "__main__":
+    main()
