@@ -45,6 +45,8 @@ RUNS = {
     "grains6000": ("tetrasand", {"grains": 6000}),
     "lammps_gamma_s10": ("lammps", {"gamma_s": 10.0}),
     "lammps_spring": ("lammps", {"tangential": "spring"}),
+    # Added after run 1 (criteria, addendum): the baseline with 3 s more at rest.
+    "base_long": ("tetrasand", {"rest": 4.0}),
 }
 
 
@@ -59,13 +61,14 @@ def scene_text(edits):
     floor, 4 s, symplectic Euler) with `edits` applied."""
     grains = edits.get("grains", BASE_GRAINS)
     pour_s = grains / 1000.0
+    rest_s = edits.get("rest", 1.0)
     t = open(SCENE).read()
     t = replace_once(t, "min = [-0.04, -0.04, 0.05]", "min = [-0.08, -0.08, 0.05]")
     t = replace_once(t, "max = [0.04, 0.04, 0.22]", "max = [0.08, 0.08, 0.30]")
     t = replace_once(t, "count = 300\n", f"count = {grains}\n")
     t = replace_once(t, "rate = 400.0", "rate = 1000.0")
     t = replace_once(t, "size = [0.3, 0.3]", "size = [0.8, 0.8]")
-    sim = f'duration = {pour_s + 1.0}\nintegrator = "symplectic"\n'
+    sim = f'duration = {pour_s + rest_s}\nintegrator = "symplectic"\n'
     if "tangential" in edits:
         sim += f'tangential = "{edits["tangential"]}"\n'
     t = replace_once(t, "duration = 1.6\n", sim)
@@ -78,7 +81,20 @@ def scene_text(edits):
         t = replace_once(t, "seed = 11\n", f"seed = {edits['seed']}\n")
     if "edge" in edits:
         t = replace_once(t, "[grain]\nradius = 5.0e-3\n", f"[grain]\nradius = 5.0e-3\nedge = {edits['edge'] * RADIUS:.6g}\n")
-    return t, grains, pour_s + 1.0
+    return t, grains, pour_s + rest_s
+
+
+def angle_series(out, grains, pour_s):
+    """(time, angle, highest centre) of every PLY of run `out` from the end of the pour on: how the heap
+    creeps once nothing more lands."""
+    plys = sorted(f for f in os.listdir(out) if f.startswith("particles_") and f.endswith(".ply"))
+    times = np.atleast_1d(np.genfromtxt(os.path.join(out, "metrics.csv"), delimiter=",", names=True)["time_s"])
+    series = []
+    for t, ply in zip(times, plys):
+        if t >= pour_s:
+            xyz = read_ply_bodies(os.path.join(out, ply))[1][-grains:]
+            series.append((float(t), repose_angle(xyz, RING), float(xyz[:, 2].max())))
+    return series
 
 
 def tetrasand_run(bin_dir, scene_file, out, grains, duration):
@@ -95,7 +111,8 @@ def tetrasand_run(bin_dir, scene_file, out, grains, duration):
     m = re.search(r": (\d+) steps of ([0-9.e+-]+) s", text)
     overflows = int(np.atleast_1d(metrics["spring_overflows"]).sum())
     kinetic = float(np.atleast_1d(metrics["kinetic_translational_J"])[-1])
-    return final, wall, dict(steps=int(m.group(1)), dt=float(m.group(2)), angle_earlier=repose_angle(earlier, RING),
+    series = angle_series(out, grains, grains / 1000.0)
+    return final, wall, dict(series=series, steps=int(m.group(1)), dt=float(m.group(2)), angle_earlier=repose_angle(earlier, RING),
                              time_earlier=float(times[k]), spring_overflows=overflows, final_kinetic_J=kinetic)
 
 
@@ -122,7 +139,7 @@ def plot(results, png):
     angles = [results[n]["angle"] for n in names]
     colours = ["tab:orange" if n.startswith("lammps") else "tab:grey" if n.startswith("base") else "tab:blue"
                for n in names]
-    fig, ax = plt.subplots(figsize=(8, 4))
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 4.5), gridspec_kw=dict(width_ratios=[3, 2]))
     ax.axhspan(30, 40, color="tab:green", alpha=0.15, label="30-40 deg")
     ax.bar(range(len(names)), angles, color=colours)
     for i, n in enumerate(names):
@@ -133,6 +150,16 @@ def plot(results, png):
     ax.set_ylim(0, 42)
     ax.set_title("3,000-grain heap (mu 0.5, viscous, edge 2r): one factor changed per bar")
     ax.legend(loc="upper left")
+    ax2.axhspan(30, 40, color="tab:green", alpha=0.15)
+    for n in names:
+        if results[n].get("series"):
+            t, a, _ = np.array(results[n]["series"]).T
+            pour_s = results[n]["grains"] / 1000.0
+            ax2.plot(t - pour_s, a, ".-", label=n)
+    ax2.set_xlabel("time after the pour's last release (s)")
+    ax2.set_ylabel("angle of repose (deg)")
+    ax2.set_title("angle against time (tetrasand runs)")
+    ax2.legend(fontsize=7)
     fig.tight_layout()
     tmp = png + ".tmp.png"
     fig.savefig(tmp, dpi=110)
@@ -150,15 +177,15 @@ def main():
         i = rest.index("--plot")
         png = rest[i + 1]
         del rest[i:i + 2]
+    plot_only = "--plot-only" in rest
+    if plot_only:
+        rest.remove("--plot-only")
     for name in rest:
         if name not in RUNS:
             sys.exit(f"repose_sweep: unknown run '{name}' (known: {' '.join(RUNS)})")
     os.makedirs(work, exist_ok=True)
     path = os.path.join(work, "results.json")
     results = json.load(open(path)) if os.path.exists(path) else {}
-    plot_only = "--plot-only" in rest
-    if plot_only:
-        rest.remove("--plot-only")
     todo = [] if plot_only else (rest or list(RUNS))
     for name in todo:
         if name in results:
@@ -184,6 +211,12 @@ def main():
         print(f"{name}: {angle:.1f} deg, H {height * 1e3:.1f} mm = {height / D_EQ:.1f} d, {wall:.0f} s "
               f"({start}, load {load[0]:.1f})", flush=True)
     if png:
+        # Runs recorded before the series was added to tetrasand_run get it from their PLYs.
+        for name, r in results.items():
+            out = os.path.join(work, name)
+            if r["code"] == "tetrasand" and "series" not in r and os.path.isdir(out):
+                r["series"] = angle_series(out, r["grains"], r["grains"] / 1000.0)
+        save_json(path, results)
         plot(results, png)
     print("\n| run | code | change | angle (deg) | H (d) | wall (s) |\n|---|---|---|---|---|---|")
     for name in RUNS:
