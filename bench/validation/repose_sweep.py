@@ -23,7 +23,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "peers"))
-from sim_peers import read_dump_frames, read_ply_bodies, repose_angle, run  # noqa: E402
+from sim_peers import centres, read_dump_frames, read_ply_bodies, repose_angle, run  # noqa: E402
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 SCENE = os.path.join(ROOT, "assets", "scenes", "reference", "coarse_pile.toml")
@@ -116,12 +116,31 @@ def tetrasand_run(bin_dir, scene_file, out, grains, duration):
                              time_earlier=float(times[k]), spring_overflows=overflows, final_kinetic_J=kinetic)
 
 
+def lammps_series(deck, grains):
+    """(time, angle, highest centre) of every frame of the deck's particles.dump (one frame per [output]
+    every steps) once all `grains` are in (fix deposit releases one grain every
+    round(1 / (rate dt)) steps, so its pour ends at its own time)."""
+    text = open(os.path.join(deck, "in.tetrasand")).read()
+    dt = float(re.search(r"^timestep\s+(\S+)", text, re.M).group(1))
+    series = []
+    # sim_peers.read_dump_frames cannot read the empty frames of a pour's start: the full frames only.
+    lines = open(os.path.join(deck, "particles.dump")).read().split("\n")
+    for i, line in enumerate(lines):
+        if line.startswith("ITEM: TIMESTEP"):
+            step, n = int(lines[i + 1]), int(lines[i + 3])
+            if n == 4 * grains:
+                rows = np.array([l.split() for l in lines[i + 9:i + 9 + n]], dtype=float)
+                xyz = centres(rows[:, 1].astype(int), rows[:, 3:6])[1]
+                series.append((step * dt, repose_angle(xyz, RING), float(xyz[:, 2].max())))
+    return series
+
+
 def lammps_run(bin_dir, scene_file, deck):
     run([os.path.join(bin_dir, "tetrasand"), "export", "lammps", scene_file, "-o", deck])
     wall, _ = run(["nice", "-n", "15", "lmp", "-in", "in.tetrasand", "-log", "log.lammps", "-screen", "none"], cwd=deck)
     _, xyz = read_dump_frames(os.path.join(deck, "final.dump"))[-1]
     pair = [l.strip() for l in open(os.path.join(deck, "in.tetrasand")) if l.startswith("pair_coeff")]
-    return xyz, wall, dict(pair_coeff=pair)
+    return xyz, wall, dict(pair_coeff=pair, series=lammps_series(deck, len(xyz)))
 
 
 def save_json(path, data):
@@ -154,11 +173,10 @@ def plot(results, png):
     for n in names:
         if results[n].get("series"):
             t, a, _ = np.array(results[n]["series"]).T
-            pour_s = results[n]["grains"] / 1000.0
-            ax2.plot(t - pour_s, a, ".-", label=n)
-    ax2.set_xlabel("time after the pour's last release (s)")
+            ax2.plot(t, a, ".-", label=n)
+    ax2.set_xlabel("time (s); each series starts when its pour's last grain is in")
     ax2.set_ylabel("angle of repose (deg)")
-    ax2.set_title("angle against time (tetrasand runs)")
+    ax2.set_title("angle against time after the pour")
     ax2.legend(fontsize=7)
     fig.tight_layout()
     tmp = png + ".tmp.png"
@@ -214,8 +232,9 @@ def main():
         # Runs recorded before the series was added to tetrasand_run get it from their PLYs.
         for name, r in results.items():
             out = os.path.join(work, name)
-            if r["code"] == "tetrasand" and "series" not in r and os.path.isdir(out):
-                r["series"] = angle_series(out, r["grains"], r["grains"] / 1000.0)
+            if "series" not in r and os.path.isdir(out):
+                r["series"] = (angle_series(out, r["grains"], r["grains"] / 1000.0) if r["code"] == "tetrasand"
+                               else lammps_series(out, r["grains"]))
         save_json(path, results)
         plot(results, png)
     print("\n| run | code | change | angle (deg) | H (d) | wall (s) |\n|---|---|---|---|---|---|")
