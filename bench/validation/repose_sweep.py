@@ -91,7 +91,7 @@ def angle_series(out, grains, pour_s):
     times = np.atleast_1d(np.genfromtxt(os.path.join(out, "metrics.csv"), delimiter=",", names=True)["time_s"])
     series = []
     for t, ply in zip(times, plys):
-        if t >= pour_s:
+        if t >= pour_s and not (series and t == series[-1][0]):  # the last output and the final state may coincide
             xyz = read_ply_bodies(os.path.join(out, ply))[1][-grains:]
             series.append((float(t), repose_angle(xyz, RING), float(xyz[:, 2].max())))
     return series
