@@ -23,6 +23,8 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "peers"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from spring_heap import test_angle  # noqa: E402
 from sim_peers import centres, read_dump_frames, read_ply_bodies, repose_angle, run  # noqa: E402
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
@@ -143,6 +145,19 @@ def lammps_run(bin_dir, scene_file, deck):
     return xyz, wall, dict(pair_coeff=pair, series=lammps_series(deck, len(xyz)))
 
 
+def final_centres(out, code, grains):
+    if code == "lammps":
+        return read_dump_frames(os.path.join(out, "final.dump"))[-1][1]
+    plys = sorted(f for f in os.listdir(out) if f.startswith("particles_") and f.endswith(".ply"))
+    return read_ply_bodies(os.path.join(out, plys[-1]))[1][-grains:]
+
+
+def after_the_fact(xyz):
+    """Measures added after the runs (docs label them so): spring_heap's angle B (its bounding radius is
+    the touching grain's) and the mean grain-centre height."""
+    return dict(angle_b=test_angle(xyz), mean_height_m=float(xyz[:, 2].mean()))
+
+
 def save_json(path, data):
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
@@ -223,6 +238,7 @@ def main():
             sys.exit(f"repose_sweep: {name}: {len(xyz)} grains in the final state, {grains} expected")
         angle = repose_angle(xyz, RING)
         height = float(xyz[:, 2].max())
+        info.update(after_the_fact(xyz))
         results[name] = dict(code=code, edits=edits, start=start, load_start=load, load_end=os.getloadavg(),
                              wall_s=wall, angle=angle, height_m=height, height_d=height / D_EQ, grains=grains, **info)
         save_json(path, results)
@@ -232,16 +248,19 @@ def main():
         # Runs recorded before the series was added to tetrasand_run get it from their PLYs.
         for name, r in results.items():
             out = os.path.join(work, name)
+            if "angle_b" not in r and os.path.isdir(out):
+                r.update(after_the_fact(final_centres(out, r["code"], r["grains"])))
             if "series" not in r and os.path.isdir(out):
                 r["series"] = (angle_series(out, r["grains"], r["grains"] / 1000.0) if r["code"] == "tetrasand"
                                else lammps_series(out, r["grains"]))
         save_json(path, results)
         plot(results, png)
-    print("\n| run | code | change | angle (deg) | H (d) | wall (s) |\n|---|---|---|---|---|---|")
+    print("\n| run | code | change | angle (deg) | angle B (deg) | H (d) | wall (s) |\n|---|---|---|---|---|---|---|")
     for name in RUNS:
         if name in results:
             r = results[name]
-            print(f"| {name} | {r['code']} | {r['edits'] or '-'} | {r['angle']:.1f} | {r['height_d']:.1f} | "
+            b = f"{r['angle_b']:.1f}" if "angle_b" in r else "-"
+            print(f"| {name} | {r['code']} | {r['edits'] or '-'} | {r['angle']:.1f} | {b} | {r['height_d']:.1f} | "
                   f"{r['wall_s']:.0f} |")
 
 
