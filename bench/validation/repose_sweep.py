@@ -49,6 +49,8 @@ RUNS = {
     "lammps_spring": ("lammps", {"tangential": "spring"}),
     # Added after run 1 (criteria, addendum): the baseline with 3 s more at rest.
     "base_long": ("tetrasand", {"rest": 4.0}),
+    # Added after gamma_s10 (criteria, addendum 2): the baseline at gamma_s10's automatic step.
+    "base_dt_g10": ("tetrasand", {"dt": 6.0033156060896112e-05}),
 }
 
 
@@ -71,6 +73,8 @@ def scene_text(edits):
     t = replace_once(t, "rate = 400.0", "rate = 1000.0")
     t = replace_once(t, "size = [0.3, 0.3]", "size = [0.8, 0.8]")
     sim = f'duration = {pour_s + rest_s}\nintegrator = "symplectic"\n'
+    if "dt" in edits:
+        sim += f'dt = {edits["dt"]!r}\n'
     if "tangential" in edits:
         sim += f'tangential = "{edits["tangential"]}"\n'
     t = replace_once(t, "duration = 1.6\n", sim)
