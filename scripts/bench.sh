@@ -34,10 +34,11 @@
 #               bench/validation/oedometer_criteria.md -> its section of docs/validation.md and
 #               docs/validation/oedometer.png                           (~30 min, CPU reference, 2 cores)
 #   repose      repose magnitude (issue 18): the 3,000-grain mu = 0.5 heap with one factor changed per run
-#               (thesis gamma_s, grain edge / radius, spring friction, mu, seed, 6,000 grains) and on LAMMPS
+#               (thesis gamma_s, grain edge / radius, spring friction, mu, seed, 6,000 grains, 3 s more at rest,
+#               the time step) and on LAMMPS
 #               through `export lammps`, against bench/validation/repose_criteria.md
 #               -> docs/validation/repose_sweep.png and the table for its section of docs/validation.md
-#               (~60-90 min, CPU reference, 2 shared cores)
+#               (~2 h on 2 shared cores: 12 pours, CPU reference and LAMMPS serial)
 #   agreement   GPU pipeline against the CPU reference on the heap, the small silo and the bed
 #               -> its section of docs/validation.md                    (~30 min on llvmpipe, 2 cores)
 #   sdf         SDF construction three ways per mesh and grid in one run: GPU scan conversion, CPU exact

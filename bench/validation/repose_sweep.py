@@ -46,7 +46,6 @@ RUNS = {
     "edge1.5": ("tetrasand", {"edge": 1.5}),
     "grains6000": ("tetrasand", {"grains": 6000}),
     "lammps_gamma_s10": ("lammps", {"gamma_s": 10.0}),
-    "lammps_spring": ("lammps", {"tangential": "spring"}),
     # Added after run 1 (criteria, addendum): the baseline with 3 s more at rest.
     "base_long": ("tetrasand", {"rest": 4.0}),
     # Added after gamma_s10 (criteria, addendum 2): the baseline at gamma_s10's automatic step.
