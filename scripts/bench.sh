@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
-# Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|agreement|all]
+# Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all]
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
 #               its section of docs/benchmarks.md (--quick: knot1 and armadillo at 64^3 and 128^3, 1,000
@@ -33,6 +33,12 @@
 #               unloaded by a servo piston, and the same with sphere grains, against the criteria of
 #               bench/validation/oedometer_criteria.md -> its section of docs/validation.md and
 #               docs/validation/oedometer.png                           (~30 min, CPU reference, 2 cores)
+#   repose      repose magnitude (issue 18): the 3,000-grain mu = 0.5 heap with one factor changed per run
+#               (thesis gamma_s, grain edge / radius, spring friction, mu, seed, 6,000 grains, 3 s more at rest,
+#               the time step) and on LAMMPS
+#               through `export lammps`, against bench/validation/repose_criteria.md
+#               -> docs/validation/repose_sweep.png and the table for its section of docs/validation.md
+#               (~2 h on 2 shared cores: 12 pours, CPU reference and LAMMPS serial)
 #   agreement   GPU pipeline against the CPU reference on the heap, the small silo and the bed
 #               -> its section of docs/validation.md                    (~30 min on llvmpipe, 2 cores)
 #   sdf         SDF construction three ways per mesh and grid in one run: GPU scan conversion, CPU exact
@@ -67,7 +73,7 @@ while [ $# -gt 0 ]; do
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in peers|sdf|sparse|sample|certificate|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|agreement|all) ;;
+case "$what" in peers|sdf|sparse|sample|certificate|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all) ;;
   *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;;
 esac
 [ "$quick" -eq 1 ] && sdf_cases="knot1@64,128 armadillo@64,128"
@@ -142,6 +148,10 @@ if runs oedometer; then
   wait "$tetrahedra"
   "$py" "$root/bench/validation/oedometer.py" "$work/oedometer" "$root/docs" >/dev/null
   echo "bench: wrote the oedometer section of docs/validation.md and docs/validation/oedometer.png"
+fi
+if runs repose; then
+  "$py" "$root/bench/validation/repose_sweep.py" "$bin" "$work/repose" --plot "$root/docs/validation/repose_sweep.png"
+  echo "bench: wrote docs/validation/repose_sweep.png; the table above goes into the repose-magnitude section of docs/validation.md"
 fi
 if runs agreement; then
   "$bin/tetrasand_validation_runs" "$work/agreement" agreement

@@ -627,6 +627,8 @@ AGREEMENT_START, AGREEMENT_END = "<!-- section: agreement -->\n", "<!-- end: agr
 OEDOMETER_START, OEDOMETER_END = "<!-- section: oedometer -->\n", "<!-- end: oedometer -->\n"  # bench/validation/oedometer.py
 # The bidisperse bed against LAMMPS: written by hand from its test (tests/sim/export_lammps_test.cpp).
 BIDISPERSE_START, BIDISPERSE_END = "<!-- section: bidisperse -->\n", "<!-- end: bidisperse -->\n"
+# Repose magnitude (issue 18): written by hand from `scripts/bench.sh repose` (bench/validation/repose_sweep.py).
+REPOSE_SWEEP_START, REPOSE_SWEEP_END = "<!-- section: repose-sweep -->\n", "<!-- end: repose-sweep -->\n"
 
 
 def main():
@@ -653,6 +655,7 @@ def main():
 
     parts = [section(restitution, ["restitution.csv"], "Restitution against impact speed"),
              section(repose, ["repose.csv"], "Angle of repose against friction"),
+             kept(REPOSE_SWEEP_START, REPOSE_SWEEP_END, "scripts/bench.sh repose"),
              section(column, ["column.csv"], "Column collapse: runout against aspect ratio"),
              section(silo, ["silo.csv", "silo_fill.csv"], "Silo discharge against orifice diameter (Beverloo)"),
              section(forces, ["contact_forces.csv", "silo_fill.csv"],
