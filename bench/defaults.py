@@ -29,7 +29,7 @@ from docs_section import replace_between  # noqa: E402
 DEFAULT_STYLE = dict(marker="*", s=260, color="gold", edgecolor="black", zorder=5, label="default")
 TRADES = ("voxel", "band", "count", "radius-map")
 # `sample`'s default count and the sweep around it (bench/defaults_criteria.md, addendum).
-DEFAULT_COUNT = 4000
+DEFAULT_COUNT = 8000  # sampler/sample_mesh.cpp's kDefaultCount (4000 until the sweep of 2026-12-03 picked 8000)
 COUNTS = (1000, 2000, 4000, 8000, 16000)
 COUNT_MESHES = ("bunny", "trefoil", "knot1", "bear", "dino")
 CAVEATS_ALLOWED = ("dino",)  # its claws taper to 2.6 mm: no count of the sweep resolves them
@@ -287,10 +287,11 @@ def per_particle_radii(root):
 
 # ---- rules ---------------------------------------------------------------------------------------
 
-def count_rule(rows):
+def count_rule(rows, default_at_run=DEFAULT_COUNT):
     """The count bench/defaults_criteria.md's addendum picks: the smallest count of the sweep at which every
     mesh is body OK (those in CAVEATS_ALLOWED: no worse than caveats) and no larger count gives any mesh a
-    better verdict. Returns (count or None, evidence, met: the pick is DEFAULT_COUNT)."""
+    better verdict. Returns (count or None, evidence, met: the pick is DEFAULT_COUNT, the present default);
+    the evidence names the default the sweep ran against when it was another."""
     meshes = list(dict.fromkeys(r["mesh"] for r in rows))
     counts = sorted({r["count"] for r in rows})
     rank = {(r["mesh"], r["count"]): VERDICT_RANK[r["verdict"]] for r in rows}
@@ -305,7 +306,10 @@ def count_rule(rows):
     pick = picks[0] if picks else None
     letter = {2: "OK", 1: "caveats", 0: "not usable"}
     evidence = "; ".join(f"{m}: " + ", ".join(f"{c} {letter[rank[(m, c)]]}" for c in counts) for m in meshes)
-    evidence += f" (rule picks: {pick if pick else 'none'}; default {DEFAULT_COUNT})"
+    evidence += f" (rule picks: {pick if pick else 'none'}; default {DEFAULT_COUNT}"
+    if default_at_run != DEFAULT_COUNT:
+        evidence += f", changed from {default_at_run} after this run"
+    evidence += ")"
     return pick, evidence, pick == DEFAULT_COUNT
 
 
@@ -320,7 +324,8 @@ def radius_map_rule(row, body_radii, world_radii):
     return measures, body_radii and world_radii, evidence
 
 
-def verdicts(energy, restitution, trade, tsuji, voxels, bands, counts=None, radius_map=None, radii=(False, False)):
+def verdicts(energy, restitution, trade, tsuji, voxels, bands, counts=None, radius_map=None, radii=(False, False),
+             count_default_at_run=DEFAULT_COUNT):
     """(default, evidence, met) rows, each rule as bench/defaults_criteria.md states it."""
     v = []
     at1 = [r for r in restitution if r[0] == 1]
@@ -392,7 +397,7 @@ def verdicts(energy, restitution, trade, tsuji, voxels, bands, counts=None, radi
             notes.append(f"at {res}: band 3 / band 1 time {t:.2f}, peak GPU memory {m:.2f}, largest error {err:.1e} voxel")
         v.append(("`sdf --band 3`", "; ".join(notes) + " (rule: <= 1.5, <= 1.5, < 1e-3)", ok))
     if counts:
-        _, evidence, met = count_rule(counts)
+        _, evidence, met = count_rule(counts, count_default_at_run)
         v.append((f"`sample` count {DEFAULT_COUNT} (radius unset)", evidence, met))
     if radius_map:
         measures, end_to_end, evidence = radius_map_rule(radius_map, *radii)
@@ -493,8 +498,9 @@ def plot_counts(verdict_ax, time_ax, counts):
         time_ax.loglog([r["count"] for r in sel], [r["seconds"] for r in sel], "o-", label=mesh)
         d = [r for r in sel if r["count"] == DEFAULT_COUNT]
         if d:
-            verdict_ax.scatter([DEFAULT_COUNT], [VERDICT_RANK[d[0]["verdict"]] + shift], **DEFAULT_STYLE)
-            time_ax.scatter([DEFAULT_COUNT], [d[0]["seconds"]], **DEFAULT_STYLE)
+            star = {**DEFAULT_STYLE, "label": "_nolegend_"}
+            verdict_ax.scatter([DEFAULT_COUNT], [VERDICT_RANK[d[0]["verdict"]] + shift], **star)
+            time_ax.scatter([DEFAULT_COUNT], [d[0]["seconds"]], **star)
     verdict_ax.set_yticks([0, 1, 2])
     verdict_ax.set_yticklabels(["not usable", "caveats", "body OK"])
     verdict_ax.set_ylim(-0.5, 2.5)
@@ -513,11 +519,10 @@ def plot_radius_map(ax, m):
             ("two radii all\n(estimate)", m["two_radius_all"], True)]
     for i, (name, n, estimate) in enumerate(bars):
         ax.bar(i, n, color="tab:grey" if estimate else "tab:blue", hatch="//" if estimate else None)
-    ax.scatter([0], [m["default"]["n"]], **DEFAULT_STYLE)
     ax.set_yscale("log")
     ax.set_xticks(range(len(bars)))
     ax.set_xticklabels([b[0] for b in bars], fontsize=7)
-    ax.set(ylabel="particles", title="dino: what a radius map would cost")
+    ax.set(ylabel="particles", title=f"dino: what a radius map would cost (default body: {m['default']['n']})")
 
 
 # ---- the section ---------------------------------------------------------------------------------
@@ -567,7 +572,7 @@ def section(v, trades, runs):
     if counts:
         lines += count_table(counts)
     if radius_map:
-        lines += radius_map_table(radius_map)
+        lines += radius_map_table(radius_map, runs["radius-map"].get("default_count", DEFAULT_COUNT))
     return "\n".join(lines)
 
 
@@ -585,10 +590,11 @@ def count_table(counts):
     return lines + [""]
 
 
-def radius_map_table(m):
+def radius_map_table(m, default_count):
     d, s = m["default"], m["small"]
     return [
-        "A radius map on CGAL's dino (the global small radius: the smallest `mostly_resolving_radius` of the "
+        f"A radius map on CGAL's dino (a: the default body, radius unset, when the default count was {default_count}; "
+        "b: the smallest `mostly_resolving_radius` of the "
         f"{d['listed']} thin regions the report lists, {100 * d['listed_share']:.2f} % of the area of "
         f"{100 * d['thin_share']:.2f} % in {d['thin_regions']} regions; run b's time is one run):", "",
         "| body | radius (m) | particles | time s | verdict | thin share | thin regions |", "|---|---|---|---|---|---|---|",
@@ -598,9 +604,9 @@ def radius_map_table(m):
         f"{s['seconds']:.1f} | {s['verdict']} | {100 * s['thin_share']:.2f} % | {s['thin_regions']} |",
         f"| b'. global radius resolving every listed region (estimate: b x (r_b / r)^2) | {m['r_all']:.4g} | "
         f"{m['global_all_estimate']:.0f} | - | - | - | - |",
-        f"| c. two radii: b's on the thin area, a's elsewhere (estimate) | {s['radius']:.4g} / {d['radius']:.4g} | "
+        f"| c. two radii: b's radius on the thin area, a's elsewhere (estimate) | {s['radius']:.4g} / {d['radius']:.4g} | "
         f"{m['two_radius_most']:.0f} | - | - | - | - |",
-        f"| c'. two radii: b''s on the thin area, a's elsewhere (estimate) | {m['r_all']:.4g} / {d['radius']:.4g} | "
+        f"| c'. two radii: the radius of b' on the thin area, a's elsewhere (estimate) | {m['r_all']:.4g} / {d['radius']:.4g} | "
         f"{m['two_radius_all']:.0f} | - | - | - | - |", "",
         f"Area check against the mesh (areas summed from the .off file): surface {m['mesh_area']:.4g} m^2, so the "
         f"thin share is {m['thin_area']:.4g} m^2 and the listed regions' {m['listed_area']:.4g} m^2; the triangles "
@@ -666,7 +672,7 @@ def main():
     for trade in only:
         meta = dict(started=time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), node=platform.node(),
                     cores=os.cpu_count(), renderer=renderer, load_start=" ".join(f"{x:.2f}" for x in os.getloadavg()),
-                    repeats=args.repeats if trade in ("voxel", "band") else 1)
+                    repeats=args.repeats if trade in ("voxel", "band") else 1, default_count=DEFAULT_COUNT)
         if trade == "voxel":
             meshes = [("knot1", knot1)] if args.quick else [("knot1", knot1),
                                                             ("bunny", os.path.join(root, "assets", "bunny.obj"))]
@@ -685,7 +691,8 @@ def main():
         runs[trade] = meta
     energy, restitution, trade = energy_rows(doc), restitution_rows(doc), sampler_trade_rows(doc)
     v = verdicts(energy, restitution, trade, tsuji_spread(validation), trades.get("voxel"), trades.get("band"),
-                 trades.get("count"), trades.get("radius-map"), per_particle_radii(root))
+                 trades.get("count"), trades.get("radius-map"), per_particle_radii(root),
+                 runs.get("count", {}).get("default_count", DEFAULT_COUNT))
     v = [(n, e, tangential_documented(root) if m is None else m) for n, e, m in v]
     os.makedirs(os.path.join(args.docs, "benchmarks"), exist_ok=True)
     plot(energy, restitution, trade, trades.get("voxel"), trades.get("band"), trades.get("count"),

@@ -89,16 +89,18 @@ def counts(verdicts_by_mesh):
 
 OK, CAV, BAD = "body OK", "usable with caveats", "not usable"
 pick = defaults.count_rule(counts({"bunny": [CAV, OK, OK, OK, OK], "dino": [BAD, CAV, CAV, CAV, CAV]}))
-check(pick[0] == 2000 and pick[2] is False, "everything settled at 2000: the count rule picks 2000, not the default")
+check(pick[0] == 2000 and pick[2] is (defaults.DEFAULT_COUNT == 2000), "everything settled at 2000: the rule picks 2000")
 pick = defaults.count_rule(counts({"bunny": [CAV, CAV, OK, OK, OK], "dino": [BAD, CAV, CAV, CAV, CAV]}))
-check(pick[0] == 4000 and pick[2] is True, "the bunny OK from 4000, the dino caveats: the default 4000 is met")
-pick = defaults.count_rule(counts({"bunny": [CAV, CAV, OK, OK, OK], "dino": [BAD, CAV, CAV, OK, OK]}))
-check(pick[0] == 8000, "the dino OK from 8000: doubling buys a verdict, so the rule picks 8000")
+check(pick[0] == 4000, "the bunny OK from 4000, the dino caveats throughout: the rule picks 4000")
+pick = defaults.count_rule(counts({"bunny": [CAV, CAV, OK, OK, OK], "dino": [BAD, CAV, CAV, OK, OK]}), 4000)
+check(pick[0] == 8000 and pick[2] is (defaults.DEFAULT_COUNT == 8000) and "changed from 4000" in pick[1],
+      "the dino OK from 8000: doubling buys a verdict, so the rule picks 8000 (and names the run's default)")
 pick = defaults.count_rule(counts({"bunny": [CAV, CAV, OK, OK, OK], "knot1": [CAV] * 5}))
 check(pick[0] is None and pick[2] is False, "a mesh other than the dino never OK: no count meets the rule")
 pick = defaults.count_rule(counts({"bunny": [CAV, OK, OK, CAV, OK]}))
 check(pick[0] == 2000, "a worse verdict at a larger count does not block a smaller one")
-check(verdict(defaults.verdicts(energy, restitution, trade, tsuji, [], [], counts({"bunny": [CAV, CAV, OK, OK, OK]})),
+settles_at_default = [CAV if c < defaults.DEFAULT_COUNT else OK for c in defaults.COUNTS]
+check(verdict(defaults.verdicts(energy, restitution, trade, tsuji, [], [], counts({"bunny": settles_at_default})),
               "`sample` count") is True, "the count row of the verdicts follows the rule")
 
 
