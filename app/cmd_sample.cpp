@@ -333,6 +333,7 @@ void print_thin_features(const sampler::ThinFeatures& thin, double r) {
     fmt::print("                   and {} more regions ({:.2f} % of the area)\n",
                thin.regions.size() - listed, 100.0 * rest);
   }
+  fmt::print("                   {}\n", sampler::local_radius_advice());
 }
 
 nlohmann::json thin_features_json(const sampler::ThinFeatures& thin) {

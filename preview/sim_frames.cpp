@@ -136,10 +136,9 @@ Camera SimFrameWriter::follow(const sim::World& world) {
   Aabb box;
   box.extend(centre - Eigen::Vector3d::Constant(reach));
   box.extend(centre + Eigen::Vector3d::Constant(reach));
-  return frame_box(box, view_direction(settings_.view, settings_.camera.up),
-                   view_image_up(settings_.view, settings_.camera.up),
-                   static_cast<double>(settings_.camera.width) / settings_.camera.height, false,
-                   settings_.camera.fov);
+  return frame_box(box, view_direction(settings_.azimuth, settings_.elevation, settings_.camera.up),
+                   settings_.camera.up, static_cast<double>(settings_.camera.width) / settings_.camera.height,
+                   false, settings_.camera.fov);
 }
 
 Camera SimFrameWriter::camera_for(const sim::World& world, const Aabb& grains) {
@@ -154,10 +153,10 @@ Camera SimFrameWriter::camera_for(const sim::World& world, const Aabb& grains) {
     wanted.extend(b.max);
   }
   framed_ = framed_ ? widen_at_once_narrow_slowly(*framed_, wanted, settings_.narrowing) : wanted;
-  return frame_box(*framed_, view_direction(settings_.view, settings_.camera.up),
-                   view_image_up(settings_.view, settings_.camera.up),
-                   static_cast<double>(settings_.camera.width) / settings_.camera.height, false,
-                   settings_.camera.fov);
+  return frame_box_tightly(
+      *framed_, view_direction(settings_.azimuth, settings_.elevation, settings_.camera.up),
+      settings_.camera.up, static_cast<double>(settings_.camera.width) / settings_.camera.height,
+      settings_.camera.fov, settings_.margin);
 }
 
 Aabb SimFrameWriter::grain_box(const sim::World& world, const Particles& particles) const {

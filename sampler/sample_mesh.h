@@ -34,7 +34,7 @@ enum class SdfBackend { Auto, Gpu, Cpu };
 inline constexpr std::size_t kCpuSdfMaxVoxels = std::size_t{1} << 23;
 
 struct SampleSettings {
-  double radius = 0.0;         // particle radius r [m]; 0: from `count`, else about 4000 particles
+  double radius = 0.0;         // particle radius r [m]; 0: from `count`, else about 8000 particles
   std::size_t count = 0;       // particle count instead of a radius
   double coverage = 1.0;       // target covering radius / r: 1 = the spheres cover the whole surface
   double grain_radius = 0.0;   // grain radius [m] for the leak figure c / (r + r_grain); 0: not reported

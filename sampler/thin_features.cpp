@@ -136,6 +136,11 @@ std::string resolving_radii_text(const ThinRegion& region) {
                      region.resolving_radius > 0.0 ? "" : " (a knife edge or a sliver)");
 }
 
+std::string local_radius_advice() {
+  return "a smaller radius on these regions alone is not offered (a body has one particle radius; "
+         "docs/body-format.md, \"Thin features\"): a smaller --radius or a larger --count resolves them";
+}
+
 ThinFeatures find_thin_features(const TriangleMesh& mesh, const sdf::ExactDistance& exact, double spacing,
                                 double radius) {
   const sdf::Pseudonormals& pn = exact.pseudonormals();

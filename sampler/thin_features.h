@@ -56,4 +56,9 @@ ThinFeatures find_thin_features(const TriangleMesh& mesh, const sdf::ExactDistan
 // of it", or that no radius does where its thinnest triangle passes at no spacing (a knife edge).
 std::string resolving_radii_text(const ThinRegion& region);
 
+// The report's last word on thin features: a smaller radius on the thin regions alone (a radius map) is
+// not offered, since a body has one particle radius, and a smaller --radius or a larger --count
+// resolves them everywhere. docs/body-format.md ("Thin features") has the measurement behind it.
+std::string local_radius_advice();
+
 }  // namespace ts::sampler

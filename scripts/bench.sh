@@ -2,6 +2,7 @@
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
 # Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all]
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
+#                        [--only TRADES]
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
 #               its section of docs/benchmarks.md (--quick: knot1 and armadillo at 64^3 and 128^3, 1,000
 #               particles on three meshes, no sampler trade: under 2 min on 2 idle cores; default: 15 min on 2 idle
@@ -23,8 +24,10 @@
 #               (--quick: 1k and 10k only)                                    (~25 min on llvmpipe, 2 cores)
 #   defaults    every default (dt, integrator, precision, damping, friction model, sampler rounds,
 #               iterations and voxel, sdf band) against the trade tables and bench/defaults_criteria.md,
-#               with the sampler-voxel and sdf-band trades run anew (knot1, bunny)
-#               -> section defaults of docs/benchmarks.md, docs/benchmarks/defaults.png  (~5 min, 2 cores)
+#               with the sampler-voxel and sdf-band trades run anew (knot1, bunny), sample's default count
+#               (1,000-16,000 on five meshes) and what a radius map would buy on the dino
+#               (--only voxel,band,count,radius-map: run those, carry the others' last rows)
+#               -> section defaults of docs/benchmarks.md, docs/benchmarks/defaults.png  (~40 min, 2 cores)
 #   validation  restitution, angle of repose, column collapse (4 x 20,000 grains), Mankoc-sized silo
 #               discharge (80,000 grains) with a Beverloo fit, contact-force distribution (the silo's fill
 #               and 3 more 30,000-grain piles), on the CPU reference
@@ -63,6 +66,7 @@ do_build=1
 quick=0
 sdf_cases="knot1@64,128,256,512,1024 armadillo@64,128,256,512,1024 icosphere:8@64,128,256,512,1024"
 grains=1000,8000,64000,512000,1000000
+only=
 while [ $# -gt 0 ]; do
   case "$1" in
     --build-dir) build=$2; shift 2 ;;
@@ -70,6 +74,7 @@ while [ $# -gt 0 ]; do
     --quick) quick=1; shift ;;
     --cases) sdf_cases=$2; shift 2 ;;
     --grains) grains=$2; shift 2 ;;
+    --only) only=$2; shift 2 ;;
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -133,6 +138,7 @@ fi
 if runs defaults; then
   defaults_args=()
   [ "$quick" -eq 1 ] && defaults_args=(--quick --repeats 1)
+  [ -n "$only" ] && defaults_args+=(--only "$only")
   "$py" "$root/bench/defaults.py" "$bin/tetrasand" "$root/docs" --work "$work/defaults" "${defaults_args[@]}" || status=1
 fi
 if runs validation; then

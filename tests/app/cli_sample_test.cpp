@@ -297,6 +297,17 @@ TEST(CliSample, JsonNamesTheThinRegionsAndTheRadiusThatResolvesThem) {
   EXPECT_EQ(resolved.at("thin_features").at("triangles").get<int>(), 0) << resolved.at("thin_features");
 }
 
+// The text report on the thin plate names its region and says why no smaller radius on the region alone is
+// offered (docs/body-format.md, "Thin features": a body has one particle radius).
+TEST(CliSample, ThinFeatureReportSaysWhyNoLocalRadiusIsOffered) {
+  const std::string out =
+      sample_fast("sample " + quoted(test::asset("plate.obj")) + " -o " + quoted(test::temp_dir()), 0);
+  EXPECT_NE(out.find("thin features"), std::string::npos) << out;
+  EXPECT_NE(out.find("a smaller radius on these regions alone is not offered (a body has one particle radius"),
+            std::string::npos)
+      << out;
+}
+
 // --timings: the kernels' times and the round trips, none in the iterations between the checks.
 TEST(CliSample, TimingsReportNoRoundTripBetweenConvergenceChecks) {
   std::string out;

@@ -80,4 +80,40 @@ check(verdict(defaults.verdicts(energy, restitution, trade, tsuji, voxels(0.80, 
 check(verdict(defaults.verdicts(energy, restitution, trade, tsuji, voxels(0.75, 10.0, False), []), "sampler voxel") is False,
       "r / 2 not certified fails the voxel rule")
 
+
+
+def counts(verdicts_by_mesh):
+    """Count-sweep rows: {mesh: [verdict at 1000, 2000, 4000, 8000, 16000]}."""
+    return [dict(mesh=m, count=c, verdict=v) for m, vs in verdicts_by_mesh.items() for c, v in zip(defaults.COUNTS, vs)]
+
+
+OK, CAV, BAD = "body OK", "usable with caveats", "not usable"
+pick = defaults.count_rule(counts({"bunny": [CAV, OK, OK, OK, OK], "dino": [BAD, CAV, CAV, CAV, CAV]}))
+check(pick[0] == 2000 and pick[2] is (defaults.DEFAULT_COUNT == 2000), "everything settled at 2000: the rule picks 2000")
+pick = defaults.count_rule(counts({"bunny": [CAV, CAV, OK, OK, OK], "dino": [BAD, CAV, CAV, CAV, CAV]}))
+check(pick[0] == 4000, "the bunny OK from 4000, the dino caveats throughout: the rule picks 4000")
+pick = defaults.count_rule(counts({"bunny": [CAV, CAV, OK, OK, OK], "dino": [BAD, CAV, CAV, OK, OK]}), 4000)
+check(pick[0] == 8000 and pick[2] is (defaults.DEFAULT_COUNT == 8000) and "changed from 4000" in pick[1],
+      "the dino OK from 8000: doubling buys a verdict, so the rule picks 8000 (and names the run's default)")
+pick = defaults.count_rule(counts({"bunny": [CAV, CAV, OK, OK, OK], "knot1": [CAV] * 5}))
+check(pick[0] is None and pick[2] is False, "a mesh other than the dino never OK: no count meets the rule")
+pick = defaults.count_rule(counts({"bunny": [CAV, OK, OK, CAV, OK]}))
+check(pick[0] == 2000, "a worse verdict at a larger count does not block a smaller one")
+settles_at_default = [CAV if c < defaults.DEFAULT_COUNT else OK for c in defaults.COUNTS]
+check(verdict(defaults.verdicts(energy, restitution, trade, tsuji, [], [], counts({"bunny": settles_at_default})),
+              "`sample` count") is True, "the count row of the verdicts follows the rule")
+
+
+def radius_map(two, small=20000, default=4000):
+    return dict(default=dict(n=default), small=dict(n=small), two_radius_most=two)
+
+
+measures, end_to_end, _ = defaults.radius_map_rule(radius_map(4500), False, True)
+check(measures and not end_to_end, "a cheap two-radius body measures well, but not end to end without body radii")
+check(not defaults.radius_map_rule(radius_map(6000), True, True)[0], "30 % of the global radius's count: not well")
+check(not defaults.radius_map_rule(radius_map(17000, small=100000), True, True)[0], "over 4x the default: not well")
+v = defaults.verdicts(energy, restitution, trade, tsuji, [], [], None, radius_map(4500), (True, True))
+check(verdict(v, "no radius map") is False, "measuring well end to end: not offering it fails the rule")
+check(defaults.per_particle_radii(ROOT)[1] is True, "the sim's particles carry one radius each (sim/world.h)")
+
 sys.exit(1 if failures else 0)

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <numbers>
 
 #include "core/error.h"
@@ -59,10 +60,45 @@ TEST(Camera, FramingHoldsEveryCornerTightly) {
         const Camera c = frame_box(box, view_direction(v, up), view_image_up(v, up), aspect, ortho, 30.0);
         const double extent = extent_in_view(c, box, aspect);
         // The margin (1.08) is on the distance for a pinhole, on the height for a parallel lens.
-        EXPECT_LE(extent, ortho ? 1.0 / 1.08 + 1e-9 : 1.0) << ortho << " " << static_cast<int>(v) << " " << aspect;
+        EXPECT_LE(extent, ortho ? 1.0 / 1.08 + 1e-9 : 1.0)
+            << ortho << " " << static_cast<int>(v) << " " << aspect;
         EXPECT_GT(extent, 0.8) << ortho << " " << static_cast<int>(v) << " " << aspect;
       }
     }
+  }
+}
+
+TEST(Camera, AzimuthAndElevationGiveTheNamedViews) {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  EXPECT_TRUE(view_direction(0.0, 0.0, z).isApprox(view_direction(View::Front, z)));
+  EXPECT_TRUE(view_direction(90.0, 0.0, z).isApprox(view_direction(View::Side, z)));
+  EXPECT_TRUE(view_direction(45.0, std::atan(1.0 / std::sqrt(2.0)) * 180.0 / std::numbers::pi, z)
+                  .isApprox(view_direction(View::Iso, z)));
+  EXPECT_NEAR(view_direction(30.0, 30.0, z).z(), 0.5, 1e-12);  // sin 30 degrees above the horizon
+}
+
+// The tight fit holds every corner and touches the image's edge on both sides of its binding axis, where
+// frame_box, centred on the box, leaves the far side of a perspective view short of the edge.
+TEST(Camera, TightFramingTouchesBothEdgesOfItsBindingAxis) {
+  const Aabb box = test_box();
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  for (double aspect : {1.0, 4.0 / 3.0, 0.5}) {
+    const Camera c = frame_box_tightly(box, view_direction(30.0, 30.0, up), up, aspect, 30.0, 1.0);
+    const ViewMatrices m = view_matrices(c, aspect, box.center(), 0.5 * box.size().norm());
+    Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector3d p(i & 1 ? box.max.x() : box.min.x(), i & 2 ? box.max.y() : box.min.y(),
+                              i & 4 ? box.max.z() : box.min.z());
+      const Eigen::Vector3d ndc = project(m, p);
+      lo = lo.cwiseMin(ndc.head<2>()), hi = hi.cwiseMax(ndc.head<2>());
+    }
+    EXPECT_GE(lo.minCoeff(), -1.0 - 1e-9) << aspect;
+    EXPECT_LE(hi.maxCoeff(), 1.0 + 1e-9) << aspect;
+    const bool x_binds = hi.x() - lo.x() > hi.y() - lo.y();
+    EXPECT_NEAR(x_binds ? lo.x() : lo.y(), -1.0, 1e-9) << aspect;
+    EXPECT_NEAR(x_binds ? hi.x() : hi.y(), 1.0, 1e-9) << aspect;
+    // The other axis centred.
+    EXPECT_NEAR(x_binds ? lo.y() + hi.y() : lo.x() + hi.x(), 0.0, 1e-9) << aspect;
   }
 }
 
