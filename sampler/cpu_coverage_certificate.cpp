@@ -31,7 +31,7 @@ constexpr double kMaxCell = 1 << 29;
 
 using Corners = std::array<Eigen::Vector3d, 3>;
 
-// One set of centres and a radius, and the margins that make float-free double arithmetic a proof.
+// One set of centres and a radius, and the margins that make double arithmetic a proof.
 struct Frame {
   double radius = 0.0;       // m, tested
   double extent = 0.0;       // m, largest distance of a vertex or centre from the local origin
