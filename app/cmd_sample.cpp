@@ -207,8 +207,9 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
       ->capture_default_str();
   cmd->add_option(
          "--backend", o.backend,
-         "Where the relaxation runs: gpu (compute kernels), cpu (the same algorithm on all cores) or "
-         "auto (cpu on a software renderer, else gpu)")
+         "Where the relaxation and the coverage certificate run: gpu (compute kernels), cpu (the same "
+         "algorithms on all cores; with --sdf-backend auto or cpu and no --preview, no GL context at all) "
+         "or auto (cpu on a software renderer, else gpu)")
       ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
       ->capture_default_str();
   cmd->add_option(
@@ -367,7 +368,7 @@ nlohmann::json thin_features_json(const sampler::ThinFeatures& thin) {
 
 // The GL device, or what ran without one.
 std::string device_name(const gpu::Context* context) {
-  return context ? context->summary() : std::string("no GL context (everything on the CPU)");
+  return context ? context->summary() : std::string("the CPU (no GL context)");
 }
 
 // Where the relaxation and the certificate ran, and why: "relaxation on the CPU, certificate on the
@@ -590,11 +591,9 @@ int run_batch(const Options& o, const std::vector<std::string>& meshes, gpu::Con
 }
 
 // Whether a run needs a GL context at all: auto asks the device what it is, the GPU paths and
-// --preview use it. The coverage certificate runs on the GPU until the CPU certifier is merged.
-bool needs_gl_context(const Options& o) {
-  (void)o;
-  return true;
-}
+// --preview use it. `--backend cpu` without them runs everything on the CPU, the SDF included
+// (--sdf-backend auto then means the exact CPU field), so it works where EGL does not.
+bool needs_gl_context(const Options& o) { return o.backend != "cpu" || o.sdf_backend == "gpu" || o.preview; }
 
 int run_sample(Options& o, const GlobalOptions& global) {
   if (o.inputs.empty() && o.list.empty()) throw Error(ExitCode::Usage, "sample: give at least one MESH or --list FILE");

@@ -18,6 +18,7 @@
 #include "core/log.h"
 #include "core/mass_properties.h"
 #include "gpu/host_sync.h"
+#include "sampler/cpu_coverage_certificate.h"
 #include "sampler/cpu_relaxer.h"
 #include "sampler/gpu_relaxer.h"
 #include "sampler/interior_fill.h"
@@ -362,10 +363,12 @@ class CertifierOf final : public Certifier {
   Impl impl_;
 };
 
-// The GPU certifier on both paths until the CPU one (branch cpu-cert) is merged.
+// The certificate follows the relaxation's backend: on the CPU (sampler/cpu_coverage_certificate.h,
+// double precision, TBB) wherever the relaxation runs there, for the same reasons.
 std::unique_ptr<Certifier> make_certifier(gpu::Context* context, const TriangleMesh& mesh,
                                           const SampleSettings& settings, SampleResult& result) {
-  result.certificate_on_cpu = false;
+  result.certificate_on_cpu = result.relax_on_cpu;
+  if (result.certificate_on_cpu) return std::make_unique<CertifierOf<CpuCoverageCertifier>>(mesh);
   return std::make_unique<CertifierOf<CoverageCertifier>>(
       needed_context(context, "the GPU coverage certificate"), mesh, settings.timings);
 }

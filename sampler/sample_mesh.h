@@ -34,11 +34,12 @@ namespace ts::sampler {
 enum class SdfBackend { Auto, Gpu, Cpu };
 inline constexpr std::size_t kCpuSdfMaxVoxels = std::size_t{1} << 23;
 
-// Where the relaxation runs: GL compute kernels (sampler/gpu_relaxer.h) or the same algorithm on the
-// CPU with TBB (sampler/cpu_relaxer.h). Auto: the CPU on a software renderer (llvmpipe runs the
-// kernels on the same cores, with a fixed cost per dispatch that small counts do not amortise and a
-// 128 MiB storage block that stops the sparse field of a 10^6-particle body; docs/benchmarks.md,
-// "sample fixed costs"), or when there is no GL context; the GPU otherwise.
+// Where the relaxation and the coverage certificate run: GL compute kernels (sampler/gpu_relaxer.h,
+// sampler/coverage_certificate.h) or the same algorithms on the CPU with TBB (sampler/cpu_relaxer.h,
+// sampler/cpu_coverage_certificate.h). Auto: the CPU on a software renderer (llvmpipe runs the kernels
+// on the same cores, with a fixed cost per dispatch that small counts do not amortise and a 128 MiB
+// storage block that stops the sparse field of a 10^6-particle body; docs/benchmarks.md, "sample
+// fixed costs"), or when there is no GL context; the GPU otherwise.
 enum class SampleBackend { Auto, Gpu, Cpu };
 
 struct SampleSettings {
@@ -128,7 +129,7 @@ struct SampleResult {
   std::size_t probes = 0;             // surface points of that pass (probe_count)
   bool sdf_on_cpu = false;            // the field came from the exact CPU path (SdfBackend)
   bool relax_on_cpu = false;          // the relaxation ran on the CPU (SampleBackend)
-  bool certificate_on_cpu = false;    // the coverage certificate ran on the CPU
+  bool certificate_on_cpu = false;    // the coverage certificate ran on the CPU (SampleBackend)
   StageSeconds stages;
   std::vector<std::string> warnings;
   FieldStats field;

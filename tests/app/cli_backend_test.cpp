@@ -217,13 +217,15 @@ TEST(CliSampleBackend, AutoRelaxesOnTheCpuOnASoftwareDeviceAndSaysSoOnTheDeviceL
   if (!device) GTEST_SKIP() << "EGL lists no software device";
   std::string out;
   ASSERT_EQ(run_sample(*device, "", &out), 0) << out;
-  EXPECT_TRUE(sample_backend(out).starts_with("relaxation on the CPU")) << out;
-  EXPECT_TRUE(sample_backend(out).ends_with(
-      "(auto: the GL device is a software renderer; --backend gpu forces the GPU)"))
+  EXPECT_EQ(
+      sample_backend(out),
+      "relaxation and certificate on the CPU (auto: the GL device is a software renderer; --backend gpu "
+      "forces the GPU)")
       << out;
-  ASSERT_EQ(run_sample(*device, "--backend auto -q --json", &out), 0) << out;
+  ASSERT_EQ(run_sample(*device, "--backend auto --json", &out), 0) << out;
   const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
   EXPECT_EQ(json.at("run").at("relax_backend"), "cpu") << out;
+  EXPECT_EQ(json.at("run").at("certificate_backend"), "cpu") << out;
   EXPECT_EQ(json.at("run").at("software_device"), true) << out;
 }
 
@@ -234,20 +236,35 @@ TEST(CliSampleBackend, BackendGpuForcesTheGpuRelaxationOnASoftwareDevice) {
   ASSERT_EQ(run_sample(*device, "--backend gpu --timings", &out), 0) << out;
   EXPECT_EQ(sample_backend(out), "relaxation and certificate on the GPU (--backend gpu)") << out;
   EXPECT_NE(out.find("sampler/relax.comp"), std::string::npos) << out;  // the kernels ran
-  ASSERT_EQ(run_sample(*device, "--backend gpu -q --json", &out), 0) << out;
+  ASSERT_EQ(run_sample(*device, "--backend gpu --json", &out), 0) << out;
   const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
   EXPECT_EQ(json.at("run").at("relax_backend"), "gpu") << out;
+  EXPECT_EQ(json.at("run").at("certificate_backend"), "gpu") << out;
 }
 
 TEST(CliSampleBackend, BackendCpuRelaxesOnTheCpuWithNoRoundTrip) {
   std::string out;
   ASSERT_EQ(run_sample("", "--backend cpu --timings", &out), 0) << out;
-  EXPECT_TRUE(sample_backend(out).starts_with("relaxation on the CPU")) << out;
-  EXPECT_TRUE(sample_backend(out).ends_with("(--backend cpu)")) << out;
+  EXPECT_EQ(sample_backend(out), "relaxation and certificate on the CPU (--backend cpu)") << out;
   EXPECT_EQ(out.find("sampler/relax.comp"), std::string::npos) << out;
   EXPECT_TRUE(std::regex_search(out, std::regex(R"(CPU relaxation \(\d+ threads\): \d+ iterations)"))) << out;
   EXPECT_TRUE(std::regex_search(out, std::regex(R"(relaxation iterations between checks \(\d+\) +0 )")))
       << out;
+}
+
+// --backend cpu opens no GL context: a device that does not exist stops auto and --backend gpu
+// (exit 3), not it; --preview still needs one.
+TEST(CliSampleBackend, BackendCpuRunsWithoutAGlContext) {
+  std::string out;
+  ASSERT_EQ(run_sample("--device 99 ", "--backend cpu", &out), 0) << out;
+  EXPECT_NE(out.find("  device           the CPU (no GL context): SDF by exact distance on the CPU"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("certificate      certified"), std::string::npos) << out;
+  for (const std::string flags : {"--backend auto", "--backend gpu", "--backend cpu --preview"}) {
+    EXPECT_EQ(run_sample("--device 99 ", flags, &out), 3) << flags << "\n" << out;
+    EXPECT_NE(out.find("device 99 does not exist"), std::string::npos) << flags << "\n" << out;
+  }
 }
 
 TEST(CliSampleBackend, BadBackendIsAUsageError) {
