@@ -33,12 +33,11 @@ def run_tetrasand(exe, mesh, count, backend, out, extra):
     load = float(open("/proc/loadavg").read().split()[0])
     body, seconds, _ = run_sample(exe, mesh, count, out, ["--backend", backend, *extra])
     points = read_ply_points(os.path.join(out, os.path.splitext(os.path.basename(mesh))[0] + ".particles.ply"))
-    cert = body["quality"].get("certificate") or {}
     return {"tool": f"tetrasand --backend {backend}", "seconds": seconds, "cpu_seconds": children_cpu() - cpu0,
             "load": load, "points": points, "radius": body["particle_radius"], "n": body["particle_count"],
             "iterations": body["quality"]["iterations"], "rounds": body["quality"]["injection_rounds"],
-            "converged": body["quality"]["converged"], "certified": cert.get("certified"),
-            "bound_over_r": cert.get("bound_over_r"), "relax_backend": body["run"].get("relax_backend"),
+            "converged": body["quality"]["converged"], "certified": body["quality"]["coverage_certified"],
+            "bound_over_r": body["quality"]["covering_bound_over_r"], "relax_backend": body["run"].get("relax_backend"),
             "certificate_backend": body["run"].get("certificate_backend"),
             "stages": {k: body["run"]["seconds"].get(k, 0.0) for k in STAGES}}
 
