@@ -421,8 +421,8 @@ void print_stage_table(const sampler::SampleResult& result, const CommandSeconds
       {"GPU context creation", c.context},
       {"mesh load and checks", c.load},
       {"plan: exact-distance tree, sizing, mass", t.plan},
-      {result.sdf_on_cpu ? "SDF: exact distance (CPU), NanoVDB, upload"
-                         : "SDF: scan conversion, NanoVDB, upload",
+      {fmt::format("SDF: {}, NanoVDB{}", result.sdf_on_cpu ? "exact distance (CPU)" : "scan conversion",
+                   result.relax_on_cpu ? "" : ", upload"),
        t.sdf},
       {"seeds, programs and buffers", t.setup},
       {"relaxation (all rounds)", t.relaxation},
