@@ -1,5 +1,6 @@
 // `tetrasand sample MESH...`: the main job. A closed mesh becomes a particle rigid body; many meshes
-// (or list files) make a batch with one GPU context, a summary CSV and --shard I/N.
+// (or list files) make a batch with one GPU context (none when nothing runs on the GPU), a summary CSV
+// and --shard I/N.
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <unistd.h>
@@ -8,6 +9,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -45,7 +47,7 @@ struct Options {
   bool json = false, allow_open = false, preview = false;
   std::vector<double> up{0.0, 0.0, 1.0};  // --preview's world up
   bool strict = false;                     // a body short of OK exits 1 (it is still written)
-  std::string sdf_backend = "auto";
+  std::string backend = "auto", sdf_backend = "auto";
   double context_seconds = 0.0;  // s, the GPU context's creation (once for a batch)
 };
 
@@ -204,14 +206,23 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
       ->check(positive())
       ->capture_default_str();
   cmd->add_option(
+         "--backend", o.backend,
+         "Where the relaxation and the coverage certificate run: gpu (compute kernels), cpu (the same "
+         "algorithms on all cores; with --sdf-backend auto or cpu and no --preview, no GL context at all) "
+         "or auto (cpu on a software renderer, else gpu)")
+      ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
+      ->capture_default_str();
+  cmd->add_option(
          "--sdf-backend", o.sdf_backend,
          "Where the SDF is built: gpu (scan conversion), cpu (exact distance, all cores) or auto (cpu on "
          "a software renderer for grids up to 2^23 voxels, else gpu)")
       ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
       ->capture_default_str();
-  cmd->add_option("--sdf-budget-mib", o.sdf_budget_mib,
-                  "Most GPU memory the sparse SDF may take [MiB]; a larger field stops the run (exit 1) with the "
-                  "particle count (or, with --voxel, the voxel) that fits")
+  cmd->add_option(
+         "--sdf-budget-mib", o.sdf_budget_mib,
+         "Most memory the sparse SDF may take [MiB] (GPU memory; host memory with the CPU relaxation); a "
+         "larger field stops the run (exit 1) with the particle count (or, with --voxel, the voxel) that "
+         "fits")
       ->check(positive())
       ->capture_default_str();
 }
@@ -263,7 +274,7 @@ TriangleMesh load_sample_mesh(const Options& o, sampler::SampleSettings& setting
   return mesh;
 }
 
-sampler::SampleResult sample_with_progress(gpu::Context& context, const TriangleMesh& mesh,
+sampler::SampleResult sample_with_progress(gpu::Context* context, const TriangleMesh& mesh,
                                            const sampler::SampleSettings& settings) {
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
   const auto progress = [&](const sampler::SampleProgress& p) {
@@ -356,14 +367,35 @@ nlohmann::json thin_features_json(const sampler::ThinFeatures& thin) {
           {"regions_not_listed", thin.regions.size() - regions.size()}};
 }
 
+// The GL device, or what ran without one.
+std::string device_name(const gpu::Context* context) {
+  return context ? context->summary() : std::string("the CPU (no GL context)");
+}
+
+// Where the relaxation and the certificate ran, and why: "relaxation on the CPU, certificate on the
+// GPU (auto: the GL device is a software renderer; --backend gpu forces the GPU)".
+std::string backend_text(const sampler::SampleResult& result, const Options& o) {
+  const auto device = [](bool cpu) { return cpu ? "CPU" : "GPU"; };
+  std::string text = result.relax_on_cpu == result.certificate_on_cpu
+                         ? fmt::format("relaxation and certificate on the {}", device(result.relax_on_cpu))
+                         : fmt::format("relaxation on the {}, certificate on the {}",
+                                       device(result.relax_on_cpu), device(result.certificate_on_cpu));
+  if (o.backend != "auto") return text + fmt::format(" (--backend {})", o.backend);
+  return text + (result.relax_on_cpu
+                     ? " (auto: the GL device is a software renderer; --backend gpu forces the GPU)"
+                     : " (auto: a hardware GL device)");
+}
+
 // The written body.json, and beside it what only this run knows: the verdict and the thin features.
 // What this run cost and where it ran: the device, the SDF's path, the probes and each stage's seconds.
 nlohmann::json run_json(const sampler::SampleResult& result, const CommandSeconds& c,
-                        const gpu::Context& context) {
+                        const gpu::Context* context) {
   const sampler::StageSeconds& t = result.stages;
-  return {{"device", context.summary()},
-          {"software_device", context.software()},
+  return {{"device", device_name(context)},
+          {"software_device", context ? nlohmann::json(context->software()) : nlohmann::json(nullptr)},
           {"sdf_backend", result.sdf_on_cpu ? "cpu" : "gpu"},
+          {"relax_backend", result.relax_on_cpu ? "cpu" : "gpu"},
+          {"certificate_backend", result.certificate_on_cpu ? "cpu" : "gpu"},
           {"probes", result.probes},
           {"certificate_passes", result.certificate_passes},
           {"seconds",
@@ -390,8 +422,8 @@ void print_stage_table(const sampler::SampleResult& result, const CommandSeconds
       {"GPU context creation", c.context},
       {"mesh load and checks", c.load},
       {"plan: exact-distance tree, sizing, mass", t.plan},
-      {result.sdf_on_cpu ? "SDF: exact distance (CPU), NanoVDB, upload"
-                         : "SDF: scan conversion, NanoVDB, upload",
+      {fmt::format("SDF: {}, NanoVDB{}", result.sdf_on_cpu ? "exact distance (CPU)" : "scan conversion",
+                   result.relax_on_cpu ? "" : ", upload"),
        t.sdf},
       {"seeds, programs and buffers", t.setup},
       {"relaxation (all rounds)", t.relaxation},
@@ -420,8 +452,8 @@ void print_json(const std::filesystem::path& json, const sampler::BodyVerdict& v
   fmt::print("{}\n", out.dump(one_line ? -1 : 2));  // a batch prints JSON Lines
 }
 
-void print_body_report(const Options& o, const sampler::SampleResult& result, const std::filesystem::path& json,
-                       const gpu::Context& context) {
+void print_body_report(const Options& o, const sampler::SampleResult& result,
+                       const std::filesystem::path& json, const gpu::Context* context) {
   const body::ParticleBody& body = result.body;
   const auto& q = body.quality;
   fmt::print("{} -> {}\n", o.mesh, json.string());
@@ -445,14 +477,15 @@ void print_body_report(const Options& o, const sampler::SampleResult& result, co
   fmt::print("  on the surface   largest |phi| = {:.2e} r\n", q.max_abs_phi_over_r);
   print_thin_features(result.thin, body.particle_radius);
   const sampler::StageSeconds& t = result.stages;
-  fmt::print("  device           {}: SDF {} {:.2f} s, relaxation {:.2f} s, certificate {:.2f} s\n",
-             context.summary(), result.sdf_on_cpu ? "by exact distance on the CPU" : "by GPU scan conversion",
-             t.sdf, t.relaxation, t.certificate);
+  fmt::print("  device           {}: SDF {} {:.2f} s, relaxation {:.2f} s, certificate {:.2f} s; {}\n",
+             device_name(context),
+             result.sdf_on_cpu ? "by exact distance on the CPU" : "by GPU scan conversion", t.sdf,
+             t.relaxation, t.certificate, backend_text(result, o));
   fmt::print(
       "  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {} (certificate {:.2f} s "
       "in {} passes, probes {:.2f} s)\n",
       q.iterations, q.injection_rounds, q.converged ? "converged" : "NOT converged", q.seconds,
-      context.summary(), result.certificate_seconds, result.certificate_passes, result.probe_seconds);
+      device_name(context), result.certificate_seconds, result.certificate_passes, result.probe_seconds);
   fmt::print("  mass properties  {:.6g} kg, volume {:.6g} m^3, centre of mass ({:.6g}, {:.6g}, {:.6g}) m, {}\n", body.mass,
              body.volume, body.center_of_mass.x(), body.center_of_mass.y(), body.center_of_mass.z(),
              body.mass_method == body::MassMethod::WindingCells
@@ -462,7 +495,7 @@ void print_body_report(const Options& o, const sampler::SampleResult& result, co
 
 // One mesh: sample, write the body (and its preview), report and judge it; `row` gets the batch
 // summary's figures. Returns the mesh's exit code: 1 under --strict when the verdict is short of OK.
-int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
+int convert_one(const Options& o, gpu::Context* context, BatchRow& row) {
   const auto start = std::chrono::steady_clock::now();
   const auto since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -474,6 +507,9 @@ int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
   settings.sdf_backend = o.sdf_backend == "cpu"   ? sampler::SdfBackend::Cpu
                          : o.sdf_backend == "gpu" ? sampler::SdfBackend::Gpu
                                                   : sampler::SdfBackend::Auto;
+  settings.backend = o.backend == "cpu"   ? sampler::SampleBackend::Cpu
+                     : o.backend == "gpu" ? sampler::SampleBackend::Gpu
+                                          : sampler::SampleBackend::Auto;
   const TriangleMesh mesh = load_sample_mesh(o, settings);
   seconds.load = since(start);
   sampler::SampleResult result =
@@ -510,7 +546,7 @@ int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
     const std::filesystem::path png = std::filesystem::path(o.output) / (name + ".preview.png");
     preview::BodyPreviewSettings look;
     look.up = Eigen::Vector3d(o.up[0], o.up[1], o.up[2]);
-    preview::write_body_preview(context, mesh, body, png, {o.mesh}, look);
+    preview::write_body_preview(*context, mesh, body, png, {o.mesh}, look);  // needs_gl_context: --preview
     log::info("preview: {}", png.string());
   }
   if (!o.json) fmt::print("verdict: {}: {}\n", row.verdict, fmt::join(verdict.reasons, "; "));
@@ -518,7 +554,7 @@ int convert_one(const Options& o, gpu::Context& context, BatchRow& row) {
 }
 
 // Every mesh of a batch, a failure a row of the summary; returns the first failure's exit code.
-int run_batch(const Options& o, const std::vector<std::string>& meshes, gpu::Context& context) {
+int run_batch(const Options& o, const std::vector<std::string>& meshes, gpu::Context* context) {
   std::vector<BatchRow> rows;
   std::set<std::string> names;
   int first_code = 0, short_of_ok = 0;
@@ -555,6 +591,11 @@ int run_batch(const Options& o, const std::vector<std::string>& meshes, gpu::Con
   return first_code;
 }
 
+// Whether a run needs a GL context at all: auto asks the device what it is, the GPU paths and
+// --preview use it. `--backend cpu` without them runs everything on the CPU, the SDF included
+// (--sdf-backend auto then means the exact CPU field), so it works where EGL does not.
+bool needs_gl_context(const Options& o) { return o.backend != "cpu" || o.sdf_backend == "gpu" || o.preview; }
+
 int run_sample(Options& o, const GlobalOptions& global) {
   if (o.inputs.empty() && o.list.empty()) throw Error(ExitCode::Usage, "sample: give at least one MESH or --list FILE");
   if (!(Eigen::Vector3d(o.up[0], o.up[1], o.up[2]).norm() > 0.0))
@@ -563,12 +604,13 @@ int run_sample(Options& o, const GlobalOptions& global) {
   o.batch = meshes.size() > 1 || !o.list.empty() || !o.shard.empty() || !o.summary.empty() ||
             (!o.inputs.empty() && o.inputs[0].rfind('@', 0) == 0);
   const auto start = std::chrono::steady_clock::now();
-  gpu::Context context(context_options(global));  // one context for the whole batch
+  std::unique_ptr<gpu::Context> context;  // one context for the whole batch, if any stage needs one
+  if (needs_gl_context(o)) context = std::make_unique<gpu::Context>(context_options(global));
   o.context_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (o.batch) return run_batch(o, meshes, context);
+  if (o.batch) return run_batch(o, meshes, context.get());
   o.mesh = meshes.front();
   BatchRow row;
-  return convert_one(o, context, row);
+  return convert_one(o, context.get(), row);
 }
 
 }  // namespace

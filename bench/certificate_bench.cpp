@@ -1,13 +1,17 @@
 // The coverage certificate against the probe pass on one body, side by side in one process: the
-// certificate (GPU, sampler/coverage_certificate.h) and the sampler's statistical pass (1M random
-// surface probes, CPU on all cores) on the particles as the body stores them, then an independent
-// probe check (10M probes, another seed) whose deepest point must never lie beyond the certified
-// bound, nor beyond r when the body is certified. Prints one JSON object (bench/certificate_bench.py
-// collects them into docs/benchmarks.md, section certificate). Exit 1 when the check fails.
+// certificate (GPU, sampler/coverage_certificate.h), its CPU twin (sampler/cpu_coverage_certificate.h,
+// all cores) and the sampler's statistical pass (1M random surface probes, CPU on all cores) on the
+// particles as the body stores them, then an independent probe check (10M probes, another seed)
+// whose deepest point must never lie beyond the certified bound, nor beyond r when the body is
+// certified; the two certificates must agree (same verdict, bounds within the floor of each other).
+// Prints one JSON object (bench/certificate_bench.py collects them into docs/benchmarks.md, section
+// certificate). Exit 1 when a check fails.
 //   tetrasand_bench_certificate MESH BODY.json [--probes N] [--independent N] [--seed S]
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -17,6 +21,7 @@
 #include "core/mesh_io.h"
 #include "gpu/context.h"
 #include "sampler/coverage_certificate.h"
+#include "sampler/cpu_coverage_certificate.h"
 #include "sampler/sampling_quality.h"
 
 namespace {
@@ -80,6 +85,29 @@ nlohmann::json certificate_figures(ts::gpu::Context& context, const ts::Triangle
           {"tiles_redone", c.tiles_redone}};
 }
 
+// The CPU certifier's figures and time, keyed "cpu_...".
+nlohmann::json cpu_certificate_figures(const ts::TriangleMesh& mesh,
+                                       const std::vector<Eigen::Vector3f>& centres, double r,
+                                       ts::sampler::CoverageCertificate* result) {
+  auto t = Clock::now();
+  ts::sampler::CpuCoverageCertifier certifier(mesh);
+  const double setup = since(t);
+  t = Clock::now();
+  *result = certifier.certify(centres, r);
+  const double seconds = since(t);
+  const ts::sampler::CoverageCertificate& c = *result;
+  return {{"cpu_certificate_s", seconds},
+          {"cpu_certificate_setup_s", setup},
+          {"cpu_certified", c.covered},
+          {"cpu_bound_over_r", c.covering_bound / r},
+          {"cpu_lower_over_r", c.covering_lower / r},
+          {"cpu_uncovered", c.uncovered},
+          {"cpu_uncovered_area", c.uncovered_area},
+          {"cpu_evaluated", c.evaluated},
+          {"cpu_levels", c.levels},
+          {"cpu_margin_over_r", c.margin / r}};
+}
+
 double probe_pass(const ts::TriangleMesh& mesh, const std::vector<Eigen::Vector3f>& centres,
                   std::size_t probes, std::uint64_t seed, double* seconds) {
   ts::sampler::CoverageSettings settings;
@@ -103,6 +131,8 @@ int main(int argc, char** argv) {
     const double r = body.particle_radius;
     ts::gpu::Context context;
     nlohmann::json out = certificate_figures(context, mesh, centres, r);
+    ts::sampler::CoverageCertificate cpu;
+    out.update(cpu_certificate_figures(mesh, centres, r, &cpu));
     double probe_s = 0.0, independent_s = 0.0;
     const double c_probes = probe_pass(mesh, centres, o.probes, o.seed, &probe_s);
     const double c_independent = probe_pass(mesh, centres, o.independent, o.seed + 1, &independent_s);
@@ -121,8 +151,21 @@ int main(int argc, char** argv) {
                        c_probes / r <= out["bound_over_r"].get<double>() &&
                        (!out["certified"].get<bool>() || c_independent <= r);
     out["criterion_holds"] = holds;
+    // Criterion 6 (bench/certificate_criteria.md): the CPU certificate gives the GPU's verdict, a bound
+    // within the floor (max(r, c) / 64, c at least either lower figure) plus both margins of the
+    // GPU's, and no probe lies beyond it, nor beyond r when it certifies.
+    const double gpu_bound = out["bound_over_r"].get<double>() * r;
+    const double c_at_least = std::max(out["lower_over_r"].get<double>() * r, cpu.covering_lower);
+    const double tolerance =
+        std::max(r, c_at_least) / 64.0 + out["margin_over_r"].get<double>() * r + cpu.margin;
+    out["cpu_bound_difference_over_floor"] = (cpu.covering_bound - gpu_bound) / (r / 64.0);
+    const bool cpu_agrees = cpu.covered == out["certified"].get<bool>() &&
+                            std::abs(cpu.covering_bound - gpu_bound) <= tolerance &&
+                            c_independent <= cpu.covering_bound && c_probes <= cpu.covering_bound &&
+                            (!cpu.covered || c_independent <= r);
+    out["cpu_agrees"] = cpu_agrees;
     fmt::print("{}\n", out.dump());
-    return holds ? 0 : 1;
+    return holds && cpu_agrees ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tetrasand_bench_certificate: %s\n", e.what());
     return 2;

@@ -8,13 +8,16 @@ tetrasand_bench_certificate runs, in one process on that body: the certificate (
 pass (CPU, all cores) side by side, and an independent 10M-probe check with another seed. Criteria
 (written before the runs: bench/certificate_criteria.md, quoted in docs/benchmarks.md): every probe lies
 within the certified bound, and no probe lies beyond r on a certified body; each body of a count given
-to --must-certify (default 200000) is certified. Exit status 1 when one fails.
+to --must-certify (default 200000) is certified; the CPU certifier (same process, all cores) gives the GPU's
+verdict and a bound within the floor of its bound (criterion 6). Exit status 1 when one fails.
 
 Usage: bench/certificate_bench.py --tetrasand build-release/bin/tetrasand [--mesh assets/bunny.obj]
        [--counts 1000 10000 100000 200000] [--must-certify 200000] [--independent 10000000] [--csv OUT.csv]
        [--markdown docs/benchmarks.md --command "scripts/bench.sh certificate"]
 --markdown rewrites the section certificate (between `<!-- section: certificate -->` and
 `<!-- end: certificate -->`) with this run's table and the reading in bench/certificate_notes.md;
+with --cpu-table-only it rewrites only the CPU-against-GPU table inside it (between
+`<!-- section: certificate-cpu -->` and `<!-- end: certificate-cpu -->`, `scripts/bench.sh certificate-cpu`);
 rows are printed and appended to the CSV as they come, so a stopped run keeps what it measured.
 """
 import argparse, csv, json, os, platform, re, subprocess, sys, tempfile, time
@@ -22,7 +25,9 @@ import argparse, csv, json, os, platform, re, subprocess, sys, tempfile, time
 FIELDS = ["mesh", "requested", "particles", "sample_s", "rounds", "sample_certificate_s", "sample_passes",
           "sample_probes_s", "certified", "bound_over_r", "lower_over_r", "probes_c_over_r", "independent_c_over_r",
           "certificate_s", "probes_s", "ratio", "evaluated", "uncovered", "levels", "tiles", "margin_over_r",
-          "criterion_holds"]
+          "criterion_holds", "cpu_certificate_s", "cpu_certified", "cpu_bound_over_r", "cpu_lower_over_r",
+          "cpu_evaluated", "cpu_uncovered", "cpu_levels", "cpu_bound_difference_over_floor", "cpu_agrees",
+          "cpu_over_gpu", "load1"]
 
 
 def run_sample(exe, mesh, count, out, extra):
@@ -62,6 +67,8 @@ def main():
     ap.add_argument("--csv")
     ap.add_argument("--markdown")
     ap.add_argument("--command", default="")
+    ap.add_argument("--cpu-table-only", action="store_true",
+                    help="with --markdown: rewrite only the CPU-against-GPU table of the section")
     args = ap.parse_args()
     bench = args.bench or os.path.join(os.path.dirname(os.path.abspath(args.tetrasand)), "tetrasand_bench_certificate")
     started = time.strftime("%Y-%m-%d")
@@ -75,12 +82,14 @@ def main():
     label = os.path.splitext(os.path.basename(args.mesh))[0]
     for count in args.counts:
         body, sample_s, cert_s, passes, probes_s = run_sample(args.tetrasand, args.mesh, count, tmp, args.sample_args.split())
+        load1 = open("/proc/loadavg").read().split()[0]  # just before the certificates and probes run
         b = run_bench(bench, args.mesh, body, args.independent)
         renderer = b["renderer"]
         rounds = json.load(open(body))["quality"]["injection_rounds"]
         row = {"mesh": label, "requested": count, "particles": b["particles"], "sample_s": sample_s, "rounds": rounds,
                "sample_certificate_s": cert_s, "sample_passes": passes, "sample_probes_s": probes_s,
-               "ratio": b["certificate_s"] / b["probes_s"], **{k: b[k] for k in FIELDS if k in b}}
+               "ratio": b["certificate_s"] / b["probes_s"], "cpu_over_gpu": b["cpu_certificate_s"] / b["certificate_s"],
+               "load1": float(load1), **{k: b[k] for k in FIELDS if k in b}}
         rows.append(row)
         print(json.dumps(row), f"(report: {tmp}/sample-{count}.log)", flush=True)
         if writer:
@@ -91,12 +100,17 @@ def main():
     ok = all(r["criterion_holds"] for r in rows)
     must = [r for r in rows if r["requested"] in args.must_certify]
     certified_ok = all(r["certified"] for r in must)
-    if args.markdown:
-        write_markdown(args, rows, started, load_start, renderer, ok, must, certified_ok)
+    cpu_ok = all(r["cpu_agrees"] for r in rows)
+    if args.markdown and args.cpu_table_only:
+        write_cpu_markdown(args, rows, started, load_start, renderer, cpu_ok)
+    elif args.markdown:
+        write_markdown(args, rows, started, load_start, renderer, ok, must, certified_ok, cpu_ok)
     print("criterion 1 holds for every body" if ok else "CRITERION 1 FAILED for some body", flush=True)
     if must:
         print("criterion 2 holds" if certified_ok else "CRITERION 2 FAILED: a body is not certified", flush=True)
-    return 0 if ok and certified_ok else 1
+    print("criterion 6 holds for every body" if cpu_ok else "CRITERION 6 FAILED: the CPU and GPU certificates "
+          "disagree on some body", flush=True)
+    return 0 if ok and certified_ok and cpu_ok else 1
 
 
 def table(rows, independent):
@@ -125,7 +139,65 @@ def verdicts(rows, ok, must, certified_ok):
     return f"This run: criterion 1 **{one}**; criterion 2 **{two}**."
 
 
-def write_markdown(args, rows, started, load_start, renderer, ok, must, certified_ok):
+def cpu_table(rows):
+    lines = ["| N | load (1 min) | GPU certificate s | CPU certificate s | CPU / GPU | 1M-probe pass s | CPU / probes "
+             "| certified GPU, CPU | bound c / r GPU, CPU | (CPU - GPU) / floor | lower c / r GPU, CPU "
+             "| sub-triangles GPU, CPU | levels GPU, CPU | agree |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    yes = lambda v: "yes" if v else "NO"
+    for r in rows:
+        lines.append(f"| {r['particles']} | {r['load1']:.2f} | {r['certificate_s']:.2f} | {r['cpu_certificate_s']:.2f} | "
+                     f"{r['cpu_over_gpu']:.2f} | {r['probes_s']:.2f} | {r['cpu_certificate_s'] / r['probes_s']:.2f} | "
+                     f"{yes(r['certified'])}, {yes(r['cpu_certified'])} | {r['bound_over_r']:.4f}, "
+                     f"{r['cpu_bound_over_r']:.4f} | {r['cpu_bound_difference_over_floor']:+.2f} | "
+                     f"{r['lower_over_r']:.4f}, {r['cpu_lower_over_r']:.4f} | {r['evaluated']}, {r['cpu_evaluated']} | "
+                     f"{r['levels']}, {r['cpu_levels']} | {yes(r['cpu_agrees'])} |")
+    return "\n".join(lines)
+
+
+def cpu_section(args, rows, started, load_start, load_end, renderer, cpu_ok):
+    return f"""<!-- section: certificate-cpu -->
+### The CPU certifier beside the GPU one
+
+`{args.command or 'bench/certificate_bench.py'}` ({started}) on {args.mesh}: on each body (made by
+`tetrasand sample --count N`), one process runs the GPU certificate, the CPU certifier
+(sampler/cpu_coverage_certificate.h, double precision, TBB on all cores) and the sampler's 1M-probe pass
+(CPU, all cores), one after the other. Machine {platform.node()} ({platform.machine()}, {os.cpu_count()} cores),
+GL renderer: {renderer}; load average {' '.join(load_start)} (1/5/15 min) at the start, {' '.join(load_end)} at the
+end, and the 1-minute figure just before each body's certificates in the table. Seconds are one run each, the
+certifier's set-up (triangle upload and shaders; the CPU's triangle copy) apart. "(CPU - GPU) / floor": the
+bounds' difference in floors r / 64.
+
+{cpu_criteria()}
+
+{verdict_6(cpu_ok)}
+
+{cpu_table(rows)}
+<!-- end: certificate-cpu -->"""
+
+
+def cpu_criteria():
+    """Criteria 6 and 7 as bench/certificate_criteria.md states them (from their heading on)."""
+    text = open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "certificate_criteria.md")).read()
+    return text[text.index("**Criteria for the CPU certifier"):].strip()
+
+
+def verdict_6(cpu_ok):
+    return f"This run: criterion 6 **{'holds for every body' if cpu_ok else 'FAILED'}**."
+
+
+def write_cpu_markdown(args, rows, started, load_start, renderer, cpu_ok):
+    here = os.path.dirname(os.path.abspath(__file__))
+    sys.path.insert(0, here)
+    from docs_section import replace_between
+    load_end = open("/proc/loadavg").read().split()[:3]
+    text = cpu_section(args, rows, started, load_start, load_end, renderer, cpu_ok)
+    inner = text.split("\n", 1)[1].rsplit("\n", 1)[0] + "\n"  # between the markers
+    replace_between(args.markdown, "<!-- section: certificate-cpu -->\n", "<!-- end: certificate-cpu -->", inner)
+    print(f"wrote the CPU certifier table of the certificate section of {args.markdown}")
+
+
+def write_markdown(args, rows, started, load_start, renderer, ok, must, certified_ok, cpu_ok):
     here = os.path.dirname(os.path.abspath(__file__))
     sys.path.insert(0, here)
     from docs_section import replace_between
@@ -142,7 +214,7 @@ Ratio = certificate time / 1M-probe pass time on the same body; "certificate in 
 time of all the certificate passes of that `sample` run (one per hole-closing round), against its
 total time in "sample s".
 
-{open(os.path.join(here, "certificate_criteria.md")).read().strip()}
+{open(os.path.join(here, "certificate_criteria.md")).read().split("**Criteria for the CPU certifier")[0].strip()}
 
 {verdicts(rows, ok, must, certified_ok)}
 
@@ -151,6 +223,7 @@ total time in "sample s".
     notes = os.path.join(here, "certificate_notes.md")
     if os.path.exists(notes):
         text += "\n" + open(notes).read()
+    text += "\n" + cpu_section(args, rows, started, load_start, load_end, renderer, cpu_ok) + "\n"
     replace_between(args.markdown, "<!-- section: certificate -->\n", "<!-- end: certificate -->\n", text)
     print(f"wrote the certificate section of {args.markdown}")
 

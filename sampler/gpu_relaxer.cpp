@@ -73,9 +73,8 @@ std::vector<gpu::HostSyncPhase> GpuRelaxer::round_trips() const {
           {"relaxation in all (uploads, band removals, results)", relax_syncs_, 0, ""}};
 }
 
-RelaxStats GpuRelaxer::relax(std::vector<Eigen::Vector3f>& positions, const RelaxSettings& settings,
-                             const std::function<void(int, std::size_t, double)>& progress,
-                             std::vector<std::uint8_t>* mobile) {
+RelaxStats GpuRelaxer::run(std::vector<Eigen::Vector3f>& positions, const RelaxSettings& settings,
+                           const RelaxProgress& progress, std::vector<std::uint8_t>* mobile) {
   if (!(settings.spacing > 0.0)) throw InputError("sampler spacing must be positive");
   if (mobile && mobile->size() != positions.size()) throw Error(ExitCode::Internal, "relax: mobile mask size");
   const gpu::HostSyncScope counted(relax_syncs_);

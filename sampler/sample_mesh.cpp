@@ -6,9 +6,11 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <random>
 #include <span>
+#include <variant>
 
 #include <tbb/parallel_for.h>
 
@@ -16,6 +18,9 @@
 #include "core/log.h"
 #include "core/mass_properties.h"
 #include "gpu/host_sync.h"
+#include "sampler/cpu_coverage_certificate.h"
+#include "sampler/cpu_relaxer.h"
+#include "sampler/gpu_relaxer.h"
 #include "sampler/interior_fill.h"
 #include "sampler/point_grid.h"
 #include "sampler/sampling_quality.h"
@@ -23,6 +28,7 @@
 #include "sampler/winding_solid.h"
 #include "sdf/exact_sdf.h"
 #include "sdf/grid.h"
+#include "sdf/host_field.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
 #include "sdf/settings.h"
@@ -234,18 +240,21 @@ SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& e
 // voxel that fits is h sqrt(bytes / budget), and with the voxel following the radius the particle
 // count that fits is N budget / bytes.
 [[noreturn]] void throw_over_budget(const sdf::GridSpec& spec, std::size_t bytes, std::size_t band_voxels,
-                                    const SamplingPlan& plan, const SampleSettings& settings) {
+                                    const SamplingPlan& plan, const SampleSettings& settings,
+                                    const char* where) {
   const double over = static_cast<double>(bytes) / static_cast<double>(settings.max_sdf_bytes);
   const std::string remedy =
       settings.voxel_size > 0.0
           ? fmt::format("a --voxel of at least {:.4g} m fits it", spec.voxel_size * std::sqrt(over))
           : fmt::format("about {:.0f} particles fit it", static_cast<double>(plan.z.count) / over);
-  throw InputError(fmt::format("the sparse SDF at voxel {:.4g} m ({} band voxels) needs {:.1f} MiB of GPU memory, above "
-                               "the budget of {} MiB (--sdf-budget-mib); {}, or raise the budget",
-                               spec.voxel_size, band_voxels, bytes / 1048576.0, settings.max_sdf_bytes >> 20, remedy));
+  throw InputError(fmt::format(
+      "the sparse SDF at voxel {:.4g} m ({} band voxels) needs {:.1f} MiB of {} memory, above "
+      "the budget of {} MiB (--sdf-budget-mib); {}, or raise the budget",
+      spec.voxel_size, band_voxels, bytes / 1048576.0, where, settings.max_sdf_bytes >> 20, remedy));
 }
 
-bool sdf_on_cpu(const gpu::Context& context, const sdf::GridSpec& spec, const SampleSettings& settings) {
+// Without a GL context the field can only come from the CPU.
+bool sdf_on_cpu(const gpu::Context* context, const sdf::GridSpec& spec, const SampleSettings& settings) {
   switch (settings.sdf_backend) {
     case SdfBackend::Cpu:
       return true;
@@ -254,12 +263,30 @@ bool sdf_on_cpu(const gpu::Context& context, const sdf::GridSpec& spec, const Sa
     case SdfBackend::Auto:
       break;
   }
-  return context.software() && spec.voxel_count() <= kCpuSdfMaxVoxels;
+  return context == nullptr || (context->software() && spec.voxel_count() <= kCpuSdfMaxVoxels);
+}
+
+bool relax_on_cpu(const gpu::Context* context, const SampleSettings& settings) {
+  switch (settings.backend) {
+    case SampleBackend::Cpu:
+      return true;
+    case SampleBackend::Gpu:
+      return false;
+    case SampleBackend::Auto:
+      break;
+  }
+  return context == nullptr || context->software();
+}
+
+gpu::Context& needed_context(gpu::Context* context, const char* stage) {
+  if (context == nullptr)
+    throw Error(ExitCode::Internal, fmt::format("sample_mesh: {} needs a GL context", stage));
+  return *context;
 }
 
 // The level set of the band in index space: by GPU scan conversion, or by exact distance on the CPU
 // (both signed by pseudonormals, as the relaxation expects).
-openvdb::FloatGrid::Ptr band_level_set(gpu::Context& context, const TriangleMesh& mesh,
+openvdb::FloatGrid::Ptr band_level_set(gpu::Context* context, const TriangleMesh& mesh,
                                        const sdf::ExactDistance& exact, const sdf::GridSpec& spec,
                                        const SampleSettings& settings, SampleResult& result) {
   FieldStats& f = result.field;
@@ -274,7 +301,8 @@ openvdb::FloatGrid::Ptr band_level_set(gpu::Context& context, const TriangleMesh
   scan.band = kBandVoxels;
   scan.index_space_grid = true;
   scan.timings = settings.timings;
-  const sdf::ScanConvertResult converted = sdf::scan_convert(context, mesh, normals, spec, scan);
+  const sdf::ScanConvertResult converted =
+      sdf::scan_convert(needed_context(context, "the GPU scan conversion"), mesh, normals, spec, scan);
   f.band_voxels = converted.stats.band_voxels;
   f.readback_bytes = converted.stats.readback_bytes;
   f.scan_peak_gpu_bytes = converted.stats.peak_gpu_bytes;
@@ -282,21 +310,69 @@ openvdb::FloatGrid::Ptr band_level_set(gpu::Context& context, const TriangleMesh
   return converted.grid;
 }
 
-// The SDF on the GPU for the relaxation: the band as an index-space level set (any voxel size), a
-// sparse NanoVDB field. The field's size is checked against the budget before it is uploaded; it
-// grows as the particle count (band voxels ~ area / voxel^2 ~ count).
-sdf::SparseField scan_field(gpu::Context& context, const TriangleMesh& mesh, const sdf::ExactDistance& exact,
-                            const sdf::GridSpec& spec, const SamplingPlan& plan,
-                            const SampleSettings& settings, SampleResult& result) {
+// The SDF for the relaxation: the band as an index-space level set (any voxel size), a sparse NanoVDB
+// field, uploaded for the GPU relaxation or kept on the host for the CPU's. The field's size is
+// checked against the budget first; it grows as the particle count (band voxels ~ area / voxel^2 ~ count).
+using RelaxField = std::variant<sdf::SparseField, sdf::HostField>;
+RelaxField make_field(gpu::Context* context, const TriangleMesh& mesh, const sdf::ExactDistance& exact,
+                      const sdf::GridSpec& spec, const SamplingPlan& plan, const SampleSettings& settings,
+                      SampleResult& result) {
   result.sdf_on_cpu = sdf_on_cpu(context, spec, settings);
   const openvdb::FloatGrid::Ptr grid = band_level_set(context, mesh, exact, spec, settings, result);
   sdf::NanoGrid nano = sdf::to_nanovdb(*grid);
   FieldStats& f = result.field;
   f.host_bytes = grid->memUsage() + nano.size();
-  if (nano.size() > settings.max_sdf_bytes) throw_over_budget(spec, nano.size(), f.band_voxels, plan, settings);
+  if (nano.size() > settings.max_sdf_bytes) {
+    throw_over_budget(spec, nano.size(), f.band_voxels, plan, settings, result.relax_on_cpu ? "host" : "GPU");
+  }
+  if (result.relax_on_cpu) return sdf::HostField(std::move(nano), spec, kBandVoxels);
+  needed_context(context, "the GPU relaxation");
   sdf::SparseField field(std::move(nano), spec, kBandVoxels);
   f.gpu_bytes = field.gpu_bytes();
   return field;
+}
+
+std::unique_ptr<ParticleRelaxer> make_relaxer(gpu::Context* context, RelaxField field, bool timings) {
+  if (auto* host = std::get_if<sdf::HostField>(&field)) return std::make_unique<CpuRelaxer>(std::move(*host));
+  return std::make_unique<GpuRelaxer>(*context, std::move(std::get<sdf::SparseField>(field)), timings);
+}
+
+// The coverage certificate on the device the backend chose, behind one call: every certifier takes
+// the particles as a body stores them and promises the same certificate (docs/coverage-certificate.md).
+class Certifier {
+ public:
+  virtual ~Certifier() = default;
+  virtual CoverageCertificate certify(std::span<const Eigen::Vector3f> centres, double radius,
+                                      const CertificateSettings& settings) = 0;
+  virtual std::string timing_report() = 0;
+};
+
+template <class Impl>
+class CertifierOf final : public Certifier {
+ public:
+  template <class... Args>
+  explicit CertifierOf(Args&&... args) : impl_(std::forward<Args>(args)...) {}
+  CoverageCertificate certify(std::span<const Eigen::Vector3f> centres, double radius,
+                              const CertificateSettings& settings) override {
+    return impl_.certify(centres, radius, settings);
+  }
+  std::string timing_report() override {
+    if constexpr (requires { impl_.timing_report(); }) return impl_.timing_report();
+    return {};
+  }
+
+ private:
+  Impl impl_;
+};
+
+// The certificate follows the relaxation's backend: on the CPU (sampler/cpu_coverage_certificate.h,
+// double precision, TBB) wherever the relaxation runs there, for the same reasons.
+std::unique_ptr<Certifier> make_certifier(gpu::Context* context, const TriangleMesh& mesh,
+                                          const SampleSettings& settings, SampleResult& result) {
+  result.certificate_on_cpu = result.relax_on_cpu;
+  if (result.certificate_on_cpu) return std::make_unique<CertifierOf<CpuCoverageCertifier>>(mesh);
+  return std::make_unique<CertifierOf<CoverageCertifier>>(
+      needed_context(context, "the GPU coverage certificate"), mesh, settings.timings);
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -335,7 +411,7 @@ struct Arrangement {
 // (sample_mesh.h step 4), until the certificate holds at the target radius or the round limit.
 class HoleClosing {
  public:
-  HoleClosing(GpuRelaxer& relaxer, CoverageCertifier& certifier, const sdf::ExactDistance& exact,
+  HoleClosing(ParticleRelaxer& relaxer, Certifier& certifier, const sdf::ExactDistance& exact,
               const sdf::GridSpec& spec, const SamplingPlan& plan, const SampleSettings& settings,
               const std::function<void(const SampleProgress&)>& progress)
       : relaxer_(relaxer),
@@ -419,8 +495,8 @@ class HoleClosing {
     return true;
   }
 
-  GpuRelaxer& relaxer_;
-  CoverageCertifier& certifier_;
+  ParticleRelaxer& relaxer_;
+  Certifier& certifier_;
   const sdf::ExactDistance& exact_;
   const sdf::GridSpec& spec_;
   const SamplingPlan& plan_;
@@ -444,9 +520,8 @@ struct CoverageFigures {
   double probe_seconds = 0.0;        // s
 };
 
-CoverageFigures measure_coverage_figures(CoverageCertifier& certifier, const TriangleMesh& mesh,
-                                         Arrangement& a, const SamplingPlan& plan,
-                                         const SampleSettings& settings) {
+CoverageFigures measure_coverage_figures(Certifier& certifier, const TriangleMesh& mesh, Arrangement& a,
+                                         const SamplingPlan& plan, const SampleSettings& settings) {
   CoverageFigures f;
   const std::vector<Eigen::Vector3f> stored = as_stored(a.particles);
   auto start = std::chrono::steady_clock::now();
@@ -560,7 +635,7 @@ body::ParticleBody::Quality measure_quality(const Arrangement& a, const Coverage
 
 // The --timings table of host-GPU round trips: the scan conversion, the relaxer's phases, and the
 // whole run since `start` (the certificate's passes and the rest).
-std::string round_trip_report(const gpu::HostSyncCounts& scan, const GpuRelaxer& relaxer,
+std::string round_trip_report(const gpu::HostSyncCounts& scan, const ParticleRelaxer& relaxer,
                               const gpu::HostSyncCounts& start) {
   std::vector<gpu::HostSyncPhase> phases{{"SDF scan conversion", scan, 0, ""}};
   for (gpu::HostSyncPhase& phase : relaxer.round_trips()) phases.push_back(std::move(phase));
@@ -579,7 +654,7 @@ std::size_t probe_count(std::size_t particles, const SampleSettings& settings) {
   return std::min(cap, wanted);
 }
 
-SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const SampleSettings& settings,
+SampleResult sample_mesh(gpu::Context* context, const TriangleMesh& mesh, const SampleSettings& settings,
                          const std::function<void(const SampleProgress&)>& progress) {
   const auto start = std::chrono::steady_clock::now();
   const gpu::HostSyncCounts syncs_at_start = gpu::host_sync_counts();
@@ -597,21 +672,22 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   stage(t.plan);
   // The field, and seeds spread over the surface.
   const sdf::GridSpec spec = choose_grid(mesh, plan.z.radius, settings);
-  sdf::SparseField field = scan_field(context, mesh, exact, spec, plan, settings, result);
+  result.relax_on_cpu = relax_on_cpu(context, settings);
+  RelaxField field = make_field(context, mesh, exact, spec, plan, settings, result);
   const gpu::HostSyncCounts scan_syncs = gpu::host_sync_counts() - syncs_at_start;
   stage(t.sdf);
   std::mt19937_64 rng(settings.seed);
   std::vector<Eigen::Vector3d> seeds = sample_surface_points(mesh, plan.z.count, rng).positions;
   // Relax and close holes.
-  GpuRelaxer relaxer(context, std::move(field), settings.timings);
-  CoverageCertifier certifier(context, mesh, settings.timings);
+  const std::unique_ptr<ParticleRelaxer> relaxer = make_relaxer(context, std::move(field), settings.timings);
+  const std::unique_ptr<Certifier> certifier = make_certifier(context, mesh, settings, result);
   stage(t.setup);
   Arrangement a =
-      HoleClosing(relaxer, certifier, exact, spec, plan, settings, progress).run(std::move(seeds));
+      HoleClosing(*relaxer, *certifier, exact, spec, plan, settings, progress).run(std::move(seeds));
   t.relaxation = a.relax_seconds, t.projection = a.projection_seconds, t.injection = a.injection_seconds;
   lap = std::chrono::steady_clock::now();
   // Measure and make the body.
-  CoverageFigures coverage = measure_coverage_figures(certifier, mesh, a, plan, settings);
+  CoverageFigures coverage = measure_coverage_figures(*certifier, mesh, a, plan, settings);
   t.certificate = coverage.certificate_seconds, t.probes = coverage.probe_seconds;
   result.probes = coverage.probes.probes;
   lap = std::chrono::steady_clock::now();
@@ -633,8 +709,8 @@ SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const 
   t.body -= t.thin_features;
   body.quality.seconds = seconds_since(start);
   if (settings.timings) {
-    result.timing_report += relaxer.timing_report() + certifier.timing_report();
-    result.timing_report += round_trip_report(scan_syncs, relaxer, syncs_at_start);
+    result.timing_report += relaxer->timing_report() + certifier->timing_report();
+    result.timing_report += round_trip_report(scan_syncs, *relaxer, syncs_at_start);
   }
   return result;
 }

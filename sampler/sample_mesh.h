@@ -3,9 +3,10 @@
 //   1. SDF by GPU scan conversion (or exact CPU distance: SdfBackend), voxel = r / 2 unless set
 //      (see SampleSettings::voxel_size);
 //   2. seeds spread area-uniformly with the injected seed, as many as the coverage target needs;
-//   3. GPU relaxation (attraction to the zero level set + Gaussian repulsion);
+//   3. relaxation (attraction to the zero level set + Gaussian repulsion) on the GPU or the CPU
+//      (SampleBackend; sampler/relaxer.h);
 //   4. exact projection onto the mesh, crowded pairs (closer than 0.6 spacing) thinned, coverage
-//      certified on the GPU (sampler/coverage_certificate.h), particles injected at the deepest
+//      certified (sampler/coverage_certificate.h), particles injected at the deepest
 //      uncovered points it proves; the first 3 rounds relax them with their neighbours (the rest
 //      frozen), later ones only place them, until the certificate holds or the round limit;
 //   5. quality figures: the certificate at radius r, and the covering radius over random surface
@@ -20,7 +21,7 @@
 #include "core/mesh.h"
 #include "gpu/context.h"
 #include "sampler/coverage_certificate.h"
-#include "sampler/gpu_relaxer.h"
+#include "sampler/relaxer.h"
 #include "sampler/thin_features.h"
 #include "sdf/settings.h"
 
@@ -32,6 +33,14 @@ namespace ts::sampler {
 // to grids of kCpuSdfMaxVoxels; docs/benchmarks.md, "sample fixed costs"), the GPU otherwise.
 enum class SdfBackend { Auto, Gpu, Cpu };
 inline constexpr std::size_t kCpuSdfMaxVoxels = std::size_t{1} << 23;
+
+// Where the relaxation and the coverage certificate run: GL compute kernels (sampler/gpu_relaxer.h,
+// sampler/coverage_certificate.h) or the same algorithms on the CPU with TBB (sampler/cpu_relaxer.h,
+// sampler/cpu_coverage_certificate.h). Auto: the CPU on a software renderer (llvmpipe runs the kernels
+// on the same cores, with a fixed cost per dispatch that small counts do not amortise and a 128 MiB
+// storage block that stops the sparse field of a 10^6-particle body; docs/benchmarks.md, "sample
+// fixed costs"), or when there is no GL context; the GPU otherwise.
+enum class SampleBackend { Auto, Gpu, Cpu };
 
 struct SampleSettings {
   double radius = 0.0;         // particle radius r [m]; 0: from `count`, else about 8000 particles
@@ -48,10 +57,12 @@ struct SampleSettings {
   std::size_t probes = 1'000'000;
   std::size_t probes_per_particle = 256;
   SdfBackend sdf_backend = SdfBackend::Auto;
+  SampleBackend backend = SampleBackend::Auto;
   // The coverage certificate that steers the rounds and is reported (floor: r / floor_divisor).
   CertificateSettings certificate;
   std::size_t max_particles = 20'000'000;
-  std::size_t max_sdf_bytes = 1ull << 30;  // sparse SDF budget on the GPU [bytes]: past it the run stops (exit 3)
+  // Sparse SDF budget [bytes], GPU memory (host memory on the CPU path): past it the run stops (exit 1).
+  std::size_t max_sdf_bytes = 1ull << 30;
   // Inside and outside (particle normals, thin features, interior fill): pseudonormals need a closed,
   // consistently oriented mesh; the generalised winding number also works on open or non-manifold
   // ones (normals then point to where the winding number drops).
@@ -82,8 +93,8 @@ std::size_t probe_count(std::size_t particles, const SampleSettings& settings);
 // Wall time of each stage of sample_mesh [s] (the --timings table and --json's "stages").
 struct StageSeconds {
   double plan = 0.0;           // validation, the exact-distance tree, sizing, mass properties
-  double sdf = 0.0;            // the field: scan conversion (or exact CPU distance), NanoVDB, upload
-  double setup = 0.0;          // seeds, the relaxer's and the certifier's programs and buffers
+  double sdf = 0.0;    // the field: scan conversion (or exact CPU distance), NanoVDB, upload (GPU path)
+  double setup = 0.0;  // seeds, the relaxer's and the certifier's programs and buffers (GPU path)
   double relaxation = 0.0;     // every relax() call, all rounds
   double projection = 0.0;     // exact projection and thinning, all rounds
   double certificate = 0.0;    // every certificate pass
@@ -117,13 +128,22 @@ struct SampleResult {
   double probe_seconds = 0.0;         // s, wall time of the statistical probe pass
   std::size_t probes = 0;             // surface points of that pass (probe_count)
   bool sdf_on_cpu = false;            // the field came from the exact CPU path (SdfBackend)
+  bool relax_on_cpu = false;          // the relaxation ran on the CPU (SampleBackend)
+  bool certificate_on_cpu = false;    // the coverage certificate ran on the CPU (SampleBackend)
   StageSeconds stages;
   std::vector<std::string> warnings;
   FieldStats field;
   std::string timing_report;
 };
 
-SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh, const SampleSettings& settings,
+// `context` may be null when no stage needs the GPU: SampleBackend Cpu or Auto (then the CPU), and
+// SdfBackend Cpu or Auto (then the exact CPU field); a GPU stage without one is an internal error.
+SampleResult sample_mesh(gpu::Context* context, const TriangleMesh& mesh, const SampleSettings& settings,
                          const std::function<void(const SampleProgress&)>& progress = {});
+inline SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh,
+                                const SampleSettings& settings,
+                                const std::function<void(const SampleProgress&)>& progress = {}) {
+  return sample_mesh(&context, mesh, settings, progress);
+}
 
 }  // namespace ts::sampler

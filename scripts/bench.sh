@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
-# Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all]
+# Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all]
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #                        [--only TRADES]
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
@@ -22,6 +22,10 @@
 #               100k and 200k particles, an independent 10M-probe check of each, and the criteria of
 #               bench/certificate_criteria.md -> section certificate of docs/benchmarks.md
 #               (--quick: 1k and 10k only)                                    (~25 min on llvmpipe, 2 cores)
+#               The CPU certifier runs beside the GPU one on each body (criterion 6: the same verdict,
+#               bounds within the floor), its table in the same section.
+#   certificate-cpu  only that CPU-against-GPU table, on bunny bodies of 1k, 10k and 100k particles
+#               (--quick: 1k and 10k) -> its part of section certificate      (~8 min on llvmpipe, 2 cores)
 #   defaults    every default (dt, integrator, precision, damping, friction model, sampler rounds,
 #               iterations and voxel, sdf band) against the trade tables and bench/defaults_criteria.md,
 #               with the sampler-voxel and sdf-band trades run anew (knot1, bunny), sample's default count
@@ -78,7 +82,7 @@ while [ $# -gt 0 ]; do
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in peers|sdf|sparse|sample|certificate|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all) ;;
+case "$what" in peers|sdf|sparse|sample|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all) ;;
   *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;;
 esac
 [ "$quick" -eq 1 ] && sdf_cases="knot1@64,128 armadillo@64,128"
@@ -134,6 +138,13 @@ if runs certificate; then
   (cd "$root" && "$py" bench/certificate_bench.py --tetrasand "$bin/tetrasand" --counts "${counts[@]}" \
     --csv "$work/certificate.csv" --markdown docs/benchmarks.md \
     --command "scripts/bench.sh certificate$([ "$quick" -eq 1 ] && echo ' --quick')") || status=1
+fi
+if [ "$what" = certificate-cpu ]; then  # not in `all`: the certificate run above makes the same table
+  counts=(1000 10000 100000)
+  [ "$quick" -eq 1 ] && counts=(1000 10000)
+  (cd "$root" && "$py" bench/certificate_bench.py --tetrasand "$bin/tetrasand" --counts "${counts[@]}" \
+    --must-certify --csv "$work/certificate-cpu.csv" --markdown docs/benchmarks.md --cpu-table-only \
+    --command "scripts/bench.sh certificate-cpu$([ "$quick" -eq 1 ] && echo ' --quick')") || status=1
 fi
 if runs defaults; then
   defaults_args=()

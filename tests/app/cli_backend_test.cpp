@@ -1,5 +1,5 @@
-// `--backend`: which engine `sim` and `sdf` run, chosen the way issue 16 asks ("the fastest path where
-// there is no GPU"): on a software GL device `sim` takes the CPU reference unless told otherwise and
+// `--backend`: which engine `sim`, `sdf` and `sample` run, chosen the way issue 16 asks ("the fastest path
+// where there is no GPU"): on a software GL device `sim` takes the CPU reference unless told otherwise and
 // says so in one line; `--backend gpu` forces the GPU pipeline, `--cpu` stays an alias of
 // `--backend cpu`, and bad combinations are usage errors (exit 2).
 #include <gtest/gtest.h>
@@ -8,6 +8,8 @@
 #include <optional>
 #include <regex>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
 #include "gpu/context.h"
@@ -194,6 +196,83 @@ TEST(SdfBackend, BadBackendAndCompareWithTheCpuPathAreRefused) {
       << out;
   EXPECT_NE(out.find("with --backend cpu the field is the exact one"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(dir / "a.vdb"));
+}
+
+// `sample` on the sphere, small and quick, with `flags`; the output in *out.
+int run_sample(const std::string& device, const std::string& flags, std::string* out) {
+  return test::run_tetrasand(device + "sample " + quoted(test::asset("sphere.obj")) + " -o " +
+                                 quoted(test::temp_dir()) + " --count 150 --probes 20000 --rounds 2 " + flags,
+                             out);
+}
+
+// The device line's tail: where the relaxation and the certificate ran, and why.
+std::string sample_backend(const std::string& out) {
+  static const std::regex line(R"(  device           .*certificate [0-9.]+ s; (.*)\n)");
+  std::smatch m;
+  return std::regex_search(out, m, line) ? m[1].str() : "(no device line)";
+}
+
+TEST(CliSampleBackend, AutoRelaxesOnTheCpuOnASoftwareDeviceAndSaysSoOnTheDeviceLine) {
+  const auto device = software_device();
+  if (!device) GTEST_SKIP() << "EGL lists no software device";
+  std::string out;
+  ASSERT_EQ(run_sample(*device, "", &out), 0) << out;
+  EXPECT_EQ(
+      sample_backend(out),
+      "relaxation and certificate on the CPU (auto: the GL device is a software renderer; --backend gpu "
+      "forces the GPU)")
+      << out;
+  ASSERT_EQ(run_sample(*device, "--backend auto --json", &out), 0) << out;
+  const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
+  EXPECT_EQ(json.at("run").at("relax_backend"), "cpu") << out;
+  EXPECT_EQ(json.at("run").at("certificate_backend"), "cpu") << out;
+  EXPECT_EQ(json.at("run").at("software_device"), true) << out;
+}
+
+TEST(CliSampleBackend, BackendGpuForcesTheGpuRelaxationOnASoftwareDevice) {
+  const auto device = software_device();
+  if (!device) GTEST_SKIP() << "EGL lists no software device";
+  std::string out;
+  ASSERT_EQ(run_sample(*device, "--backend gpu --timings", &out), 0) << out;
+  EXPECT_EQ(sample_backend(out), "relaxation and certificate on the GPU (--backend gpu)") << out;
+  EXPECT_NE(out.find("sampler/relax.comp"), std::string::npos) << out;  // the kernels ran
+  ASSERT_EQ(run_sample(*device, "--backend gpu --json", &out), 0) << out;
+  const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
+  EXPECT_EQ(json.at("run").at("relax_backend"), "gpu") << out;
+  EXPECT_EQ(json.at("run").at("certificate_backend"), "gpu") << out;
+}
+
+TEST(CliSampleBackend, BackendCpuRelaxesOnTheCpuWithNoRoundTrip) {
+  std::string out;
+  ASSERT_EQ(run_sample("", "--backend cpu --timings", &out), 0) << out;
+  EXPECT_EQ(sample_backend(out), "relaxation and certificate on the CPU (--backend cpu)") << out;
+  EXPECT_EQ(out.find("sampler/relax.comp"), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(CPU relaxation \(\d+ threads\): \d+ iterations)"))) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(relaxation iterations between checks \(\d+\) +0 )")))
+      << out;
+}
+
+// --backend cpu opens no GL context: a device that does not exist stops auto and --backend gpu
+// (exit 3), not it; --preview still needs one.
+TEST(CliSampleBackend, BackendCpuRunsWithoutAGlContext) {
+  std::string out;
+  ASSERT_EQ(run_sample("--device 99 ", "--backend cpu", &out), 0) << out;
+  EXPECT_NE(out.find("  device           the CPU (no GL context): SDF by exact distance on the CPU"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("certificate      certified"), std::string::npos) << out;
+  for (const std::string flags : {"--backend auto", "--backend gpu", "--backend cpu --preview"}) {
+    EXPECT_EQ(run_sample("--device 99 ", flags, &out), 3) << flags << "\n" << out;
+    EXPECT_NE(out.find("device 99 does not exist"), std::string::npos) << flags << "\n" << out;
+  }
+}
+
+TEST(CliSampleBackend, BadBackendIsAUsageError) {
+  std::string out;
+  EXPECT_EQ(run_sample("", "--backend tpu", &out), 2) << out;
+  EXPECT_NE(out.find("--backend"), std::string::npos) << out;
+  EXPECT_NE(out.find("tpu"), std::string::npos) << out;
+  EXPECT_EQ(out.find("certificate"), std::string::npos) << out;  // refused before any work
 }
 
 }  // namespace

@@ -308,11 +308,12 @@ TEST(CliSample, ThinFeatureReportSaysWhyNoLocalRadiusIsOffered) {
       << out;
 }
 
-// --timings: the kernels' times and the round trips, none in the iterations between the checks.
+// --timings: the kernels' times and the round trips, none in the iterations between the checks (the
+// GPU relaxation: auto relaxes on the CPU on a software renderer).
 TEST(CliSample, TimingsReportNoRoundTripBetweenConvergenceChecks) {
   std::string out;
   ASSERT_EQ(test::run_tetrasand("sample " + quoted(test::asset("sphere.obj")) + " -o " +
-                                    quoted(test::temp_dir()) + kFast + "--timings",
+                                    quoted(test::temp_dir()) + kFast + "--backend gpu --timings",
                                 &out),
             0)
       << out;

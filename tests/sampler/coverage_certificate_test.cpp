@@ -3,7 +3,8 @@
 // (an icosahedral set on a sphere: the exact maximum of the nearest-centre distance over each
 // triangle, from its Voronoi vertices), and against dense random sampling. The bound must never be
 // below the exact value (nor below any sampled one) and must lie within the stated tolerance above
-// it: max(r, c) / 64 (the floor) plus the float margin.
+// it: max(r, c) / 64 (the floor) plus the float margin. The known-answer cases run against both
+// certifiers, the GPU one and its CPU twin (sampler/cpu_coverage_certificate.h), so each proves both.
 #include "sampler/coverage_certificate.h"
 
 #include <gtest/gtest.h>
@@ -12,8 +13,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <ostream>
 #include <random>
 
+#include "sampler/cpu_coverage_certificate.h"
 #include "sampler/point_grid.h"
 #include "sampler/sampling_quality.h"
 #include "tests/test_meshes.h"
@@ -25,6 +29,42 @@ gpu::Context& shared_context() {
   static gpu::Context context;
   return context;
 }
+
+enum class Backend { Gpu, Cpu };
+void PrintTo(Backend backend, std::ostream* out) { *out << (backend == Backend::Gpu ? "Gpu" : "Cpu"); }
+
+// Either certifier behind one call.
+class EitherCertifier {
+ public:
+  EitherCertifier(Backend backend, const TriangleMesh& mesh) {
+    if (backend == Backend::Gpu) {
+      gpu_ = std::make_unique<CoverageCertifier>(shared_context(), mesh);
+    } else {
+      cpu_ = std::make_unique<CpuCoverageCertifier>(mesh);
+    }
+  }
+  CoverageCertificate certify(std::span<const Eigen::Vector3f> centres, double radius,
+                              const CertificateSettings& settings = {}) {
+    return gpu_ ? gpu_->certify(centres, radius, settings) : cpu_->certify(centres, radius, settings);
+  }
+
+ private:
+  std::unique_ptr<CoverageCertifier> gpu_;
+  std::unique_ptr<CpuCoverageCertifier> cpu_;
+};
+
+// The known-answer cases, each run against both certifiers.
+class KnownCoverage : public testing::TestWithParam<Backend> {
+ protected:
+  EitherCertifier make_certifier(const TriangleMesh& mesh) const { return EitherCertifier(GetParam(), mesh); }
+};
+
+std::string backend_name(const testing::TestParamInfo<Backend>& param) {
+  return param.param == Backend::Gpu ? "Gpu" : "Cpu";
+}
+
+INSTANTIATE_TEST_SUITE_P(Certifiers, KnownCoverage, testing::Values(Backend::Gpu, Backend::Cpu),
+                         backend_name);
 
 std::vector<Eigen::Vector3f> to_float(const std::vector<Eigen::Vector3d>& points) {
   std::vector<Eigen::Vector3f> out;
@@ -161,7 +201,7 @@ TriangleMesh square_patch(double a, int n) {
 
 // ---------------------------------------------------------------------------------------------
 
-TEST(CoverageCertificate, IcosahedralSetsOnASphereAreBoundedWithinTheFloorOfTheirExactCoveringRadius) {
+TEST_P(KnownCoverage, IcosahedralSetsOnASphereAreBoundedWithinTheFloorOfTheirExactCoveringRadius) {
   const TriangleMesh sphere = test::icosphere(1.0, 4);  // 5120 triangles, vertices on the unit sphere
   // The 12 icosahedron vertices and the 42 of its first geodesic subdivision are its first vertices.
   for (const std::size_t n : {std::size_t{12}, std::size_t{42}}) {
@@ -176,7 +216,7 @@ TEST(CoverageCertificate, IcosahedralSetsOnASphereAreBoundedWithinTheFloorOfThei
           std::acos(sphere.vertices[sphere.triangles[0][0]].dot(sphere.vertices[sphere.triangles[0][1]]));
       EXPECT_NEAR(exact, chord, 1.0 - std::cos(0.5 * edge_angle));
     }
-    CoverageCertifier certifier(shared_context(), sphere);
+    EitherCertifier certifier = make_certifier(sphere);
     const std::vector<Eigen::Vector3f> stored = to_float(centres);
     for (const double r : {1.1 * exact, 0.97 * exact}) {
       const CoverageCertificate cert = certifier.certify(stored, r);
@@ -191,11 +231,11 @@ TEST(CoverageCertificate, IcosahedralSetsOnASphereAreBoundedWithinTheFloorOfThei
   }
 }
 
-TEST(CoverageCertificate, LatticeWithOneParticleRemovedHasAHoleAsDeepAsTheSpacing) {
+TEST_P(KnownCoverage, LatticeWithOneParticleRemovedHasAHoleAsDeepAsTheSpacing) {
   const double s = 0.05;
   const TriangleMesh patch = square_patch(1.0, 3);
   std::vector<Eigen::Vector3d> lattice = hex_lattice(s, -2 * s, 1.0 + 2 * s, -2 * s, 1.0 + 2 * s, 0.0);
-  CoverageCertifier certifier(shared_context(), patch);
+  EitherCertifier certifier = make_certifier(patch);
   const double r = 0.75 * s;  // above the lattice's s / sqrt(3), below the hole's s
   {
     const CoverageCertificate full = certifier.certify(to_float(lattice), r);
@@ -223,16 +263,17 @@ TEST(CoverageCertificate, LatticeWithOneParticleRemovedHasAHoleAsDeepAsTheSpacin
 }
 
 // A triangle larger than the neighbour search: its corners lie beyond the shells searched from its
-// centroid although centres are near it. An equilateral triangle whose circumcentre O is a hole of
+// centroid although centres are near it (for the CPU certifier, whose search has no shell limit, a
+// triangle many radii across). An equilateral triangle whose circumcentre O is a hole of
 // a hexagonal lattice (distance s / sqrt 3 from the nearest lattice points) has, for every centre p,
 // a corner at least sqrt(rho^2 + |p - O|^2) from p (its corner vectors from O sum to zero): with rho
 // just below the search radius the smallest largest-corner distance lies beyond it. The triangle
 // must still be split and certified: c = s / sqrt 3 (O is in it; no point of the plane is deeper).
-TEST(CoverageCertificate, TriangleLargerThanTheSearchIsSplitAndCertified) {
+TEST_P(KnownCoverage, TriangleLargerThanTheSearchIsSplitAndCertified) {
   const double s = 0.05, r = 0.75 * s, hole = s / std::sqrt(3.0);
   const Eigen::Vector3d o(0.5 * s, 0.5 * s / std::sqrt(3.0), 0.0);  // centroid of (0,0), (s,0), (s/2, h)
   for (const int shells : {2, 8}) {
-    const double rho = (shells - 0.02) * r;  // below the search radius shells * r ...
+    const double rho = (shells - 0.02) * r;                     // below the search radius shells * r ...
     ASSERT_GT(std::sqrt(rho * rho + hole * hole), shells * r);  // ... its best corner distance above it
     TriangleMesh triangle;
     for (const double degrees : {90.0, 210.0, 330.0}) {
@@ -241,9 +282,9 @@ TEST(CoverageCertificate, TriangleLargerThanTheSearchIsSplitAndCertified) {
     }
     triangle.triangles.push_back({0, 1, 2});
     const double reach = rho + 2.0 * s;
-    const std::vector<Eigen::Vector3d> lattice = hex_lattice(s, o.x() - reach, o.x() + reach, o.y() - reach,
-                                                             o.y() + reach, 0.0);
-    CoverageCertifier certifier(shared_context(), triangle);
+    const std::vector<Eigen::Vector3d> lattice =
+        hex_lattice(s, o.x() - reach, o.x() + reach, o.y() - reach, o.y() + reach, 0.0);
+    EitherCertifier certifier = make_certifier(triangle);
     CertificateSettings settings;
     settings.max_shells = shells;
     const CoverageCertificate cert = certifier.certify(to_float(lattice), r, settings);
@@ -257,13 +298,13 @@ TEST(CoverageCertificate, TriangleLargerThanTheSearchIsSplitAndCertified) {
 // radius is sqrt(t^2 + s^2 / 3), on the bottom face. Thin (t = 0.3 s): the top balls reach through and
 // the certificate holds. Thick (t = 2 s): the whole bottom face and the lower sides are uncovered, and
 // nothing of the top face is.
-TEST(CoverageCertificate, PlateCoveredFromOneSideIsJudgedFaceByFace) {
+TEST_P(KnownCoverage, PlateCoveredFromOneSideIsJudgedFaceByFace) {
   const double s = 0.05, a = 0.5, r = 0.75 * s;
   for (const double t : {0.3 * s, 2.0 * s}) {
     const TriangleMesh plate = test::box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d(a, a, t));
     const std::vector<Eigen::Vector3d> top = hex_lattice(s, -2 * s, a + 2 * s, -2 * s, a + 2 * s, t);
     const double exact = std::sqrt(t * t + s * s / 3.0);
-    CoverageCertifier certifier(shared_context(), plate);
+    EitherCertifier certifier = make_certifier(plate);
     const CoverageCertificate cert = certifier.certify(to_float(top), r);
     expect_bounds_exact(cert, exact, r);
     if (t < r) continue;
@@ -274,19 +315,20 @@ TEST(CoverageCertificate, PlateCoveredFromOneSideIsJudgedFaceByFace) {
     }
     EXPECT_NEAR(bottom_area, a * a, 1e-9 * a * a);  // all of the far face, none of it certified
     EXPECT_LE(cert.uncovered_area, a * a + 4.0 * a * t);
-    // With a search too short to find any top particle from the bottom face, those pieces are
-    // bounded on the CPU: still above the exact value, and still uncovered.
+    // With a search too short to find any top particle from the bottom face, the GPU's pieces are
+    // bounded on the CPU: still above the exact value, and still uncovered. (The CPU certifier's
+    // search is exact whatever max_shells says; the same statements hold for it.)
     CertificateSettings short_search;
     short_search.max_shells = 1;
-    const CoverageCertificate cpu = certifier.certify(to_float(top), r, short_search);
-    EXPECT_GE(cpu.covering_bound, exact);
-    EXPECT_LE(cpu.covering_lower, exact);
-    EXPECT_FALSE(cpu.covered);
-    EXPECT_GE(cpu.uncovered_area, a * a * (1.0 - 1e-9));
+    const CoverageCertificate shortened = certifier.certify(to_float(top), r, short_search);
+    EXPECT_GE(shortened.covering_bound, exact);
+    EXPECT_LE(shortened.covering_lower, exact);
+    EXPECT_FALSE(shortened.covered);
+    EXPECT_GE(shortened.uncovered_area, a * a * (1.0 - 1e-9));
   }
 }
 
-TEST(CoverageCertificate, NeverBelowDenseSamplingNorTheExactValueOnARandomSet) {
+TEST_P(KnownCoverage, NeverBelowDenseSamplingNorTheExactValueOnARandomSet) {
   const TriangleMesh sphere = test::icosphere(1.0, 3);
   std::mt19937_64 rng(5);
   std::normal_distribution<double> normal;
@@ -305,7 +347,7 @@ TEST(CoverageCertificate, NeverBelowDenseSamplingNorTheExactValueOnARandomSet) {
   for (const auto& v : sphere.vertices) sampled = std::max(sampled, grid.nearest(v).distance);
   EXPECT_LE(sampled, exact * (1.0 + 1e-12));
   EXPECT_GT(sampled, 0.98 * exact);
-  CoverageCertifier certifier(shared_context(), sphere);
+  EitherCertifier certifier = make_certifier(sphere);
   for (const double r : {0.8 * exact, 1.05 * exact}) {
     const CoverageCertificate cert = certifier.certify(stored, r);
     EXPECT_GE(cert.covering_bound, sampled);
@@ -360,7 +402,7 @@ TEST(CoverageCertificate, SameInputGivesTheSameBitsAndABudgetCostsTilesNotRefine
   }
 }
 
-TEST(CoverageCertificate, FarFromTheOriginAndTinyTheBoundStaysAboveTheExactValue) {
+TEST_P(KnownCoverage, FarFromTheOriginAndTinyTheBoundStaysAboveTheExactValue) {
   // The lattice-with-a-hole case, 1000 times smaller and 20 m from the origin: the float margin
   // grows with the distance from the mesh's own centre only, not from the origin.
   const double s = 0.05e-3, r = 0.75 * s;
@@ -377,7 +419,7 @@ TEST(CoverageCertificate, FarFromTheOriginAndTinyTheBoundStaysAboveTheExactValue
   std::vector<Eigen::Vector3d> as_stored = to_double(stored);
   const double exact = exact_covering_radius(patch, as_stored);
   EXPECT_NEAR(exact, s, 0.2 * s);
-  CoverageCertifier certifier(shared_context(), patch);
+  EitherCertifier certifier = make_certifier(patch);
   const CoverageCertificate cert = certifier.certify(stored, r);
   EXPECT_GE(cert.covering_bound, exact);
   EXPECT_LE(cert.covering_lower, exact);

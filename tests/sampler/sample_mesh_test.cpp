@@ -384,6 +384,45 @@ TEST(SampleMesh, CpuAndGpuSdfBothMeetTheTargets) {
   }
 }
 
+// Both relaxations give a body that meets the targets: the CPU one (the default on a software
+// renderer, SampleBackend::Auto) and the GPU kernels; the result says which one ran.
+TEST(SampleMesh, CpuAndGpuRelaxationBothMeetTheTargets) {
+  const TriangleMesh mesh = load_mesh(test::asset("torus.obj"));
+  for (const SampleBackend backend : {SampleBackend::Cpu, SampleBackend::Gpu, SampleBackend::Auto}) {
+    SampleSettings settings;
+    settings.count = 300;
+    settings.backend = backend;
+    const SampleResult result = sample_mesh(shared_context(), mesh, settings);
+    const bool cpu =
+        backend == SampleBackend::Cpu || (backend == SampleBackend::Auto && shared_context().software());
+    EXPECT_EQ(result.relax_on_cpu, cpu);
+    EXPECT_EQ(result.certificate_on_cpu, cpu);
+    EXPECT_EQ(result.field.gpu_bytes > 0, !cpu);  // the CPU path uploads no field
+    EXPECT_GT(result.stages.relaxation, 0.0);
+    expect_meets_quality_targets(mesh, result, settings.density);
+  }
+}
+
+// Without a GL context (a null one) the CPU backend runs every stage on the CPU, auto takes it, and
+// a stage that needs the GPU says so.
+TEST(SampleMesh, CpuBackendNeedsNoGlContext) {
+  const TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));
+  for (const SampleBackend backend : {SampleBackend::Cpu, SampleBackend::Auto}) {
+    SampleSettings settings;
+    settings.count = 300;
+    settings.backend = backend;
+    const SampleResult result = sample_mesh(nullptr, mesh, settings);
+    EXPECT_TRUE(result.sdf_on_cpu);
+    EXPECT_TRUE(result.relax_on_cpu);
+    EXPECT_TRUE(result.certificate_on_cpu);
+    expect_meets_quality_targets(mesh, result, settings.density);
+  }
+  SampleSettings settings;
+  settings.count = 300;
+  settings.backend = SampleBackend::Gpu;
+  EXPECT_THROW(sample_mesh(nullptr, mesh, settings), Error);
+}
+
 TEST(SampleMesh, ZeroVolumeMeshIsRefused) {
   // A closed but flat mesh: two copies of one square with opposite windings.
   TriangleMesh flat;

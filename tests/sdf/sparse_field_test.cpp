@@ -17,6 +17,7 @@
 #include "gpu/context.h"
 #include "core/error.h"
 #include "gpu/gl.h"
+#include "sdf/host_field.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
 #include "shaders/common/layouts.h"
@@ -166,6 +167,49 @@ TEST_F(SparseFieldTest, OffTheGridIsTheOutsideBackgroundAndTheGradientIsTheNorma
   EXPECT_NEAR(values[1].w(), 0.04, 0.01);
   EXPECT_NEAR(values[1].x(), 1.0, 0.02);
   EXPECT_NEAR(values[1].head<3>().norm(), 1.0, 1e-5);
+}
+
+// The host reader the CPU relaxation uses (sdf::HostField) reads what GLSL reads: the trilinear value
+// and the unit central-difference gradient, to float precision (the GPU computes in float, the host in
+// double: a few ulps of the value, ~1e-6 voxel, and of the gradient's direction), in the band, off it
+// and across the voxel faces where the seven reads of one sample straddle cells.
+TEST_F(SparseFieldTest, HostFieldSamplesWhatGlslSamples) {
+  const SparseField field(*result_.grid, spec_, 3.0);
+  const HostField host(to_nanovdb(*result_.grid), spec_, 3.0);
+  EXPECT_EQ(host.band_voxels(), field.band_voxels());
+  EXPECT_EQ(host.background(), field.background());
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Eigen::Vector4f> points;
+  for (int n = 0; n < 20000; ++n) {
+    points.emplace_back(static_cast<float>(u(rng) * (spec_.dims.x() - 1)),
+                        static_cast<float>(u(rng) * (spec_.dims.y() - 1)),
+                        static_cast<float>(u(rng) * (spec_.dims.z() - 1)), 0.0f);
+  }
+  points.emplace_back(2.5f, 3.5f, 4.5f, 0.0f);  // on voxel faces: x +- 0.5 falls on voxel centres
+  const auto trilinear = probe(field, points, 1);
+  const auto sampled = probe(field, points, 2);
+  FieldAccessor accessor = host.accessor();
+  double worst_value = 0.0, worst_trilinear = 0.0, worst_normal = 0.0;
+  std::size_t in_band = 0;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const Eigen::Vector3d x = points[k].head<3>().cast<double>();
+    const FieldSample s = host.sample(accessor, x * spec_.voxel_size);
+    worst_value = std::max(worst_value, std::abs(s.value - sampled[k].w()) / spec_.voxel_size);
+    worst_trilinear = std::max(
+        worst_trilinear,
+        std::abs(sparse_trilinear(accessor, spec_.index_offset, x) - trilinear[k].x()) / spec_.voxel_size);
+    // The direction only where the gradient is well defined: a voxel inside the band's edge (near the
+    // edge float rounding of the GPU's small differences turns its direction by more).
+    if (std::abs(s.value) < host.background() - spec_.voxel_size) {
+      worst_normal = std::max(worst_normal, (s.normal - sampled[k].head<3>().cast<double>()).norm());
+    }
+    in_band += std::abs(s.value) < host.background();
+  }
+  EXPECT_GT(in_band, 2000u);
+  EXPECT_LT(worst_value, 1e-5) << "[voxels]";
+  EXPECT_LT(worst_trilinear, 1e-5) << "[voxels]";
+  EXPECT_LT(worst_normal, 1e-4);
 }
 
 TEST_F(SparseFieldTest, GpuMemoryFollowsTheBandNotTheBox) {
