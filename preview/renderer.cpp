@@ -13,7 +13,6 @@
 #include "gpu/gl.h"
 #include "gpu/graphics.h"
 #include "preview/colors.h"
-#include "shaders/common/layouts.h"
 #include "shaders/preview/bindings.h"
 
 namespace ts::preview {
@@ -285,8 +284,7 @@ void Renderer::Impl::upload_particles(const Eigen::Vector3d& new_origin) {
 }
 
 void Renderer::Impl::bind_volume(const gpu::Program& p) const {
-  static_assert(TS_PREVIEW_SPARSE_FIELD_3 == TS_PREVIEW_SPARSE_FIELD_0 + TS_FIELD_CHUNKS - 1, "field chunks take consecutive slots");
-  field.bind(p, TS_PREVIEW_SPARSE_FIELD_0);
+  field.bind(p, TS_PREVIEW_SPARSE_FIELD);
   set_vec3(p, "volume_origin", Eigen::Vector3d(volume_spec.origin - origin));
   p.set("voxel_size", static_cast<float>(volume_spec.voxel_size));
   p.set("volume_dims", static_cast<float>(volume_spec.dims.x()), static_cast<float>(volume_spec.dims.y()),

@@ -6,7 +6,6 @@
 
 #include "core/error.h"
 #include "shaders/common/bindings.h"
-#include "shaders/common/layouts.h"
 #include "shaders/sampler/bindings.h"
 
 namespace ts::sampler {
@@ -27,8 +26,7 @@ std::size_t GpuRelaxer::gpu_bytes() const {
   return field_.gpu_bytes() + positions_[0].bytes() * 2 + step_info_.bytes() + partials_.bytes() + grid_.bytes();
 }
 
-static_assert(TS_SAMPLER_SPARSE_FIELD_3 == TS_SAMPLER_SPARSE_FIELD_0 + TS_FIELD_CHUNKS - 1, "field chunks take consecutive slots");
-void GpuRelaxer::bind_sdf(const gpu::Program& program) const { field_.bind(program, TS_SAMPLER_SPARSE_FIELD_0); }
+void GpuRelaxer::bind_sdf(const gpu::Program& program) const { field_.bind(program, TS_SAMPLER_SPARSE_FIELD); }
 
 void GpuRelaxer::project(std::uint32_t count, int steps) {
   positions_[0].bind(TS_SAMPLER_POSITIONS);

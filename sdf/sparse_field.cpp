@@ -5,13 +5,10 @@
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 
-#include <bit>
 #include <cmath>
-#include <cstdint>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "shaders/common/layouts.h"
 
 namespace ts::sdf {
 
@@ -31,20 +28,12 @@ int largest_fitting_resolution(const GridSpec& spec, std::size_t bytes, std::siz
   return static_cast<int>(std::floor(longest * std::sqrt(static_cast<double>(limit) / static_cast<double>(bytes))));
 }
 
-// One chunk's bytes: the largest power of two that one storage block holds (and `cap`, when set),
-// at most 1 GiB, so that TS_FIELD_CHUNKS of them stay within PNanoVDB's 32-bit byte offsets.
-std::size_t chunk_bytes(std::size_t max_block, std::size_t cap) {
-  std::size_t limit = std::min<std::size_t>(max_block, std::size_t{1} << 30);
-  if (cap > 0) limit = std::min(limit, std::max<std::size_t>(cap, 8));
-  return std::bit_floor(limit);
-}
-
 }  // namespace
 
 SparseField::SparseField(const openvdb::FloatGrid& level_set, const GridSpec& spec, double band_voxels)
     : SparseField(to_nanovdb(level_set), spec, band_voxels) {}
 
-SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels, std::size_t max_chunk_bytes)
+SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels)
     : spec_(spec),
       band_(band_voxels),
       background_(static_cast<float>(band_voxels * spec.voxel_size)),
@@ -55,22 +44,17 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
   GLint64 max_block = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
   const std::size_t bytes = host_.size();
-  const std::size_t chunk = chunk_bytes(static_cast<std::size_t>(std::max<GLint64>(max_block, 8)), max_chunk_bytes);
-  // PNanoVDB addresses the grid with 32-bit byte offsets; the kernels declare TS_FIELD_CHUNKS blocks.
-  const std::size_t limit = std::min<std::size_t>(chunk * TS_FIELD_CHUNKS, std::size_t{1} << 32);
+  // PNanoVDB addresses the buffer with 32-bit byte offsets, and one storage block is all a kernel reads.
+  const std::size_t limit = std::min<std::size_t>(static_cast<std::size_t>(max_block), std::size_t{1} << 32);
   if (bytes > limit) {
-    throw GpuError(fmt::format("the sparse SDF ({} band voxels, {:.1f} MiB) exceeds the {:.1f} MiB the GPU kernels "
-                               "can address ({} storage blocks of {:.1f} MiB); the largest grid that fits has about {} "
-                               "voxels along its longest side (use a larger voxel)",
-                               band_voxels_, bytes / 1048576.0, limit / 1048576.0, TS_FIELD_CHUNKS,
-                               chunk / 1048576.0, largest_fitting_resolution(spec, bytes, limit)));
+    throw GpuError(fmt::format("the sparse SDF ({} band voxels, {:.1f} MiB) exceeds this GPU's largest storage "
+                               "block ({:.1f} MiB); the largest grid that fits has about {} voxels along its longest "
+                               "side (use a larger voxel)",
+                               band_voxels_, bytes / 1048576.0, limit / 1048576.0,
+                               largest_fitting_resolution(spec, bytes, limit)));
   }
-  chunk_shift_ = static_cast<unsigned>(std::countr_zero(chunk / 4));
   try {
-    const auto* data = static_cast<const std::uint8_t*>(host_.data());
-    for (std::size_t offset = 0; offset < bytes; offset += chunk) {
-      chunks_.emplace_back(std::min(chunk, bytes - offset), data + offset);
-    }
+    buffer_ = gpu::Buffer(bytes, host_.data());
   } catch (const GpuError& e) {
     throw GpuError(fmt::format("{} for the sparse SDF ({} band voxels); the largest grid that might fit has about {} "
                                "voxels along its longest side",
@@ -78,15 +62,8 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
   }
 }
 
-std::size_t SparseField::gpu_bytes() const {
-  std::size_t total = 0;
-  for (const gpu::Buffer& chunk : chunks_) total += chunk.bytes();
-  return total;
-}
-
-void SparseField::bind(const gpu::Program& program, GLuint first_binding) const {
-  for (GLuint k = 0; k < TS_FIELD_CHUNKS; ++k) chunks_[k < chunks_.size() ? k : 0].bind(first_binding + k);
-  program.set("field_chunk_shift", chunk_shift_);
+void SparseField::bind(const gpu::Program& program, GLuint binding) const {
+  buffer_.bind(binding);
   program.set("field_index_offset", spec_.index_offset.x(), spec_.index_offset.y(), spec_.index_offset.z());
   program.set("field_voxel_size", static_cast<float>(spec_.voxel_size));
   program.set("field_background", background_);

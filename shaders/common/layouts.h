@@ -109,12 +109,6 @@ TS_LAYOUT(SimSpringSlots64) {
 
 // Binding slots are not layouts: each stage names its own in shaders/<stage>/bindings.h.
 
-// The sparse SDF (sdf::SparseField) is one NanoVDB grid split into at most TS_FIELD_CHUNKS storage
-// buffers of equal power-of-two size, bound to TS_FIELD_CHUNKS consecutive slots from the stage's
-// base: one block may hold no more than GL_MAX_SHADER_STORAGE_BLOCK_SIZE (128 MiB on llvmpipe), while
-// a 1M-particle field is several times that. PNanoVDB's 32-bit byte offsets cap the grid at 4 GiB.
-#define TS_FIELD_CHUNKS 4
-
 // Motion types (TS_SIM_BODY_VELOCITY.w)
 #define TS_MOTION_DYNAMIC 0
 #define TS_MOTION_KINEMATIC 1

@@ -1,52 +1,11 @@
 // The narrow-band SDF as a sparse NanoVDB float level set (sdf::SparseField), read through NanoVDB's
-// PNanoVDB.h (Debian libnanovdb-dev; copied beside the shaders by the build). The grid arrives in up to
-// TS_FIELD_CHUNKS storage buffers (common/layouts.h says why) at consecutive slots, which the including
-// kernel names before including this file: TS_FIELD_BINDING_0 to _3, aliases of its stage's slots
-// (sampler/bindings.h, preview/bindings.h). PNanoVDB's buffer reads are routed to the chunk that holds
-// each word (PNANOVDB_BUF_CUSTOM).
+// PNanoVDB.h (Debian libnanovdb-dev; copied beside the shaders by the build). The including kernel
+// declares, before including this file, the grid's buffer at its own stage's binding slot: a
+// readonly std430 block named SparseField holding `uint pnanovdb_buf_data[]` (see sampler/relax.comp).
 // Positions are in grid-local voxel units (voxel (0,0,0) of the grid spec at 0), so float precision
 // does not depend on where the grid sits in index space; values are world units.
 #ifndef TETRASAND_COMMON_SPARSE_FIELD_GLSL
 #define TETRASAND_COMMON_SPARSE_FIELD_GLSL
-
-#include "common/layouts.h"
-
-#ifndef TS_FIELD_BINDING_3
-#error "define TS_FIELD_BINDING_0 to _3 (the stage's slots of the sparse field) before including common/sparse_field.glsl"
-#endif
-#if TS_FIELD_CHUNKS != 4
-#error "common/sparse_field.glsl declares 4 chunk blocks: update it with TS_FIELD_CHUNKS"
-#endif
-
-layout(std430, binding = TS_FIELD_BINDING_0) readonly buffer SparseFieldChunk0 { uint field_chunk0[]; };
-layout(std430, binding = TS_FIELD_BINDING_1) readonly buffer SparseFieldChunk1 { uint field_chunk1[]; };
-layout(std430, binding = TS_FIELD_BINDING_2) readonly buffer SparseFieldChunk2 { uint field_chunk2[]; };
-layout(std430, binding = TS_FIELD_BINDING_3) readonly buffer SparseFieldChunk3 { uint field_chunk3[]; };
-
-uniform uint field_chunk_shift;  // log2 of the words one chunk holds (every chunk but the last is full)
-
-// What PNanoVDB.h's GLSL buffer would define, over the chunks. Chunks hold whole 8-byte words, so
-// a 64-bit value is two 32-bit reads that may fall in neighbouring chunks, each routed on its own.
-// Blocks are chosen by branches, not by indexing an array of blocks: GLSL 4.50 allows only
-// dynamically uniform indices there, and neighbouring invocations read different chunks.
-#define PNANOVDB_BUF_CUSTOM
-struct pnanovdb_buf_t {
-  uint unused;
-};
-uint pnanovdb_buf_read_uint32(pnanovdb_buf_t buf, uint byte_offset) {
-  uint word = byte_offset >> 2u;
-  uint chunk = word >> field_chunk_shift;
-  uint local = word & ((1u << field_chunk_shift) - 1u);
-  if (chunk == 0u) return field_chunk0[local];
-  if (chunk == 1u) return field_chunk1[local];
-  if (chunk == 2u) return field_chunk2[local];
-  return field_chunk3[local];
-}
-uvec2 pnanovdb_buf_read_uint64(pnanovdb_buf_t buf, uint byte_offset) {
-  return uvec2(pnanovdb_buf_read_uint32(buf, byte_offset), pnanovdb_buf_read_uint32(buf, byte_offset + 4u));
-}
-#define pnanovdb_grid_type_t uint
-#define PNANOVDB_GRID_TYPE_GET(grid_typeIn, nameIn) pnanovdb_grid_type_constants[grid_typeIn].nameIn
 
 #define PNANOVDB_GLSL
 #include "nanovdb/PNanoVDB.h"

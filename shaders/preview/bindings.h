@@ -4,9 +4,9 @@
 //   particles (particles.vert + particles.frag; shadow map and G-buffer):
 //     buffers TS_PREVIEW_SPHERES, TS_PREVIEW_COLORS
 //   ray cast (raycast.vert + raycast.frag; shadow map and G-buffer):
-//     buffers TS_PREVIEW_SPARSE_FIELD_0-3, unit TS_PREVIEW_UNIT_PARTICLE_DEPTH
+//     buffer TS_PREVIEW_SPARSE_FIELD, unit TS_PREVIEW_UNIT_PARTICLE_DEPTH
 //   shade (shade.vert + shade.frag; the lighting pass):
-//     buffers TS_PREVIEW_SPARSE_FIELD_0-3, units TS_PREVIEW_UNIT_ALBEDO, TS_PREVIEW_UNIT_NORMAL, TS_PREVIEW_UNIT_DEPTH,
+//     buffer TS_PREVIEW_SPARSE_FIELD, units TS_PREVIEW_UNIT_ALBEDO, TS_PREVIEW_UNIT_NORMAL, TS_PREVIEW_UNIT_DEPTH,
 //     TS_PREVIEW_UNIT_SHADOW
 //
 // The buffers sit at 27 and up because the simulator's kernels use bindings 0-26
@@ -18,11 +18,7 @@
 
 #define TS_PREVIEW_SPHERES 27  // vec4[]: xyz centre relative to the scene centre [m], w radius [m]
 #define TS_PREVIEW_COLORS 28   // uint[]: sRGB colour per sphere, RGBA8 with red in the low byte
-// uint[]: the NanoVDB level set (sdf::SparseField) in TS_FIELD_CHUNKS consecutive slots
-#define TS_PREVIEW_SPARSE_FIELD_0 20
-#define TS_PREVIEW_SPARSE_FIELD_1 21
-#define TS_PREVIEW_SPARSE_FIELD_2 22
-#define TS_PREVIEW_SPARSE_FIELD_3 23
+#define TS_PREVIEW_SPARSE_FIELD 29  // uint[]: the NanoVDB level set (sdf::SparseField), as PNanoVDB.h reads it
 
 #define TS_PREVIEW_UNIT_PARTICLE_DEPTH 1  // sampler2D: window depth of the particle layer
 #define TS_PREVIEW_UNIT_ALBEDO 2          // sampler2D: G-buffer albedo (sRGB)

@@ -6,10 +6,7 @@
 
 #include "preview/bindings.h"
 
-#define TS_FIELD_BINDING_0 TS_PREVIEW_SPARSE_FIELD_0
-#define TS_FIELD_BINDING_1 TS_PREVIEW_SPARSE_FIELD_1
-#define TS_FIELD_BINDING_2 TS_PREVIEW_SPARSE_FIELD_2
-#define TS_FIELD_BINDING_3 TS_PREVIEW_SPARSE_FIELD_3
+layout(std430, binding = TS_PREVIEW_SPARSE_FIELD) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
 #include "common/sparse_field.glsl"
 
 uniform vec3 volume_origin;  // voxel (0,0,0)'s centre, relative to the scene centre [m]

@@ -5,9 +5,9 @@
 //   pass (kernel)               slots
 //   common/grid_* (the grid)    TS_GRID_POSITIONS = TS_SAMPLER_POSITIONS_IN, TS_SORT_* (1-5)
 //   sampler/relax.comp          POSITIONS_IN, POSITIONS_OUT, VELOCITIES, STEP_INFO, TS_GRID_CELL_COUNT,
-//                               TS_GRID_CELL_START, TS_GRID_SORTED, SPARSE_FIELD_0-3
+//                               TS_GRID_CELL_START, TS_GRID_SORTED, SPARSE_FIELD
 //   sampler/reduce_steps.comp   STEP_INFO, PARTIALS
-//   sampler/project.comp        POSITIONS, SPARSE_FIELD_0-3
+//   sampler/project.comp        POSITIONS, SPARSE_FIELD
 //   common/grid_* for the certificate: TS_GRID_POSITIONS = TS_CERT_CENTRES, TS_SORT_* (1-5)
 //   sampler/certify_evaluate.comp  CERT_CENTRES, CERT_TRIANGLES, CERT_QUEUE, TS_GRID_CELL_COUNT,
 //                               TS_GRID_CELL_START, TS_GRID_SORTED, CERT_SPLITS, CERT_UNCOVERED,
@@ -38,10 +38,6 @@
 #define TS_CERT_NEXT_QUEUE 10              // uvec4 per sub-triangle of the next level
 #define TS_CERT_HOLES 11                   // CertLeaf per sub-triangle left uncovered at this level
 
-// uint[]: the NanoVDB level set (sdf::SparseField) in TS_FIELD_CHUNKS consecutive slots
-#define TS_SAMPLER_SPARSE_FIELD_0 12
-#define TS_SAMPLER_SPARSE_FIELD_1 13
-#define TS_SAMPLER_SPARSE_FIELD_2 14
-#define TS_SAMPLER_SPARSE_FIELD_3 15
+#define TS_SAMPLER_SPARSE_FIELD 8  // uint[]: the NanoVDB level set (sdf::SparseField), as PNanoVDB.h reads it
 
 #endif

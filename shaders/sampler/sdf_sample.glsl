@@ -5,10 +5,7 @@
 #ifndef TETRASAND_SAMPLER_SDF_SAMPLE_GLSL
 #define TETRASAND_SAMPLER_SDF_SAMPLE_GLSL
 
-#define TS_FIELD_BINDING_0 TS_SAMPLER_SPARSE_FIELD_0
-#define TS_FIELD_BINDING_1 TS_SAMPLER_SPARSE_FIELD_1
-#define TS_FIELD_BINDING_2 TS_SAMPLER_SPARSE_FIELD_2
-#define TS_FIELD_BINDING_3 TS_SAMPLER_SPARSE_FIELD_3
+layout(std430, binding = TS_SAMPLER_SPARSE_FIELD) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
 #include "common/sparse_field.glsl"
 
 // xyz: unit gradient (zero where undefined, as off the band), w: signed distance [m].

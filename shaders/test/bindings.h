@@ -1,7 +1,7 @@
 // Binding slots of the test kernels (tests/gpu/), named once for GLSL and the tests.
 //   test/saxpy.comp          TS_TEST_SAXPY_X, TS_TEST_SAXPY_Y
 //   test/layout_probe.comp   TS_TEST_PROBE_* (one block per shared layout; the tests read offsets back)
-//   test/sparse_field_probe.comp  TS_TEST_FIELD_GRID_0-3, TS_TEST_FIELD_POINTS, TS_TEST_FIELD_VALUES
+//   test/sparse_field_probe.comp  TS_TEST_FIELD_GRID, TS_TEST_FIELD_POINTS, TS_TEST_FIELD_VALUES
 #ifndef TETRASAND_TEST_BINDINGS_H
 #define TETRASAND_TEST_BINDINGS_H
 
@@ -19,12 +19,8 @@
 #define TS_TEST_PROBE_CERT_TRIANGLES 8
 #define TS_TEST_PROBE_CERT_LEAVES 9
 
+#define TS_TEST_FIELD_GRID 0    // uint[]: an sdf::SparseField's NanoVDB grid
 #define TS_TEST_FIELD_POINTS 1  // vec4: xyz grid-local position [voxels]
 #define TS_TEST_FIELD_VALUES 2  // vec4: what the probe read there (see the kernel)
-// uint[]: an sdf::SparseField's NanoVDB grid in TS_FIELD_CHUNKS consecutive slots
-#define TS_TEST_FIELD_GRID_0 3
-#define TS_TEST_FIELD_GRID_1 4
-#define TS_TEST_FIELD_GRID_2 5
-#define TS_TEST_FIELD_GRID_3 6
 
 #endif

@@ -5,10 +5,7 @@
 // round(position); mode 1: x = trilinear value; mode 2: xyz = field_sample's unit gradient, w = its value.
 #include "test/bindings.h"
 layout(local_size_x = 64) in;
-#define TS_FIELD_BINDING_0 TS_TEST_FIELD_GRID_0
-#define TS_FIELD_BINDING_1 TS_TEST_FIELD_GRID_1
-#define TS_FIELD_BINDING_2 TS_TEST_FIELD_GRID_2
-#define TS_FIELD_BINDING_3 TS_TEST_FIELD_GRID_3
+layout(std430, binding = TS_TEST_FIELD_GRID) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
 #include "common/sparse_field.glsl"
 layout(std430, binding = TS_TEST_FIELD_POINTS) readonly buffer Points { vec4 points[]; };
 layout(std430, binding = TS_TEST_FIELD_VALUES) writeonly buffer Values { vec4 values[]; };

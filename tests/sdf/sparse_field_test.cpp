@@ -8,19 +8,16 @@
 #include <nanovdb/util/IO.h>
 #include <openvdb/tools/Interpolation.h>
 
-#include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <random>
 
 #include "core/primitives.h"
 #include "gpu/context.h"
-#include "core/error.h"
 #include "gpu/gl.h"
 #include "sdf/host_field.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
-#include "shaders/common/layouts.h"
 #include "shaders/test/bindings.h"
 #include "tests/test_meshes.h"
 #include "tests/test_support.h"
@@ -51,7 +48,7 @@ class SparseFieldTest : public ::testing::Test {
     gpu::Program program = gpu::Program::compute(library, "test/sparse_field_probe.comp");
     gpu::Buffer in = gpu::Buffer::from<Eigen::Vector4f>(points);
     gpu::Buffer out(points.size() * sizeof(Eigen::Vector4f));
-    field.bind(program, TS_TEST_FIELD_GRID_0);
+    field.bind(program, TS_TEST_FIELD_GRID);
     in.bind(TS_TEST_FIELD_POINTS);
     out.bind(TS_TEST_FIELD_VALUES);
     program.set("count", static_cast<unsigned>(points.size()));
@@ -87,40 +84,6 @@ TEST_F(SparseFieldTest, GlslReadsTheLevelSetAtEveryVoxelBitForBit) {
   }
   EXPECT_GT(inside_off_band, 200u);
   EXPECT_GT(outside_off_band, 200u);
-}
-
-TEST_F(SparseFieldTest, AGridSplitIntoChunksReadsLikeOneBufferBitForBit) {
-  // The torus's grid cut into TS_FIELD_CHUNKS chunks of a power of two each (the last one partly
-  // full): a field larger than one storage block (llvmpipe: 128 MiB) is read this way. Every voxel
-  // and every gradient must read as from the single buffer, across every chunk boundary.
-  const SparseField whole(*result_.grid, spec_, 3.0);
-  const std::size_t bytes = whole.gpu_bytes();
-  const std::size_t chunk = std::bit_ceil((bytes + TS_FIELD_CHUNKS - 1) / TS_FIELD_CHUNKS);
-  const SparseField split(to_nanovdb(*result_.grid), spec_, 3.0, chunk);
-  ASSERT_EQ(whole.chunk_count(), 1u);
-  ASSERT_GE(split.chunk_count(), 3u);
-  ASSERT_LE(split.chunk_count(), static_cast<std::size_t>(TS_FIELD_CHUNKS));
-  EXPECT_EQ(split.gpu_bytes(), bytes);
-  std::vector<Eigen::Vector4f> points;
-  for (int k = 0; k < spec_.dims.z(); ++k)
-    for (int j = 0; j < spec_.dims.y(); ++j)
-      for (int i = 0; i < spec_.dims.x(); ++i) points.emplace_back(i + 0.3f, j + 0.6f, k + 0.1f, 0.0f);
-  for (int mode : {0, 2}) {
-    const auto expected = probe(whole, points, mode);
-    const auto values = probe(split, points, mode);
-    for (std::size_t v = 0; v < points.size(); ++v) {
-      ASSERT_EQ(values[v], expected[v]) << "mode " << mode << " at " << points[v].transpose();
-    }
-  }
-  // A grid past what the chunks can address is refused with the size and what would fit.
-  try {
-    const SparseField too_big(to_nanovdb(*result_.grid), spec_, 3.0, chunk / 4);
-    FAIL() << "a grid larger than " << TS_FIELD_CHUNKS << " chunks was accepted";
-  } catch (const GpuError& e) {
-    const std::string message = e.what();
-    EXPECT_NE(message.find("storage blocks of"), std::string::npos) << message;
-    EXPECT_NE(message.find("voxels along its longest side"), std::string::npos) << message;
-  }
 }
 
 TEST_F(SparseFieldTest, TrilinearValuesAgreeWithOpenVdbToFloatPrecision) {
