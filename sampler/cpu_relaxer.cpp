@@ -15,6 +15,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "core/error.h"
+#include "core/stopwatch.h"
 
 namespace ts::sampler {
 
@@ -107,18 +108,6 @@ class CpuRelaxer::NeighbourGrid {
 };
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-// Runs `work` and adds its wall time to `total` [s].
-template <class Work>
-void timed(double& total, Work&& work) {
-  const auto start = std::chrono::steady_clock::now();
-  work();
-  total += seconds_since(start);
-}
 
 // Interleaves the low 21 bits of x, y and z (a Morton code).
 std::uint64_t morton(std::uint64_t x, std::uint64_t y, std::uint64_t z) {

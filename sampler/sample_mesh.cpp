@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mass_properties.h"
+#include "core/stopwatch.h"
 #include "gpu/host_sync.h"
 #include "sampler/cpu_coverage_certificate.h"
 #include "sampler/cpu_relaxer.h"
@@ -373,18 +374,6 @@ std::unique_ptr<Certifier> make_certifier(gpu::Context* context, const TriangleM
   if (result.certificate_on_cpu) return std::make_unique<CertifierOf<CpuCoverageCertifier>>(mesh);
   return std::make_unique<CertifierOf<CoverageCertifier>>(
       needed_context(context, "the GPU coverage certificate"), mesh, settings.timings);
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-// Runs `work` and adds its wall time to `total` [s].
-template <class Work>
-void timed(double& total, Work&& work) {
-  const auto start = std::chrono::steady_clock::now();
-  work();
-  total += seconds_since(start);
 }
 
 // The particles as a body stores them (float, mesh coordinates): what the certificate and the probes judge.
