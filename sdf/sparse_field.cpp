@@ -19,6 +19,36 @@ NanoGrid to_nanovdb(const openvdb::FloatGrid& level_set) {
                                                      nanovdb::ChecksumMode::Disable);
 }
 
+Eigen::Vector3i gpu_index_shift(const GridSpec& spec) {
+  Eigen::Vector3i shift;
+  for (int a = 0; a < 3; ++a) shift[a] = -static_cast<int>(std::floor(spec.index_offset[a] / 128.0)) * 128;
+  return shift;
+}
+
+NanoGrid to_gpu_nanovdb(const openvdb::FloatGrid& level_set, const GridSpec& spec) {
+  const Eigen::Vector3i s = gpu_index_shift(spec);
+  if (s.isZero()) return to_nanovdb(level_set);
+  const openvdb::Coord shift(s.x(), s.y(), s.z());
+  // A copy of the band moved by `shift`: leaves keep their voxels (the shift is a multiple of 8), tiles
+  // (the flood fill's inside and any constant region) are filled at their moved boxes.
+  openvdb::FloatGrid::Ptr moved = openvdb::FloatGrid::create(level_set.background());
+  moved->setGridClass(level_set.getGridClass());
+  moved->setTransform(level_set.transform().copy());
+  openvdb::FloatTree& tree = moved->tree();
+  for (auto leaf = level_set.tree().cbeginLeaf(); leaf; ++leaf) {
+    auto* copy = new openvdb::FloatTree::LeafNodeType(*leaf);
+    copy->setOrigin(leaf->origin() + shift);
+    tree.addLeaf(copy);
+  }
+  for (auto tile = level_set.tree().cbeginValueAll(); tile; ++tile) {
+    if (!tile.isTileValue()) continue;
+    openvdb::CoordBBox box = tile.getBoundingBox();
+    box.translate(shift);
+    tree.fill(box, *tile, tile.isValueOn());
+  }
+  return to_nanovdb(*moved);
+}
+
 namespace {
 
 // The largest resolution (voxels along the longest side) whose field fits `limit` bytes: the band,
@@ -31,7 +61,7 @@ int largest_fitting_resolution(const GridSpec& spec, std::size_t bytes, std::siz
 }  // namespace
 
 SparseField::SparseField(const openvdb::FloatGrid& level_set, const GridSpec& spec, double band_voxels)
-    : SparseField(to_nanovdb(level_set), spec, band_voxels) {}
+    : SparseField(to_gpu_nanovdb(level_set, spec), spec, band_voxels) {}
 
 SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels)
     : spec_(spec),
@@ -64,7 +94,8 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
 
 void SparseField::bind(const gpu::Program& program, GLuint binding) const {
   buffer_.bind(binding);
-  program.set("field_index_offset", spec_.index_offset.x(), spec_.index_offset.y(), spec_.index_offset.z());
+  const Eigen::Vector3i offset = gpu_index_offset();
+  program.set("field_index_offset", offset.x(), offset.y(), offset.z());
   program.set("field_voxel_size", static_cast<float>(spec_.voxel_size));
   program.set("field_background", background_);
 }

@@ -22,8 +22,21 @@ namespace ts::sdf {
 
 using NanoGrid = nanovdb::GridHandle<nanovdb::HostBuffer>;
 
-// A float level set as a NanoVDB grid on the host (no checksum; min/max/bbox statistics on).
+// A float level set as a NanoVDB grid on the host (no checksum; min/max/bbox statistics on), in the
+// level set's own index space (.nvdb output, the CPU's sdf::HostField).
 NanoGrid to_nanovdb(const openvdb::FloatGrid& level_set);
+
+// The translation from a level set's index space to the GPU field's: a multiple of 128 voxels (a lower
+// internal node of OpenVDB's tree, so leaves and tiles move whole) that puts spec's voxel (0, 0, 0) in
+// [0, 128)^3, so every band voxel of a grid under 3968 voxels a side has NanoVDB coordinates in
+// [0, 4096) and one root key, (0, 0). Why: NVIDIA's GLSL compiler (driver 580.159.04, H200, seen
+// 2026-12-04) computes the high word of PNanoVDB's 64-bit root key (pnanovdb_coord_to_key, as two
+// 32-bit words) wrong for negative coordinates, so the root walk found no tile and every read was the
+// background; llvmpipe computed it right. Coordinates whose keys are all zero avoid that arithmetic.
+Eigen::Vector3i gpu_index_shift(const GridSpec& spec);
+
+// The level set as the GPU reads it: to_nanovdb of the level set moved by gpu_index_shift(spec).
+NanoGrid to_gpu_nanovdb(const openvdb::FloatGrid& level_set, const GridSpec& spec);
 
 class SparseField {
  public:
@@ -33,7 +46,7 @@ class SparseField {
   // flood-filled. Converted to NanoVDB and uploaded; throws GpuError (exit 3) when the GPU cannot
   // hold it, naming the size and the largest resolution that would fit.
   SparseField(const openvdb::FloatGrid& level_set, const GridSpec& spec, double band_voxels);
-  // The same from a grid already converted (to_nanovdb) and checked by the caller.
+  // The same from a grid already converted by to_gpu_nanovdb(level_set, spec) and checked by the caller.
   SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels);
 
   const GridSpec& spec() const { return spec_; }
@@ -43,7 +56,9 @@ class SparseField {
   bool empty() const { return buffer_.id() == 0; }
   std::size_t gpu_bytes() const { return buffer_.bytes(); }
   std::size_t band_voxels() const { return band_voxels_; }  // active voxels of the level set
-  const NanoGrid& host() const { return host_; }         // the uploaded bytes (tests, .nvdb output)
+  const NanoGrid& host() const { return host_; }         // the uploaded bytes (tests), in the GPU's index space
+  // NanoVDB index of spec's voxel (0, 0, 0) in the uploaded grid: spec.index_offset + gpu_index_shift(spec).
+  Eigen::Vector3i gpu_index_offset() const { return spec_.index_offset + gpu_index_shift(spec_); }
 
   // Binds the grid to `binding` and sets the uniforms shaders/common/sparse_field.glsl reads.
   void bind(const gpu::Program& program, GLuint binding) const;

@@ -19,6 +19,39 @@ struct FieldReader {
   pnanovdb_readaccessor_t accessor;
 };
 
+// NanoVDB coordinates of the root tile at (0, 0, 0), where sdf::gpu_index_shift puts every band voxel
+// of a grid under 3968 voxels a side.
+bool field_in_first_root_tile(ivec3 ijk) {
+  return all(greaterThanEqual(ijk, ivec3(0))) && all(lessThan(ijk, ivec3(4096)));
+}
+
+// Caches the upper node of the root tile at (0, 0, 0) in the accessor, so that reads in that tile
+// never walk the root. Why: NVIDIA's GLSL compiler (driver 580.159.04, seen 2026-12-04 by
+// tests/sdf/sparse_field_test.cpp on an H200) gives the high word of PNanoVDB's root key
+// (pnanovdb_coord_to_key) as 3 where it is 0, so the root walk found no tile and every read was the
+// background; llvmpipe computes it right. The accessor's own cache test (ijk ^ key above bit 12) keeps
+// the node for every coordinate of the tile. Without such a tile (an empty grid) nothing is cached.
+void field_prime(inout FieldReader reader) {
+  pnanovdb_buf_t buf;
+  pnanovdb_root_handle_t root = reader.accessor.root;
+  uint tiles = pnanovdb_root_get_tile_count(buf, root);
+  pnanovdb_root_tile_handle_t tile = pnanovdb_root_get_tile_zero(PNANOVDB_GRID_TYPE_FLOAT, root);
+  for (uint t = 0u; t < tiles; ++t) {
+    pnanovdb_uint64_t key = pnanovdb_root_tile_get_key(buf, tile);
+    if (key.x == 0u && key.y == 0u && !pnanovdb_int64_is_zero(pnanovdb_root_tile_get_child(buf, tile))) {
+      reader.accessor.upper = pnanovdb_root_get_child(PNANOVDB_GRID_TYPE_FLOAT, buf, root, tile);
+      reader.accessor.key = ivec3(0);
+      return;
+    }
+    tile.address = pnanovdb_address_offset(tile.address, PNANOVDB_GRID_TYPE_GET(PNANOVDB_GRID_TYPE_FLOAT, root_tile_size));
+  }
+}
+
+// A read outside the first root tile drops the accessor's cached upper node: cache it again.
+void field_keep_primed(inout FieldReader reader) {
+  if (pnanovdb_address_is_null(reader.accessor.upper.address)) field_prime(reader);
+}
+
 FieldReader field_reader() {
   pnanovdb_buf_t buf;
   pnanovdb_grid_handle_t grid;
@@ -26,16 +59,21 @@ FieldReader field_reader() {
   pnanovdb_root_handle_t root = pnanovdb_tree_get_root(buf, pnanovdb_grid_get_tree(buf, grid));
   FieldReader reader;
   pnanovdb_readaccessor_init(reader.accessor, root);
+  field_prime(reader);
   return reader;
 }
 
 // The value of grid voxel `g` (grid-local integer coordinates) [world units]; off the band the
-// background's +-value (tiles and inactive voxels keep the flood fill's sign).
+// background's +-value (tiles and inactive voxels keep the flood fill's sign). The read goes through a
+// copy of the accessor, kept only for coordinates in the first root tile: a read outside it (grids of
+// 3968 voxels a side or more, or probes off the grid) walks the root without dropping the primed node.
+// One PNanoVDB call per read: each call is inlined, and llvmpipe's compile time follows the count.
 float field_voxel(inout FieldReader reader, ivec3 g) {
   pnanovdb_buf_t buf;
   pnanovdb_coord_t ijk = g + field_index_offset;
-  pnanovdb_address_t address =
-      pnanovdb_readaccessor_get_value_address(PNANOVDB_GRID_TYPE_FLOAT, buf, reader.accessor, ijk);
+  pnanovdb_readaccessor_t walker = reader.accessor;
+  pnanovdb_address_t address = pnanovdb_readaccessor_get_value_address(PNANOVDB_GRID_TYPE_FLOAT, buf, walker, ijk);
+  if (field_in_first_root_tile(ijk)) reader.accessor = walker;
   return pnanovdb_read_float(buf, address);
 }
 

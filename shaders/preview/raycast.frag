@@ -73,12 +73,14 @@ bool find_surface(vec3 o, vec3 dir, float t, float t_exit, out float t_hit) {
   float traced_to = t_min;  // the field has no crossing before here
   pnanovdb_vec3_t pos = pnanovdb_hdda_ray_start(origin, t_min, direction);
   pnanovdb_coord_t ijk = pnanovdb_hdda_pos_to_ijk(pos);
+  field_keep_primed(volume_reader);  // (common/sparse_field.glsl: the root walk is what NVIDIA miscompiles)
   int dim = int(pnanovdb_readaccessor_get_dim(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk));
   pnanovdb_hdda_t hdda;
   pnanovdb_hdda_init(hdda, origin, t_min, direction, t_max, dim);
   while (pnanovdb_hdda_step(hdda)) {
     pnanovdb_vec3_t next = pnanovdb_hdda_ray_start(origin, hdda.tmin + 1.0001, direction);
     ijk = pnanovdb_hdda_pos_to_ijk(next);
+    field_keep_primed(volume_reader);
     dim = int(pnanovdb_readaccessor_get_dim(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk));
     pnanovdb_hdda_update(hdda, origin, direction, dim);
     if (hdda.dim > 1 || !pnanovdb_readaccessor_is_active(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk)) {

@@ -2,7 +2,13 @@
 #extension GL_GOOGLE_include_directive : require
 // Reads an sdf::SparseField at given grid-local positions the way the sampler and the preview do,
 // so tests can compare with the host's NanoVDB/OpenVDB values. mode 0: x = the voxel value at
-// round(position); mode 1: x = trilinear value; mode 2: xyz = field_sample's unit gradient, w = its value.
+// round(position); mode 1: x = trilinear value; mode 2: xyz = field_sample's unit gradient, w = its value;
+// modes 3 and 4 (bit patterns, for comparing PNanoVDB's tree walk with the host's step by step): 3: the
+// root's byte offset, its tile count and the root key of the voxel at round(position); 4: the byte
+// offset of the root tile holding that key (0: none), the value's byte offset, and the root tile's size;
+// mode 5: as mode 0 with the accessor's root moved onto the grid header (whose word at the root's tile
+// count offset is the grid index, 0): a read that walked the root would find no tile and give the
+// background, so this shows that reads in the first root tile never walk it (the NVIDIA work-around).
 #include "test/bindings.h"
 layout(local_size_x = 64) in;
 layout(std430, binding = TS_TEST_FIELD_GRID) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
@@ -16,11 +22,30 @@ void main() {
   if (i >= count) return;
   FieldReader reader = field_reader();
   vec3 x = points[i].xyz;
-  if (mode == 0) {
+  if (mode == 5) {
+    reader.accessor.root.address.byte_offset = 0u;
+    values[i] = vec4(field_voxel(reader, ivec3(round(x))), 0.0, 0.0, 0.0);
+  } else if (mode == 0) {
     values[i] = vec4(field_voxel(reader, ivec3(round(x))), 0.0, 0.0, 0.0);
   } else if (mode == 1) {
     values[i] = vec4(field_trilinear(reader, x), 0.0, 0.0, 0.0);
-  } else {
+  } else if (mode == 2) {
     values[i] = field_sample(reader, x);
+  } else {
+    pnanovdb_buf_t buf;
+    pnanovdb_grid_handle_t grid;
+    grid.address.byte_offset = 0u;
+    pnanovdb_root_handle_t root = pnanovdb_tree_get_root(buf, pnanovdb_grid_get_tree(buf, grid));
+    pnanovdb_coord_t ijk = ivec3(round(x)) + field_index_offset;
+    pnanovdb_uint64_t key = pnanovdb_coord_to_key(ijk);
+    if (mode == 3) {
+      values[i] = uintBitsToFloat(uvec4(root.address.byte_offset, pnanovdb_root_get_tile_count(buf, root), key.x, key.y));
+    } else {
+      pnanovdb_root_tile_handle_t tile = pnanovdb_root_find_tile(PNANOVDB_GRID_TYPE_FLOAT, buf, root, ijk);
+      pnanovdb_address_t address =
+          pnanovdb_readaccessor_get_value_address(PNANOVDB_GRID_TYPE_FLOAT, buf, reader.accessor, ijk);
+      values[i] = uintBitsToFloat(uvec4(tile.address.byte_offset, address.byte_offset,
+                                        PNANOVDB_GRID_TYPE_GET(PNANOVDB_GRID_TYPE_FLOAT, root_tile_size), 0u));
+    }
   }
 }

@@ -10,6 +10,8 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <array>
 #include <random>
 
 #include "core/primitives.h"
@@ -84,6 +86,79 @@ TEST_F(SparseFieldTest, GlslReadsTheLevelSetAtEveryVoxelBitForBit) {
   }
   EXPECT_GT(inside_off_band, 200u);
   EXPECT_GT(outside_off_band, 200u);
+}
+
+// PNanoVDB's tree walk in GLSL, step by step against the host's NanoVDB grid: the root's offset and
+// tile count, the root key of a voxel, the root tile that holds it and the value's address. When a
+// driver reads the field wrong (every voxel the background), this says at which step the walk parts.
+// On NVIDIA's driver 580.159.04 (H200, 2026-12-04) it fails at the key's high word (3 for 0): the
+// driver's miscompile, which the next test shows the reads no longer depend on.
+TEST_F(SparseFieldTest, GlslWalksTheTreeAsTheHostGridIsLaidOut) {
+  const SparseField field(*result_.grid, spec_, 3.0);
+  const nanovdb::FloatGrid* nano = field.host().grid<float>();
+  ASSERT_NE(nano, nullptr);
+  using Root = nanovdb::FloatGrid::TreeType::RootType;
+  const Root& root = nano->tree().root();
+  const auto offset_of = [&](const void* p) {
+    return static_cast<std::uint32_t>(static_cast<const char*>(p) - reinterpret_cast<const char*>(nano));
+  };
+  std::vector<Eigen::Vector4f> points;
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> ux(0, spec_.dims.x() - 1), uy(0, spec_.dims.y() - 1), uz(0, spec_.dims.z() - 1);
+  auto accessor = result_.grid->getConstAccessor();
+  while (points.size() < 64) {
+    const Eigen::Vector3i g(ux(rng), uy(rng), uz(rng));
+    const Eigen::Vector3i ijk = g + spec_.index_offset;
+    if (!accessor.isValueOn(openvdb::Coord(ijk.x(), ijk.y(), ijk.z()))) continue;  // band voxels only
+    points.emplace_back(g.x(), g.y(), g.z(), 0.0f);
+  }
+  const auto bits = [](const Eigen::Vector4f& v) {
+    std::array<std::uint32_t, 4> u{};
+    std::memcpy(u.data(), v.data(), sizeof(u));
+    return u;
+  };
+  const auto walk = probe(field, points, 3);
+  const auto found = probe(field, points, 4);
+  ASSERT_FALSE(gpu_index_shift(spec_).isZero());  // the torus's grid starts at negative indices: moved
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    const Eigen::Vector3i ijk = points[p].head<3>().cast<int>() + field.gpu_index_offset();
+    ASSERT_TRUE((ijk.array() >= 0).all() && (ijk.array() < 4096).all()) << ijk.transpose();
+    const nanovdb::Coord coord(ijk.x(), ijk.y(), ijk.z());
+    const std::uint64_t key = Root::DataType::CoordToKey(coord);
+    std::uint32_t tile_offset = 0;
+    for (std::uint32_t t = 0; t < root.tileCount(); ++t) {
+      if (root.data()->tile(t)->key == key) tile_offset = offset_of(root.data()->tile(t));
+    }
+    const auto w = bits(walk[p]), f = bits(found[p]);
+    SCOPED_TRACE(::testing::Message() << "voxel " << ijk.transpose());
+    EXPECT_EQ(w[0], offset_of(&root)) << "root offset";
+    EXPECT_EQ(w[1], root.tileCount()) << "root tile count";
+    EXPECT_EQ(w[2], static_cast<std::uint32_t>(key)) << "root key, low word";
+    EXPECT_EQ(w[3], static_cast<std::uint32_t>(key >> 32)) << "root key, high word";
+    EXPECT_EQ(f[2], sizeof(Root::DataType::Tile)) << "root tile size";
+    EXPECT_EQ(f[0], tile_offset) << "root tile holding the voxel";
+    const auto* leaf = root.probeLeaf(coord);
+    ASSERT_NE(leaf, nullptr);
+    const float* value = &leaf->data()->mValues[nanovdb::FloatGrid::TreeType::LeafNodeType::CoordToOffset(coord)];
+    ASSERT_NE(value, nullptr);
+    EXPECT_EQ(f[1], offset_of(value)) << "value address";
+    if (::testing::Test::HasFailure()) break;  // one voxel's trace says where the walk parts
+  }
+}
+
+// The work-around for NVIDIA's miscompiled root key (common/sparse_field.glsl, field_prime): with the
+// root made unusable after the accessor is primed, every voxel still reads bit for bit, so no read in
+// the first root tile depends on the root walk.
+TEST_F(SparseFieldTest, ReadsInTheFirstRootTileNeverWalkTheRoot) {
+  const SparseField field(*result_.grid, spec_, 3.0);
+  std::vector<Eigen::Vector4f> points;
+  for (int k = 0; k < spec_.dims.z(); ++k)
+    for (int j = 0; j < spec_.dims.y(); ++j)
+      for (int i = 0; i < spec_.dims.x(); ++i) points.emplace_back(i, j, k, 0.0f);
+  const auto values = probe(field, points, 5);
+  for (std::size_t v = 0; v < points.size(); ++v) {
+    ASSERT_EQ(values[v].x(), result_.dense.values[v].w()) << "voxel " << points[v].transpose();
+  }
 }
 
 TEST_F(SparseFieldTest, TrilinearValuesAgreeWithOpenVdbToFloatPrecision) {
