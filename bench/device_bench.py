@@ -31,17 +31,22 @@ from docs_section import replace_between  # noqa: E402
 from sample_bench import resolve_mesh, run_sample  # noqa: E402
 
 SCHEMA = "tetrasand-device-bench/1"
-PARTS = ["sdf", "sampler", "sim", "preview"]  # in order of value: the first gets its time first
+# In order of value: the first gets its time first. selftest first: the GPU kernels' agreement tests
+# on the device, because timings of kernels that compute wrong are worth nothing (2026-12-04: PNanoVDB's
+# root walk read every voxel as the background on NVIDIA while every llvmpipe test passed).
+PARTS = ["selftest", "sdf", "sampler", "sim", "preview"]
 
 # Sizes of each part: the full run (issue 16) and --quick (tiny, so the chain runs on llvmpipe here).
 SIZES = {
     "full": {
+        "selftest": "full",
         "sdf": {"meshes": ["knot1", "armadillo", "icosphere:8"], "resolutions": [256, 512, 1024, 2048]},
         "sampler": {"mesh": "bunny", "counts": [10_000, 100_000, 1_000_000]},
         "sim": {"grains": [64_000, 1_000_000, 4_000_000], "precisions": ["float", "double"], "seconds": 1.0},
         "preview": {"mesh": "bunny", "size": 1024, "resolution": 1024, "particles": 1_000_000, "repeat": 3},
     },
     "quick": {
+        "selftest": "quick",
         "sdf": {"meshes": ["knot1", "icosphere:2"], "resolutions": [16, 24]},
         "sampler": {"mesh": "bunny", "counts": [400, 600]},
         "sim": {"grains": [1000], "precisions": ["float", "double"], "seconds": 0.1},
@@ -50,9 +55,21 @@ SIZES = {
 }
 # Time caps (s). Full: 460 s of parts in a call of at most 8 minutes (unpacking and `devices` take the
 # rest); time a part leaves unused goes to the parts after it. Quick: loose, for 2 loaded cores.
-CAPS = {"full": {"sdf": 200, "sampler": 80, "sim": 130, "preview": 50},
-        "quick": {"sdf": 90, "sampler": 90, "sim": 150, "preview": 120}}
-BINARIES = {"sdf": "tetrasand_bench_sdf", "sampler": "tetrasand", "sim": "tetrasand_bench_sim",
+CAPS = {"full": {"selftest": 60, "sdf": 150, "sampler": 80, "sim": 130, "preview": 50},
+        "quick": {"selftest": 200, "sdf": 90, "sampler": 90, "sim": 150, "preview": 120}}
+# The selftest: test executables and the GoogleTest filters of their GPU-against-host tests (the full
+# set on the device; --quick a few, since each new kernel compiles for tens of seconds on llvmpipe).
+SELFTESTS = {
+    "full": [("tetrasand_gpu_tests", "GpuContext.*:GpuQueue.*:Graphics.*:GpuGrid.*:GpuLayouts.*:HostSync.*"),
+             ("tetrasand_sdf_tests", "SparseFieldTest.*:ScanConvert.*"),
+             ("tetrasand_sampler_tests", "Relaxer.*:CoverageCertificate.*:Meshes/CpuAgainstGpu.*"),
+             ("tetrasand_sim_tests", "GpuStepperTest.*:GpuCpuAgreement.*"),
+             ("tetrasand_preview_tests", "PreviewRenderer.*:PreviewGolden.*")],
+    "quick": [("tetrasand_gpu_tests", "GpuLayouts.*"),
+              ("tetrasand_sdf_tests", "SparseFieldTest.ReadsInTheFirstRootTileNeverWalkTheRoot")],
+}
+TEST_BINARIES = [exe for exe, _ in SELFTESTS["full"]]
+BINARIES = {"selftest": "tetrasand_gpu_tests", "sdf": "tetrasand_bench_sdf", "sampler": "tetrasand", "sim": "tetrasand_bench_sim",
             "preview": "tetrasand_bench_preview"}
 
 
@@ -116,6 +133,37 @@ class Run:
             return os.path.join(ROOT, "assets", "bunny.obj")
         carried = os.path.join(self.meshes or "", name + ".off")
         return carried if self.meshes and os.path.exists(carried) else resolve_mesh(name, self.work)
+
+    def selftest(self, cap):
+        """Each test executable under what is left of the cap; a missing one (a bundle packed without the
+        tests) is recorded as such. The part is an error when any test failed, with the names."""
+        rows, start, failed = [], time.perf_counter(), []
+        for exe, pattern in SELFTESTS[self.sizes["selftest"]]:
+            path, left = os.path.join(self.bin, exe), cap - (time.perf_counter() - start)
+            if not os.access(path, os.X_OK):
+                rows.append({"binary": exe, "filter": pattern, "status": "missing"})
+                continue
+            if left <= 0:
+                rows.append({"binary": exe, "filter": pattern, "status": "not run (part cap reached)"})
+                continue
+            report = os.path.join(self.work, exe + ".json")
+            rc, secs, out, err = run_capped([path, f"--gtest_filter={pattern}", f"--gtest_output=json:{report}"],
+                                            left, os.path.join(self.work, exe))
+            tests = [(f"{suite['name']}.{t['name']}", t.get("failures", []))
+                     for suite in (json.load(open(report)).get("testsuites", []) if os.path.exists(report) else [])
+                     for t in suite.get("testsuite", [])]
+            bad = [name for name, failures in tests if failures]
+            status = "timeout" if rc is None else ("ok" if rc == 0 else "failed")
+            failed += bad or ([f"{exe} ({status})"] if status != "ok" else [])
+            rows.append({"binary": exe, "filter": pattern, "status": status, "seconds": round(secs, 2),
+                         "tests": len(tests), "failed": bad,
+                         "messages": {name: tail(f[0].get("failure", ""), 6) for name, f in tests if f},
+                         "output_tail": tail(out + err, 20) if status != "ok" else ""})
+        missing = [r["binary"] for r in rows if r["status"] == "missing"]
+        if len(missing) == len(rows):
+            raise FileNotFoundError(f"no test executable in {self.bin} (prepare packs them from a build with tests)")
+        err = "failed: " + ", ".join(failed) if failed else ""
+        return (1 if failed else 0), time.perf_counter() - start, err, {"rows": rows}
 
     def sdf(self, cap):
         s = self.sizes["sdf"]
@@ -261,7 +309,7 @@ def run(args):
 # --- the markdown: one section per part, headed by the machine, GPU, driver and date ---
 
 def provenance(res, part):
-    m, p = res["machine"], res["parts"][part]
+    m, p = res["machine"], res["parts"].get(part, {"status": "not in this results file"})
     gl = m.get("nvidia_smi") or m["gl_renderer"] or "unknown GPU"
     label = "" if "NVIDIA" in m["gl_renderer"] else (
         " **Not an NVIDIA GPU**: this run's GL device is the one named here (a test of the script, not a figure "
@@ -272,6 +320,22 @@ def provenance(res, part):
             f"{m['cores']} cores ({m['cpu']}). Part status: **{p['status']}**"
             + (f" after {p['seconds']:.0f} s of its {p['cap_s']:.0f} s cap" if "seconds" in p else "")
             + (f" ({p['error'].splitlines()[0]})" if p.get("error") else "") + "." + label)
+
+
+def selftest_section(res):
+    p = res["parts"].get("selftest", {})
+    lines = ["### GPU self-test on an NVIDIA GPU", "", provenance(res, "selftest"), "",
+             "The GPU kernels' agreement tests (GoogleTest, from the build the bundle was packed from) run on the "
+             "device before any timing: kernels that compute wrong make their timings worthless.", ""]
+    rows = p.get("rows", [])
+    if rows:
+        lines += ["| executable | filter | status | tests | failed | s |", "|---|---|---|---|---|---|"]
+        lines += [f"| {r['binary']} | `{r['filter']}` | {r['status']} | {r.get('tests', '')} "
+                  f"| {', '.join(r.get('failed', [])) or '-'} | {r.get('seconds', '')} |" for r in rows]
+    messages = [(name, text) for r in rows for name, text in r.get("messages", {}).items()]
+    for name, text in messages[:6]:
+        lines += ["", f"`{name}`:", "", "```", text, "```"]
+    return "\n".join(lines)
 
 
 def sdf_section(res):
@@ -358,7 +422,7 @@ def preview_section(res):
 
 
 def sections(res, baseline=None):
-    return {"sdf": sdf_section(res), "sampler": sampler_section(res, baseline), "sim": sim_section(res),
+    return {"selftest": selftest_section(res), "sdf": sdf_section(res), "sampler": sampler_section(res, baseline), "sim": sim_section(res),
             "preview": preview_section(res)}
 
 
@@ -366,9 +430,8 @@ def load_results(path):
     res = json.load(open(path))
     if res.get("schema") != SCHEMA:
         raise SystemExit(f"{path}: not a device-bench results file (schema {res.get('schema')!r}, expected {SCHEMA})")
-    missing = [p for p in PARTS if p not in res["parts"]]
-    if missing:
-        raise SystemExit(f"{path}: no record of part(s) {', '.join(missing)}")
+    for part in PARTS:  # a file from before a part existed: that part counts as not run
+        res["parts"].setdefault(part, {"status": "skipped", "error": "no record in this results file"})
     return res
 
 

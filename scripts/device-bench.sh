@@ -6,10 +6,12 @@
 #       device machine lacks: payload.tar.xz (the executables, stripped; the shared libraries ldd names
 #       minus the system and GL/EGL ones; the shaders; CGAL's knot1 and armadillo) and gl/*.deb (libglvnd's
 #       EGL/OpenGL loaders, fetched with apt-get download). Prints the bundle's size; fails above the carry limit.
+#       The test executables of the GPU agreement tests travel too (the run's selftest part runs them first).
 #   scripts/device-bench.sh run [--quick] [--bundle DIR | --build-dir DIR] [--out DIR] [--only PARTS]
 #                               [--caps PART=S,...] [--budget S]
 #       there (or here with --quick): with a bundle, unpacks it (the .debs into / only where no libEGL is
-#       installed), then runs SDF, sampler, sim and preview, each under its own time cap (bench/device_bench.py),
+#       installed), then runs selftest (the GPU agreement tests), SDF, sampler, sim and preview, each under
+#       its own time cap (bench/device_bench.py),
 #       into DIR/device-bench.json and DIR/device-bench.md (DIR: --out, else $OUT, else ./device-bench-out).
 #       Without a bundle it runs the build tree's binaries (default build-release).
 #   scripts/device-bench.sh report RESULTS.json [--markdown FILE] [--baseline HERE.json] [--allow-test]
@@ -26,6 +28,9 @@ py=/usr/bin/python3
 [ -x "$py" ] || py=$(command -v python3)
 carry_limit=$((64 * 1024 * 1024))  # bytes: the device tool's limit on the working tree and carried paths together
 binaries=(tetrasand tetrasand_bench_sdf tetrasand_bench_sim tetrasand_bench_preview)
+# The test executables whose GPU agreement tests the device run's selftest part runs first
+# (bench/device_bench.py SELFTESTS); packed when the build has them.
+test_binaries=(tetrasand_gpu_tests tetrasand_sdf_tests tetrasand_sampler_tests tetrasand_sim_tests tetrasand_preview_tests)
 gl_packages=(libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2)
 # What ldd names that the bundle leaves out: the C and C++ runtimes every Linux has, and the GL loaders
 # (libglvnd, from gl/*.deb there, so that the NVIDIA driver's own libraries are the ones loaded).
@@ -76,8 +81,14 @@ stage_payload() {
     [ -x "$1/bin/$b" ] || { echo "device-bench: $1/bin/$b not built" >&2; exit 1; }
     strip --strip-unneeded -o "$2/bin/$b" "$1/bin/$b"
   done
+  local packed=("${binaries[@]}")
+  for b in "${test_binaries[@]}"; do
+    [ -x "$1/bin/$b" ] || { echo "device-bench: $1/bin/$b not built: the selftest part will record it missing" >&2; continue; }
+    strip --strip-unneeded -o "$2/bin/$b" "$1/bin/$b"
+    packed+=("$b")
+  done
   cp -r "$1/share/tetrasand/shaders" "$2/share/tetrasand/"
-  for b in "${binaries[@]}"; do ldd "$1/bin/$b"; done | awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u |
+  for b in "${packed[@]}"; do ldd "$1/bin/$b"; done | awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u |
     while read -r lib; do
       basename "$lib" | grep -Eq "$system_libs" || cp -L "$lib" "$2/lib/"
     done
@@ -97,8 +108,8 @@ prepare() {
     esac
   done
   if [ "$do_build" -eq 1 ]; then
-    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-    cmake --build "$build" -j "$(nproc)" --target "${binaries[@]}" tetrasand_shaders >/dev/null
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTETRASAND_BUILD_TESTS=ON -DTETRASAND_BUILD_BENCH=ON >/dev/null
+    cmake --build "$build" -j "$(nproc)" --target "${binaries[@]}" "${test_binaries[@]}" tetrasand_shaders >/dev/null
   fi
   if [ -e "$bundle" ] && [ ! -f "$bundle/payload.tar.xz" ] && [ -n "$(ls -A "$bundle")" ]; then
     echo "device-bench: $bundle is not empty and holds no payload.tar.xz: not overwriting it" >&2

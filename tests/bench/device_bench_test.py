@@ -16,7 +16,7 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(ROOT, "scripts", "device-bench.sh")
 DOCS = os.path.join(ROOT, "docs", "benchmarks.md")
-PARTS = ["sdf", "sampler", "sim", "preview"]
+PARTS = ["selftest", "sdf", "sampler", "sim", "preview"]
 failures = []
 
 
@@ -50,17 +50,21 @@ def quick(build):
         check(p.get("status") == "ok", f"{part}: status ok (got {p.get('status')}: {p.get('error')})")
         check(len(p.get("rows", [])) > 0, f"{part}: has rows")
         check(0 < p.get("seconds", 0) <= p.get("cap_s", 0), f"{part}: took {p.get('seconds')} s within its cap")
+    selftest = res["parts"]["selftest"]["rows"]
+    check(all(r["status"] == "ok" and r["tests"] > 0 and not r["failed"] for r in selftest),
+          f"selftest: every test executable ran its GPU tests and passed ({selftest})")
     sdf = res["parts"]["sdf"]["rows"]
     check(len(sdf) == 4 and all(int(r["gpu_wrong_signs"]) == 0 for r in sdf), "sdf: 2 meshes x 2 grids, no wrong sign")
     sim = res["parts"]["sim"]["rows"]
     check(sorted(r["precision"] for r in sim) == ["double", "float"], "sim: a float and a double row")
     sampler = res["parts"]["sampler"]["rows"]
-    check(all(r["status"] == "ok" and "sampler/relax.comp" in r["timings"] for r in sampler),
-          "sampler: every count ok, with its per-kernel times")
+    # --backend auto: the GPU kernels on a hardware GPU, the CPU relaxation on llvmpipe; either names itself.
+    check(all(r["status"] == "ok" and ("sampler/relax.comp" in r["timings"] or "CPU relaxation" in r["timings"])
+              for r in sampler), "sampler: every count ok, with the timings of the relaxation that ran")
     check(len(res["parts"]["preview"]["rows"]) == 3, "preview: SDF, impostor and hybrid rows")
     md = open(os.path.join(out, "device-bench.md")).read()
-    check(all(f"### {t} on an NVIDIA GPU" in md for t in ("SDF", "Sampling", "Simulation", "Preview")),
-          "device-bench.md has the four sections")
+    check(all(f"### {t} on an NVIDIA GPU" in md for t in ("GPU self-test", "SDF", "Sampling", "Simulation", "Preview")),
+          "device-bench.md has the five sections")
 
 
 def report(build):
@@ -83,7 +87,7 @@ def report(build):
               f"nvidia-{part}: names the GL renderer and the date")
         check("Not an NVIDIA GPU" in body, f"nvidia-{part}: an llvmpipe run is labelled as not NVIDIA")
     check("| knot1 | 6400 |" in doc and "| 1000 | double |" in doc, "the SDF and sim rows are in their sections")
-    outside = lambda text: text.split("<!-- section: nvidia-sdf -->")[0]
+    outside = lambda text: text.split("<!-- section: nvidia-selftest -->")[0]
     check(outside(doc) == outside(original), "the text before the NVIDIA sections is unchanged")
     device_bench("report", results, "--markdown", copy, "--allow-test", "--baseline", results)
     sampler = open(copy).read().split("<!-- section: nvidia-sampler -->")[1].split("<!-- end: nvidia-sampler -->")[0]
@@ -92,19 +96,44 @@ def report(build):
     shutil.rmtree(tmp)
 
 
+# A stand-in test executable whose GoogleTest report has one failed test, as a GPU that computes wrong gives.
+FAILING_TESTS = """#!/bin/sh
+for a in "$@"; do case "$a" in --gtest_output=json:*) report=${a#--gtest_output=json:} ;; esac; done
+cat > "$report" <<'JSON'
+{"testsuites": [{"name": "SparseFieldTest", "testsuite": [
+  {"name": "ReadsInTheFirstRootTileNeverWalkTheRoot", "failures": [{"failure": "voxel 1 2 3: 0.24 != -0.12"}]},
+  {"name": "OffTheGridIsTheOutsideBackgroundAndTheGradientIsTheNormal"}]}]}
+JSON
+exit 1
+"""
+
+
 def caps(build):
-    """sdf stopped at a 0.5 s cap, sampler still run, sim without its executable: an error record."""
+    """selftest with a failing test executable: an error naming the test, the rest still run; sdf
+    stopped at a 0.5 s cap, sampler still run, sim without its executable: an error record."""
     tmp = tempfile.mkdtemp(prefix="device-bench-caps.")
     fake = os.path.join(tmp, "bin")
     os.makedirs(fake)
     for exe in ("tetrasand", "tetrasand_bench_sdf"):
         os.symlink(os.path.join(build, "bin", exe), os.path.join(fake, exe))
+    failing = os.path.join(fake, "tetrasand_sdf_tests")
+    with open(failing, "w") as f:
+        f.write(FAILING_TESTS)
+    os.chmod(failing, 0o755)
     out = os.path.join(tmp, "out")
     res = subprocess.run([sys.executable, os.path.join(ROOT, "bench", "device_bench.py"), "run", "--quick", "--bin",
-                          fake, "--out", out, "--only", "sdf,sampler,sim", "--caps", "sdf=0.5"],
+                          fake, "--out", out, "--only", "selftest,sdf,sampler,sim", "--caps", "selftest=0.3,sdf=0.5"],
                          capture_output=True, text=True)
     print(res.stdout + res.stderr)
     parts = json.load(open(os.path.join(out, "device-bench.json")))["parts"]
+    rows = {r["binary"]: r for r in parts["selftest"].get("rows", [])}
+    check(parts["selftest"]["status"] == "error"
+          and "SparseFieldTest.ReadsInTheFirstRootTileNeverWalkTheRoot" in parts["selftest"]["error"],
+          f"selftest: an error naming the failed test ({parts['selftest'].get('error')})")
+    check(rows.get("tetrasand_gpu_tests", {}).get("status") == "missing"
+          and rows.get("tetrasand_sdf_tests", {}).get("failed") == ["SparseFieldTest.ReadsInTheFirstRootTileNeverWalkTheRoot"]
+          and "0.24 != -0.12" in json.dumps(rows.get("tetrasand_sdf_tests", {}).get("messages")),
+          "selftest: the missing executable recorded as missing, the failed test with its message")
     check(parts["sdf"]["status"] == "timeout" and parts["sdf"]["seconds"] < 5,
           f"sdf: recorded as timeout after {parts['sdf'].get('seconds')} s")
     check(parts["sampler"]["status"] == "ok", f"sampler: still ran after the timeout ({parts['sampler']['status']})")
