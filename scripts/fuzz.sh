@@ -65,7 +65,8 @@ seed_fuzz_body() {
 }
 seed_fuzz_scene() { cp "$root"/assets/scenes/*.toml "$1/"; }
 seed_fuzz_vdb() {
-  local out=$1 bin="$root/build-test/bin/tetrasand"
+  # TETRASAND_BIN: a tetrasand binary to write the seed .vdb files with (default: build-test's).
+  local out=$1 bin="${TETRASAND_BIN:-$root/build-test/bin/tetrasand}"
   if [ -x "$bin" ]; then
     "$bin" -q sdf "$root/assets/cube.obj" -o "$out/cube.vdb" --resolution 6 --band 2 || true
     "$bin" -q sdf "$root/assets/torus.obj" -o "$out/torus.vdb" --resolution 8 --band 2 || true
