@@ -21,9 +21,8 @@ void remove_scratch() {
 
 const fs::path& scratch_dir() {
   static const fs::path dir = [] {
-    // In memory when the system has a tmpfs at /dev/shm: the targets write every input to a file,
-    // and on a disk-backed /tmp those writes and the readers' directory scans (read_body looks for
-    // interrupted replacements) are a large share of an input's time.
+    // In memory when the system has a tmpfs at /dev/shm: the targets write every input to a file
+    // (two for fuzz_body), millions of writes that a disk-backed /tmp need not see.
     std::error_code ec;
     const fs::path base = fs::is_directory("/dev/shm", ec) && ::access("/dev/shm", W_OK) == 0
                               ? fs::path("/dev/shm")
