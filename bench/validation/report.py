@@ -527,6 +527,8 @@ def column(run, docs):
         per = "; ".join(f"{src}: a = {', '.join(f'{x:.2f}' for x in a[sources == src])}" for src in sorted(set(sources)))
         runs_note = (f" The columns come from more than one run ({per}); bench/validation/column_criteria.md says "
                      f"which were added when and that the criteria apply to all of them together.")
+    note_path = os.path.join(run, "column_note.md")  # how this run differs from the plan, when it does
+    note = "\n" + open(note_path).read().strip() + "\n" if os.path.exists(note_path) else ""
     ok_low = abs(slope_low - 1.0) <= 0.25
     ok_high = abs(slope_high - 0.5) <= 0.15
     across = 2 * d["r0_m"].min() / COARSE_D_EQ
@@ -561,7 +563,7 @@ radius sets the aspect ratio a = H0 / R0. The narrowest column is {across:.0f} g
   columns (one run each), so it carries the run-to-run scatter of a single deposit; the tolerances were
   set before the run (bench/validation/column_criteria.md).{runs_note} The small version (400 grains) is the test
   `ColumnCollapse.RunoutGrowsWithAspectRatio`.
-"""
+{note}"""
 
 
 def discharge_rate(t, n, grains=600):
