@@ -32,10 +32,10 @@
 #               (1,000-16,000 on five meshes) and what a radius map would buy on the dino
 #               (--only voxel,band,count,radius-map: run those, carry the others' last rows)
 #               -> section defaults of docs/benchmarks.md, docs/benchmarks/defaults.png  (~40 min, 2 cores)
-#   validation  restitution, angle of repose, column collapse (4 x 20,000 grains), Mankoc-sized silo
+#   validation  restitution, angle of repose, column collapse (8 x 20,000 grains), Mankoc-sized silo
 #               discharge (80,000 grains) with a Beverloo fit, contact-force distribution (the silo's fill
 #               and 3 more 30,000-grain piles), on the CPU reference
-#               -> docs/validation.md and docs/validation/*.png                        (~2 h, 2 cores)
+#               -> docs/validation.md and docs/validation/*.png                        (~2.5 h, 2 cores)
 #   oedometer   the thesis's stress-strain test: 1,000 tetrahedral grains in a cylinder loaded to 5 kPa and
 #               unloaded by a servo piston, and the same with sphere grains, against the criteria of
 #               bench/validation/oedometer_criteria.md -> its section of docs/validation.md and
