@@ -32,10 +32,10 @@
 #               (1,000-16,000 on five meshes) and what a radius map would buy on the dino
 #               (--only voxel,band,count,radius-map: run those, carry the others' last rows)
 #               -> section defaults of docs/benchmarks.md, docs/benchmarks/defaults.png  (~40 min, 2 cores)
-#   validation  restitution, angle of repose, column collapse (4 x 20,000 grains), Mankoc-sized silo
+#   validation  restitution, angle of repose, column collapse (8 x 20,000 grains), Mankoc-sized silo
 #               discharge (80,000 grains) with a Beverloo fit, contact-force distribution (the silo's fill
 #               and 3 more 30,000-grain piles), on the CPU reference
-#               -> docs/validation.md and docs/validation/*.png                        (~2 h, 2 cores)
+#               -> docs/validation.md and docs/validation/*.png                        (~2.5 h, 2 cores)
 #   oedometer   the thesis's stress-strain test: 1,000 tetrahedral grains in a cylinder loaded to 5 kPa and
 #               unloaded by a servo piston, and the same with sphere grains, against the criteria of
 #               bench/validation/oedometer_criteria.md -> its section of docs/validation.md and
@@ -56,8 +56,9 @@
 #               (12 min on llvmpipe, 2 idle cores; over an hour on 2 loaded ones)
 #   sparse      GPU memory of the SDF against resolution: the sparse NanoVDB field (what the sampler and the
 #               preview hold) against the dense textures they held before, band voxels, bytes per band
-#               voxel, bytes read back; bunny, knot1, armadillo at 64^3..1024^3 (--quick: 64, 128)
-#               -> section sparse of docs/benchmarks.md, docs/benchmarks/sparse_memory.png (~5 min, 2 cores)
+#               voxel, bytes read back, peak resident memory; bunny, knot1, armadillo at 64^3..2032^3
+#               (--quick: 64, 128) -> section sparse of docs/benchmarks.md, docs/benchmarks/sparse_memory.png,
+#               the raw rows in docs/benchmarks/sparse_memory_rows.json (2032: ~30 min a mesh at load 15)
 #   all         every one of the above, in one run
 # Exit status: 0 when every physical comparison is within its stated tolerance, 1 otherwise.
 # The preview bench (tetrasand_bench_preview) has no peer; see docs/benchmarks.md.
@@ -188,11 +189,15 @@ cgal_meshes() {
 }
 if runs sparse; then
   meshes=$(cgal_meshes)
-  sparse_res=64,128,256,512,1024
-  [ "$quick" -eq 1 ] && sparse_res=64,128
+  # 2032, not 2048: the scan converter's slab is a 3D texture, and llvmpipe's 2048 side is smaller than a
+  # 2048 grid with its padding (2058 voxels); 2032 gives 2042.
+  sparse_res=64,128,256,512,1024,2032
+  sparse_rows=(--rows "$root/docs/benchmarks/sparse_memory_rows.json")
+  # --quick writes its rows to the work folder, leaving the full run's rows in docs/ alone.
+  [ "$quick" -eq 1 ] && sparse_res=64,128 && sparse_rows=(--rows "$work/sparse_memory_rows.json")
   "$py" "$root/bench/sparse_memory.py" "$bin/tetrasand" "$root/assets/bunny.obj,$meshes/knot1.off,$meshes/armadillo.off" \
     "$sparse_res" --markdown "$root/docs/benchmarks.md" --plot "$root/docs/benchmarks/sparse_memory.png" \
-    --command "scripts/bench.sh sparse$([ "$quick" -eq 1 ] && echo ' --quick')" || status=1
+    "${sparse_rows[@]}" --command "scripts/bench.sh sparse$([ "$quick" -eq 1 ] && echo ' --quick')" || status=1
   echo "bench: wrote section sparse of docs/benchmarks.md and docs/benchmarks/sparse_memory.png"
 fi
 if runs sdf; then

@@ -35,9 +35,15 @@ def scene():
     # The test's peak: the highest key after the approach (whose high target ends at the first drop).
     drop = next(k for k in range(1, len(keys)) if keys[k][1] < keys[k - 1][1])
     peak = max(range(drop, len(keys)), key=lambda k: keys[k][1])
+    # The ramps may be graded (several keys each way): loading starts at the last key at the seating
+    # stress before the peak, unloading ends at the first key back at it.
+    seat_stress = keys[drop][1]
+    seat = max(k for k in range(drop, peak) if keys[k][1] == seat_stress)
+    end = next(k for k in range(peak + 1, len(keys)) if keys[k][1] == seat_stress)
     with open(os.path.join(os.path.dirname(SCENE), prop["body"])) as f:
         piston_radius = json.load(f)["particle_radius"]
-    return dict(seat=keys[peak - 1][0], peak=keys[peak][0], end=keys[peak + 1][0], seat_stress=keys[peak - 1][1],
+    return dict(seat=keys[seat][0], peak=keys[peak][0], end=keys[end][0], seat_stress=seat_stress,
+                graded=peak - seat > 1,
                 peak_stress=keys[peak][1], face=piston_radius, radius=s["grain"]["radius"],
                 density=s["material"][0]["density"], cylinder=s["boundary"][1]["radius"])
 
@@ -144,8 +150,8 @@ def section(run, docs):
              f"`assets/scenes/validation/oedometer.toml`: {int(rows['tetrahedra']['grains'])} tetrahedral grains "
              f"(r = {sc['radius'] * 1e3:.0f} mm spheres, E = 1 MPa, mu = 0.5, tangential springs) in a smooth cylinder "
              f"of radius {sc['cylinder'] * 1e3:.0f} mm, pressed by a servo piston (`[prop.servo]`) seated at "
-             f"{sc['seat_stress']:.0f} Pa, loaded linearly to {sc['peak_stress'] / 1e3:.0f} kPa over "
-             f"{sc['peak'] - sc['seat']:.1f} s and unloaded to {sc['seat_stress']:.0f} Pa over "
+             f"{sc['seat_stress']:.0f} Pa, loaded {'along a graded ramp (stress rate about proportional to sigma^(1/2))' if sc['graded'] else 'linearly'} to {sc['peak_stress'] / 1e3:.0f} kPa over "
+             f"{sc['peak'] - sc['seat']:.1f} s and unloaded {'along its mirror ' if sc['graded'] else ''}to {sc['seat_stress']:.0f} Pa over "
              f"{sc['end'] - sc['peak']:.1f} s. Strain from the piston's travel over the bed height at seating. "
              f"The contrast run replaces each grain by one sphere of its volume and mass (radius 4^(1/3) r; the "
              f"`[grain]` table cannot say one sphere, so the bench swaps them in the initial world).\n",

@@ -1,11 +1,14 @@
 #!/usr/bin/python3
 """docs/validation.md from the CSV files of tetrasand_validation_runs, with PNG plots (matplotlib).
 
-Usage: bench/validation/report.py RUN_DIR DOCS_DIR
+Usage: bench/validation/report.py RUN_DIR DOCS_DIR [--only column]
+(--only column: only the column-collapse section, from RUN_DIR/column.csv, which may hold the columns of
+more than one run with a `source` column; see bench/validation/column_criteria.md)
 Each section states what the literature expects and whether tetrasand meets it, from the numbers of
 this run (nothing is hard-coded but the literature's values and the tolerances).
 """
 import os
+import re
 import sys
 import time
 from collections import namedtuple
@@ -481,10 +484,13 @@ holding at least 5 forces.
 
 
 def column(run, docs):
-    d = np.genfromtxt(os.path.join(run, "column.csv"), delimiter=",", names=True)
-    a, n = d["aspect"], d["normalised_runout"]
+    d = np.genfromtxt(os.path.join(run, "column.csv"), delimiter=",", names=True, dtype=None, encoding=None)
+    # A `source` column (the run's date) when the columns come from more than one run
+    # (bench/validation/column_criteria.md: columns added to kept ones); absent in a plain run.
+    sources = d["source"].astype(str) if "source" in d.dtype.names else np.array([""] * len(d))
+    a, n = d["aspect"].astype(float), d["normalised_runout"].astype(float)
     order = np.argsort(a)
-    a, n, grains = a[order], n[order], int(d["grains"][0])
+    a, n, grains, sources = a[order], n[order], int(d["grains"][0]), sources[order]
     rising = bool(np.all(np.diff(n) > 0))
     slope = float(np.polyfit(np.log(a), np.log(n), 1)[0])
     low, high = a < 1.7, a >= 1.7
@@ -495,16 +501,34 @@ def column(run, docs):
     x = np.linspace(min(a.min(), 0.3), max(a.max(), 6), 100)
     lube = np.where(x < 1.7, 1.24 * x, 1.6 * np.sqrt(x))
     fig, ax = plt.subplots(figsize=(6, 4))
-    ax.loglog(a, n, "o-", label=f"tetrasand (CPU reference, {grains} grains, r = 5 mm)")
+    ax.loglog(a, n, "-", color="C0", lw=1)
+    for k, src in enumerate(sorted(set(sources))):
+        m = sources == src
+        ax.loglog(a[m], n[m], "os^"[k % 3], color="C0", mfc="none" if k else "C0",
+                  label=f"tetrasand (CPU reference, {grains} grains, r = 5 mm){', run of ' + src if src else ''}")
     ax.loglog(x, lube, "--", color="grey", label="Lube et al. 2004: 1.24 a, 1.6 a^(1/2) above a = 1.7")
     ax.set_xlabel("aspect ratio a = H0 / R0")
     ax.set_ylabel("normalised runout (R_inf - R0) / R0")
     ax.legend(fontsize=7)
     img = save(fig, docs, "column.png")
+    several = len(set(sources)) > 1
     table = "\n".join(f"| {r0 * 1e3:.0f} | {h0 * 1e3:.0f} | {ai:.2f} | {ro * 1e3:.0f} | {ni:.2f} | "
                       f"{(1.24 * ai if ai < 1.7 else 1.6 * np.sqrt(ai)):.2f} | {ts:.2f} / {tp:.2f} |"
-                      for r0, h0, ai, ro, ni, ts, tp in zip(d["r0_m"][order], d["h0_m"][order], a, d["runout_m"][order],
-                                                           n, d["settle_s"][order], d["spread_s"][order]))
+                      + (f" {src} |" if several else "")
+                      for r0, h0, ai, ro, ni, ts, tp, src in zip(d["r0_m"][order], d["h0_m"][order], a,
+                                                                d["runout_m"][order], n, d["settle_s"][order],
+                                                                d["spread_s"][order], sources))
+    head = "| R0 (mm) | H0 (mm) | a | R_inf (mm) | (R_inf - R0) / R0 | Lube et al. 2004 | settle / spread (s) |"
+    rule = "|---|---|---|---|---|---|---|"
+    if several:
+        head, rule = head + " run |", rule + "---|"
+    runs_note = ""
+    if several:
+        per = "; ".join(f"{src}: a = {', '.join(f'{x:.2f}' for x in a[sources == src])}" for src in sorted(set(sources)))
+        runs_note = (f" The columns come from more than one run ({per}); bench/validation/column_criteria.md says "
+                     f"which were added when and that the criteria apply to all of them together.")
+    note_path = os.path.join(run, "column_note.md")  # how this run differs from the plan, when it does
+    note = "\n" + open(note_path).read().strip() + "\n" if os.path.exists(note_path) else ""
     ok_low = abs(slope_low - 1.0) <= 0.25
     ok_high = abs(slope_high - 0.5) <= 0.15
     across = 2 * d["r0_m"].min() / COARSE_D_EQ
@@ -525,8 +549,8 @@ radius sets the aspect ratio a = H0 / R0. The narrowest column is {across:.0f} g
 
 {img}
 
-| R0 (mm) | H0 (mm) | a | R_inf (mm) | (R_inf - R0) / R0 | Lube et al. 2004 | settle / spread (s) |
-|---|---|---|---|---|---|---|
+{head}
+{rule}
 {table}
 
 - Expected: (R_inf - R0) / R0 = 1.24 a below a = 1.7 and 1.6 a^(1/2) above (Lube et al. 2004,
@@ -537,8 +561,9 @@ radius sets the aspect ratio a = H0 / R0. The narrowest column is {across:.0f} g
   above a = 1.7: a^{slope_high:.2f} (1/2 expected: **{'meets' if ok_high else 'does not meet'}** it within 0.15);
   largest gap to Lube's values {gap * 100:.0f} %. Each exponent rests on {int(low.sum())} and {int(high.sum())}
   columns (one run each), so it carries the run-to-run scatter of a single deposit; the tolerances were
-  set before the run. The small version (400 grains) is the test `ColumnCollapse.RunoutGrowsWithAspectRatio`.
-"""
+  set before the run (bench/validation/column_criteria.md).{runs_note} The small version (400 grains) is the test
+  `ColumnCollapse.RunoutGrowsWithAspectRatio`.
+{note}"""
 
 
 def discharge_rate(t, n, grains=600):
@@ -631,11 +656,35 @@ BIDISPERSE_START, BIDISPERSE_END = "<!-- section: bidisperse -->\n", "<!-- end: 
 REPOSE_SWEEP_START, REPOSE_SWEEP_END = "<!-- section: repose-sweep -->\n", "<!-- end: repose-sweep -->\n"
 
 
+COLUMN_TITLE, COLUMN_NEXT = "## Column collapse: runout against aspect ratio\n", "## Silo discharge"
+
+
+def column_only(run, docs, path):
+    """`--only column`: rewrites the column-collapse section (and the header's count of columns) from
+    RUN_DIR/column.csv, every other section as it last ran."""
+    doc = open(path).read()
+    if COLUMN_TITLE not in doc or COLUMN_NEXT not in doc:
+        sys.exit(f"report: {path} has no column-collapse section followed by the silo's to replace")
+    start = doc.index(COLUMN_TITLE)
+    end = doc.index(COLUMN_NEXT, start)
+    count = len(np.genfromtxt(os.path.join(run, "column.csv"), delimiter=",", names=True, dtype=None, encoding=None))
+    doc = doc[:start] + column(run, docs) + "\n" + doc[end:]
+    doc = re.sub(r"the column collapse \(\d+ columns of", f"the column collapse ({count} columns of", doc, count=1)
+    open(path + ".tmp", "w").write(doc)
+    os.replace(path + ".tmp", path)
+
+
 def main():
-    if len(sys.argv) != 3:
+    only = None
+    if len(sys.argv) == 5 and sys.argv[3] == "--only" and sys.argv[4] == "column":
+        only = "column"
+    elif len(sys.argv) != 3:
         sys.exit(__doc__)
     run, docs = sys.argv[1], sys.argv[2]
     path = os.path.join(docs, "validation.md")
+    if only == "column":
+        column_only(run, docs, path)
+        return
     if os.path.exists(os.path.join(run, "agreement_bed.csv")):
         # `scripts/bench.sh agreement`: only its section changes.
         replace_between(path, AGREEMENT_START, AGREEMENT_END, agreement(run, docs))
@@ -663,7 +712,9 @@ def main():
     fill = os.path.join(run, "silo_fill.csv")
     silo_grains = int(np.genfromtxt(fill, delimiter=",", names=True)["grains"]) if os.path.exists(fill) else 0
     columns = os.path.join(run, "column.csv")
-    column_grains = int(np.genfromtxt(columns, delimiter=",", names=True)["grains"][0]) if os.path.exists(columns) else 0
+    column_rows = np.genfromtxt(columns, delimiter=",", names=True, dtype=None, encoding=None) if os.path.exists(columns) else []
+    column_grains = int(column_rows["grains"][0]) if len(column_rows) else 0
+    column_count = len(column_rows)
     extra_piles = max(0, len(force_fills(run)) - 1) if os.path.exists(fill) else 0
     piles = f" and {extra_piles} more pil{'es' if extra_piles > 1 else 'e'}" if extra_piles else ""
     note = os.path.join(run, "NOTE.md")  # how this run was made, when it was not one plain command
@@ -675,7 +726,7 @@ Produced by `scripts/bench.sh validation` ({time.strftime('%Y-%m-%d')}, {os.cpu_
 precision; no NVIDIA GPU was lent to this project's sessions, and on Mesa's llvmpipe the GPU pipeline
 is slower than the CPU reference). Tetrahedral grains of four touching spheres, quartz density,
 E = 1 MPa in the scene runs. The restitution run is one r = 1 mm sphere; the angle of repose (4 heaps of
-3,000 grains), the column collapse (4 columns of {column_grains:,} grains), the silo ({silo_grains:,} grains, sized to the
+3,000 grains), the column collapse ({column_count} columns of {column_grains:,} grains), the silo ({silo_grains:,} grains, sized to the
 conditions of Mankoc et al. 2007) and the contact forces (that silo's settled fill{piles}) use coarse r = 5 mm
 grains, whose longer time step covers the same number of grain diameters in fewer steps.
 

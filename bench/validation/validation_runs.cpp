@@ -2,9 +2,9 @@
 // the GPU pipeline), written as CSV files that bench/validation/report.py plots and compares with
 // the literature. Usage:
 //   tetrasand_validation_runs OUT_DIR [restitution|repose|silo
-//   [SCENE]|column|all|agreement[-heap|-silo|-bed]|
+//   [SCENE]|column [R0_M,R0_M,...]|all|agreement[-heap|-silo|-bed]|
 //                                      oedometer[-tetrahedra|-spheres]]
-// `all` is the physical report: restitution and repose take minutes, the column collapse (4 x 20,000
+// `all` is the physical report: restitution and repose take minutes, the column collapse (8 x 20,000
 // grains) and the Mankoc-sized silo (80,000 grains) tens of minutes each on two cores. `agreement`
 // (GPU pipeline against the CPU reference) is separate: on llvmpipe it is the slow part.
 #include <fmt/format.h>
@@ -18,6 +18,7 @@
 #include <functional>
 #include <memory>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -473,10 +474,12 @@ Collapse collapse_column(double r0, std::size_t count) {
 }
 
 // Runout against aspect ratio: 20,000 grains per column, the cylinder's radius setting the aspect
-// ratio (from 0.5 to 5; the break of Lube et al. is at 1.7).
-void column(const fs::path& out) {
+// ratio (from 0.4 to 5.4; the break of Lube et al. is at 1.7): four columns on each side of the break
+// (bench/validation/column_criteria.md). `radii` (m) runs only those columns.
+void column(const fs::path& out, std::vector<double> radii) {
+  if (radii.empty()) radii = {0.37, 0.32, 0.275, 0.25, 0.22, 0.195, 0.165, 0.15};
   std::string csv = "r0_m,grains,h0_m,runout_m,aspect,normalised_runout,settle_s,spread_s,seconds\n";
-  for (double r0 : {0.37, 0.275, 0.22, 0.165}) {
+  for (double r0 : radii) {
     const Collapse c = collapse_column(r0, 20000);
     csv += fmt::format("{},{},{:.5f},{:.5f},{:.4f},{:.4f},{:.2f},{:.2f},{:.1f}\n", c.r0, c.grains, c.h0, c.runout,
                        c.h0 / c.r0, (c.runout - c.r0) / c.r0, c.settle_time, c.spread_time, c.seconds);
@@ -572,13 +575,37 @@ void agreement(const fs::path& out, const std::string& part) {
   if (part == "bed" || part == "all") ts::write_file_atomically(out / "agreement_bed.csv", bed_csv);
 }
 
+// "0.32,0.25" -> {0.32, 0.25}: cylinder radii in metres, each within the floor the column lays out.
+std::vector<double> radii_list(const std::string& text) {
+  std::vector<double> radii;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, comma - at);
+    std::size_t used = 0;
+    double r0 = 0;
+    try {
+      r0 = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != item.size() || item.empty() || !(r0 >= 0.05 && r0 <= 1.0)) {
+      throw std::runtime_error(fmt::format("column radii: '{}' is not a radius in metres within 0.05-1 "
+                                           "(expected e.g. 0.32,0.25)", item));
+    }
+    radii.push_back(r0);
+    at = comma + 1;
+  }
+  return radii;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|forces "
-                 "[GRAINS]|column|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres]]\n",
+                 "[GRAINS]|column [R0,R0,...]|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres]]\n",
                  argv[0]);
     return 2;
   }
@@ -588,7 +615,7 @@ int main(int argc, char** argv) {
     fs::create_directories(out);
     if (what == "restitution" || what == "all") restitution(out);
     if (what == "repose" || what == "all") repose(out);
-    if (what == "column" || what == "all") column(out);
+    if (what == "column" || what == "all") column(out, what == "column" && argc > 3 ? radii_list(argv[3]) : std::vector<double>{});
     if (what == "silo" || what == "all") silo(out, what == "silo" && argc > 3 ? fs::path(argv[3]) : fs::path());
     if (what == "forces" || what == "all") forces(out, what == "forces" && argc > 3 ? std::stoul(argv[3]) : 30000);
     if (what == "agreement") agreement(out, "all");
