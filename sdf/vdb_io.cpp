@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/allocation_cap.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 
@@ -59,15 +60,22 @@ openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such file");
   if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory, not a .vdb file");
   openvdb::GridPtrVecPtr grids;
+  // No single allocation of a sound read comes near the file's size; one far above it is a length
+  // field the reader trusts (core/allocation_cap.h): refuse it at once instead of reserving it.
+  const std::uintmax_t file_bytes = std::filesystem::file_size(path, ec);
+  const std::size_t cap = static_cast<std::size_t>(ec ? 0 : file_bytes) * 4 + (std::size_t{64} << 20);
   try {
+    const AllocationCap allocation_cap(cap);
     openvdb::io::File file(path.string());
     file.open();
     grids = file.getGrids();
     file.close();
   } catch (const openvdb::Exception& e) {
     throw InputError(path, "is not a readable OpenVDB file (" + openvdb_problem(e.what()) + ")");
-  } catch (const std::bad_alloc&) {  // a size in the file beyond memory
-    throw InputError(path, "is not a readable OpenVDB file (a size in it is beyond this machine's memory)");
+  } catch (const std::bad_alloc&) {  // a length in the file beyond the cap (or beyond memory)
+    throw InputError(path, fmt::format("is not a readable OpenVDB file (a length in it asks for more than {} MiB, "
+                                       "more than a file of {} bytes can hold)",
+                                       cap >> 20, file_bytes));
   } catch (const std::length_error&) {
     throw InputError(path, "is not a readable OpenVDB file (a size in it is beyond any string or array)");
   }
