@@ -27,7 +27,22 @@ AllocationCap::~AllocationCap() { t_cap = previous_; }
 
 }  // namespace ts
 
-// The replaceable global allocation functions (the unaligned ones; the default operator delete frees
-// with free(), which matches malloc, and the nothrow forms call these).
+// The replaceable global allocation functions, every unaligned form, so that what these allocate with
+// malloc is always freed with free (a sanitizer's own operator delete would report the mismatch). The
+// aligned forms stay the library's, paired with each other.
 void* operator new(std::size_t bytes) { return allocate(bytes); }
 void* operator new[](std::size_t bytes) { return allocate(bytes); }
+void* operator new(std::size_t bytes, const std::nothrow_t&) noexcept {
+  try {
+    return allocate(bytes);
+  } catch (const std::bad_alloc&) {
+    return nullptr;
+  }
+}
+void* operator new[](std::size_t bytes, const std::nothrow_t& tag) noexcept { return operator new(bytes, tag); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
