@@ -37,13 +37,28 @@ std::string lowercase_extension(const fs::path& path) {
   return ext;
 }
 
+// The first bytes of a file (at most `count`), to tell its format by content.
+std::string file_start(const fs::path& path, std::size_t count) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes(count, '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(count));
+  bytes.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return bytes;
+}
+
+bool starts_as_ply(std::string_view bytes) { return bytes.starts_with("ply\n") || bytes.starts_with("ply\r\n"); }
+
 // OFF and PLY get a strict pass first (core/mesh_file_checks.h): assimp's readers trust declared
-// counts for allocations and clamp out-of-range indices without an error.
+// counts for allocations and clamp out-of-range indices without an error. A PLY is told by its
+// content too, whatever its name: assimp falls back to reading a file by its signature when the
+// reader its extension names refuses it, so a PLY named .glb reached assimp's PLY reader unchecked
+// and hung it (fuzz_mesh, 2026-12-04: 112 bytes, more than 2 minutes; tests/core/bad_meshes/).
 void check_before_assimp(const fs::path& path) {
   const std::string ext = lowercase_extension(path);
-  if (ext != ".off" && ext != ".ply") return;
+  const bool ply_content = starts_as_ply(file_start(path, 8));
+  if (ext != ".off" && ext != ".ply" && !ply_content) return;
   const std::string bytes = read_file(path);
-  if (bytes.starts_with("ply\n") || bytes.starts_with("ply\r\n") || ext == ".ply") {
+  if (ply_content || ext == ".ply") {
     detail::check_ply_file(path, bytes);
   } else {
     detail::check_off_file(path, bytes);
