@@ -123,5 +123,21 @@ TEST(VdbIo, AFuzzedFileWithAHugeNameIsAShortError) {
   EXPECT_LT(message.size(), 600u) << message.substr(0, 400);
 }
 
+// Found by fuzz_vdb (2026-12-04): a root node that declares billions of tiles in a 64 kB file. OpenVDB
+// read on past the end of the file, one failed read per tile (18 s in Release); the stream now throws
+// on the first read past its end, and the error says what is wrong with the file.
+TEST(VdbIo, AFileThatEndsBeforeTheTilesItDeclaresIsAClearError) {
+  const std::filesystem::path file =
+      std::filesystem::path(TETRASAND_SOURCE_DIR) / "tests/sdf/bad_vdb/root-tile-count-in-billions.vdb";
+  std::string message;
+  try {
+    read_level_set(file);
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  EXPECT_EQ(message, file.string() + ": is not a readable OpenVDB file (it ends before the data it declares: it is "
+                                     "cut short or a count in it is wrong)");
+}
+
 }  // namespace
 }  // namespace ts::sdf
