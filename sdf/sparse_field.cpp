@@ -9,6 +9,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/log.h"
 
 namespace ts::sdf {
 
@@ -71,6 +72,13 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
   const nanovdb::FloatGrid* nano = host_.grid<float>();
   if (!nano) throw Error(ExitCode::Internal, "SparseField: the NanoVDB grid is not a float grid");
   band_voxels_ = nano->activeVoxelCount();
+  const Eigen::Vector3i far_corner = gpu_index_offset() + spec.dims - Eigen::Vector3i::Ones();
+  if (far_corner.maxCoeff() >= 4096) {
+    log::warn("the sparse SDF is {} voxels along its longest side: past 4096 voxels from its corner the GPU "
+              "reads walk NanoVDB's root, which NVIDIA's driver 580 computed wrong (docs/architecture.md, "
+              "\"The GPU field\"); on an NVIDIA GPU prefer a coarser voxel or the CPU path (--backend cpu)",
+              spec.dims.maxCoeff());
+  }
   GLint64 max_block = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
   const std::size_t bytes = host_.size();
