@@ -212,4 +212,39 @@ void check_ply_file(const std::filesystem::path& path, std::string_view bytes) {
   check_ply_data(path, bytes, header);
 }
 
+namespace {
+
+std::uint32_t read_u32_le(std::string_view bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int b = 3; b >= 0; --b) v = (v << 8) | static_cast<unsigned char>(bytes[at + static_cast<std::size_t>(b)]);
+  return v;
+}
+
+}  // namespace
+
+void check_glb_file(const std::filesystem::path& path, std::string_view bytes) {
+  constexpr std::size_t kHeader = 12, kChunkHeader = 8;
+  if (bytes.size() < kHeader) throw InputError(path, fmt::format("a GLB file needs a 12-byte header; it has {} bytes", bytes.size()));
+  const std::uint32_t version = read_u32_le(bytes, 4), length = read_u32_le(bytes, 8);
+  // Version 1 (KHR_binary_glTF) is left to assimp, which has no reader for it and says so.
+  if (version != 2) return;
+  if (length != bytes.size()) {
+    throw InputError(path, fmt::format("the GLB header says the file is {} bytes long; it is {}", length, bytes.size()));
+  }
+  std::size_t at = kHeader;
+  for (int chunk = 0; at < bytes.size(); ++chunk) {
+    if (at + kChunkHeader > bytes.size()) {
+      throw InputError(path, fmt::format("GLB chunk {} at byte {} has no room for its 8-byte header", chunk, at));
+    }
+    const std::uint64_t chunk_length = read_u32_le(bytes, at);
+    const std::uint32_t type = read_u32_le(bytes, at + 4);
+    if (chunk == 0 && type != 0x4E4F534Au) throw InputError(path, "the first GLB chunk is not JSON");
+    if (at + kChunkHeader + chunk_length > bytes.size()) {
+      throw InputError(path, fmt::format("GLB chunk {} of {} bytes at byte {} runs past the end of the file ({} bytes)",
+                                         chunk, chunk_length, at, bytes.size()));
+    }
+    at += kChunkHeader + static_cast<std::size_t>(chunk_length);
+  }
+}
+
 }  // namespace ts::detail

@@ -1,5 +1,5 @@
 #pragma once
-// Strict checks of OFF and PLY files before assimp reads them. Assimp's readers are lenient where it
+// Strict checks of OFF, PLY and GLB files before assimp reads them. Assimp's readers are lenient where it
 // hurts: an OFF or PLY header that declares billions of elements makes them reserve memory for all
 // of them (the machine swaps or the process is killed), and face indices out of range are silently
 // clamped or replaced, so a broken file loads as a plausible but wrong mesh. These checks stream
@@ -15,5 +15,10 @@ void check_off_file(const std::filesystem::path& path, std::string_view text);
 
 // `bytes` is the whole file: ascii, binary_little_endian or binary_big_endian.
 void check_ply_file(const std::filesystem::path& path, std::string_view bytes);
+
+// `bytes` is the whole file: a binary glTF (GLB) of version 2. Checks the structure assimp's GLB reader
+// trusts: the header's total length is the file's, and every chunk lies inside the file. assimp reads a chunk length past the end of the file into
+// its JSON parser (an over-read ASan reports; fuzz_mesh, 2026-12-04).
+void check_glb_file(const std::filesystem::path& path, std::string_view bytes);
 
 }  // namespace ts::detail

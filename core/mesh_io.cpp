@@ -55,10 +55,14 @@ bool starts_as_ply(std::string_view bytes) { return bytes.starts_with("ply\n") |
 // and hung it (fuzz_mesh, 2026-12-04: 112 bytes, more than 2 minutes; tests/core/bad_meshes/).
 void check_before_assimp(const fs::path& path) {
   const std::string ext = lowercase_extension(path);
-  const bool ply_content = starts_as_ply(file_start(path, 8));
-  if (ext != ".off" && ext != ".ply" && !ply_content) return;
+  const std::string start = file_start(path, 8);
+  const bool ply_content = starts_as_ply(start);
+  const bool glb_content = start.starts_with("glTF");  // binary glTF's magic, whatever the name
+  if (ext != ".off" && ext != ".ply" && !ply_content && !glb_content) return;
   const std::string bytes = read_file(path);
-  if (ply_content || ext == ".ply") {
+  if (glb_content) {
+    detail::check_glb_file(path, bytes);
+  } else if (ply_content || ext == ".ply") {
     detail::check_ply_file(path, bytes);
   } else {
     detail::check_off_file(path, bytes);

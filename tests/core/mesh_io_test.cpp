@@ -235,6 +235,7 @@ TEST(MeshIo, InputsThatCrashedOrWereMisreadAreClearErrors) {
       {"ply-comment-between-properties-ascii.ply",
        "line 6: 'property float y' follows line 5 ('comment a wrapped comment') inside element 'vertex'"},
       {"ply-content-named-glb-hangs-assimp.glb", "the PLY header has no end_header line"},
+      {"glb-chunk-longer-than-the-file.glb", "the GLB header says the file is 1900 bytes long; it is 267"},
   };
   const std::filesystem::path dir = std::filesystem::path(TETRASAND_SOURCE_DIR) / "tests/core/bad_meshes";
   std::size_t checked = 0;
