@@ -16,9 +16,10 @@ void check_off_file(const std::filesystem::path& path, std::string_view text);
 // `bytes` is the whole file: ascii, binary_little_endian or binary_big_endian.
 void check_ply_file(const std::filesystem::path& path, std::string_view bytes);
 
-// `bytes` is the whole file: a binary glTF (GLB) of version 2. Checks the structure assimp's GLB reader
-// trusts: the header's total length is the file's, and every chunk lies inside the file. assimp reads a chunk length past the end of the file into
-// its JSON parser (an over-read ASan reports; fuzz_mesh, 2026-12-04).
+// `bytes` is the whole file: a binary glTF (GLB) of version 2. Checks the structure assimp's GLB
+// reader trusts: the header's total length is the file's, and every chunk lies inside the file
+// (assimp read a chunk length past the end of the file into its JSON parser, an over-read ASan
+// reports; fuzz_mesh, 2026-12-04). Other versions are left to assimp.
 void check_glb_file(const std::filesystem::path& path, std::string_view bytes);
 
 }  // namespace ts::detail

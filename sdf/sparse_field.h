@@ -29,10 +29,12 @@ NanoGrid to_nanovdb(const openvdb::FloatGrid& level_set);
 // The translation from a level set's index space to the GPU field's: a multiple of 128 voxels (a lower
 // internal node of OpenVDB's tree, so leaves and tiles move whole) that puts spec's voxel (0, 0, 0) in
 // [0, 128)^3, so every band voxel of a grid under 3968 voxels a side has NanoVDB coordinates in
-// [0, 4096) and one root key, (0, 0). Why: NVIDIA's GLSL compiler (driver 580.159.04, H200, seen
-// 2026-12-04) computes the high word of PNanoVDB's 64-bit root key (pnanovdb_coord_to_key, as two
-// 32-bit words) wrong for negative coordinates, so the root walk found no tile and every read was the
-// background; llvmpipe computed it right. Coordinates whose keys are all zero avoid that arithmetic.
+// [0, 4096): one root tile, whose upper node the GLSL reader caches up front so that it never walks
+// the root (shaders/common/sparse_field.glsl, field_prime). Why: NVIDIA's GLSL compiler (driver
+// 580.159.04, H200, seen 2026-12-04) computes the high word of PNanoVDB's 64-bit root key
+// (pnanovdb_coord_to_key, as two 32-bit words) as 3 where it is 0, for negative and positive
+// coordinates alike, so the root walk found no tile and every read was the background; llvmpipe
+// computes it right.
 Eigen::Vector3i gpu_index_shift(const GridSpec& spec);
 
 // The level set as the GPU reads it: to_nanovdb of the level set moved by gpu_index_shift(spec).

@@ -22,10 +22,8 @@ void main() {
   if (i >= count) return;
   FieldReader reader = field_reader();
   vec3 x = points[i].xyz;
-  if (mode == 5) {
-    reader.accessor.root.address.byte_offset = 0u;
-    values[i] = vec4(field_voxel(reader, ivec3(round(x))), 0.0, 0.0, 0.0);
-  } else if (mode == 0) {
+  if (mode == 5) reader.accessor.root.address.byte_offset = 0u;
+  if (mode == 0 || mode == 5) {
     values[i] = vec4(field_voxel(reader, ivec3(round(x))), 0.0, 0.0, 0.0);
   } else if (mode == 1) {
     values[i] = vec4(field_trilinear(reader, x), 0.0, 0.0, 0.0);
