@@ -1,4 +1,8 @@
-// The .vdb reader (sdf/vdb_io.h read_level_set): what `preview` reads as an SDF.
+// The .vdb reader (sdf/vdb_io.h): what `preview` reads as an SDF. read_level_set runs OpenVDB's reader
+// in a child process, whose coverage libFuzzer cannot see (and a fork an input cost 38 inputs a
+// second under ASan), so this target runs that child's part in its own process: OpenVDB's tree
+// readers are header templates, compiled and instrumented here. The upstream heap overflow of
+// fuzz/findings/README.md therefore still ends a run here; read_level_set contains it.
 #include <cstddef>
 #include <cstdint>
 
@@ -11,7 +15,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   ts::log::set_level(ts::log::Level::Error);
   const auto file = ts::fuzz::scratch_file("field.vdb", ts::fuzz::as_text(data, size));
   try {
-    (void)ts::sdf::read_level_set(file);
+    (void)ts::sdf::detail::read_grids_in_this_process(file);
   } catch (const ts::InputError&) {
   }
   return 0;

@@ -3,11 +3,19 @@
 #include <fmt/format.h>
 #include <openvdb/io/Stream.h>
 
+#include <ext/stdio_filebuf.h>
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "core/allocation_cap.h"
 #include "core/atomic_file.h"
@@ -56,12 +64,15 @@ void write_vdb(const std::filesystem::path& path, const openvdb::FloatGrid::Ptr&
       inputs);
 }
 
-openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path) {
-  ensure_openvdb_initialized();
+namespace {
+
+// How the reader process ends (besides a signal, which is OpenVDB's reader crashing).
+enum ReaderExit : int { kGridsStreamed = 0, kBadFile = 3, kReaderBug = 4 };
+
+}  // namespace
+
+openvdb::GridPtrVecPtr detail::read_grids_in_this_process(const std::filesystem::path& path) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such file");
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory, not a .vdb file");
-  openvdb::GridPtrVecPtr grids;
   // No single allocation of a sound read comes near the file's size; one far above it is a length
   // field the reader trusts (core/allocation_cap.h): refuse it at once instead of reserving it.
   const std::uintmax_t file_bytes = std::filesystem::file_size(path, ec);
@@ -75,7 +86,7 @@ openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path) {
     if (!in) throw InputError(path, "cannot be opened for reading (permission?)");
     in.exceptions(std::ios::failbit | std::ios::badbit);
     openvdb::io::Stream stream(in, /*delayLoad=*/false);
-    grids = stream.getGrids();
+    return stream.getGrids();
   } catch (const std::ios_base::failure&) {
     throw InputError(path, "is not a readable OpenVDB file (it ends before the data it declares: it is cut short "
                            "or a count in it is wrong)");
@@ -88,6 +99,121 @@ openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path) {
   } catch (const std::length_error&) {
     throw InputError(path, "is not a readable OpenVDB file (a size in it is beyond any string or array)");
   }
+}
+
+namespace {
+
+void write_all(int fd, std::string_view bytes) {
+  while (!bytes.empty()) {
+    const ssize_t written = ::write(fd, bytes.data(), bytes.size());
+    if (written <= 0 && errno != EINTR) return;
+    if (written > 0) bytes.remove_prefix(static_cast<std::size_t>(written));
+  }
+}
+
+// The reader process: reads the file, streams its float grids back through `data_fd` as OpenVDB
+// writes them (uncompressed, no statistics: nothing that needs TBB's threads, which a forked
+// process does not have), and says what went wrong through `message_fd`. Never returns.
+[[noreturn]] void run_reader_process(const std::filesystem::path& path, int data_fd, int message_fd) {
+  int code = kGridsStreamed;
+  std::string message;
+  try {
+    const openvdb::GridPtrVecPtr grids = detail::read_grids_in_this_process(path);
+    openvdb::GridCPtrVec floats;
+    for (const auto& grid : *grids)
+      if (openvdb::gridPtrCast<openvdb::FloatGrid>(grid)) floats.push_back(grid);
+    __gnu_cxx::stdio_filebuf<char> buffer(data_fd, std::ios::out, std::size_t{1} << 16);
+    std::ostream out(&buffer);
+    openvdb::io::Stream stream(out);
+    stream.setCompression(openvdb::io::COMPRESS_NONE);
+    stream.setGridStatsMetadataEnabled(false);
+    stream.write(floats);
+    out.flush();
+    if (!out) throw std::runtime_error("the pipe to the reading process broke");
+  } catch (const InputError& e) {
+    code = kBadFile;
+    message = e.what();
+  } catch (const std::exception& e) {
+    code = kReaderBug;
+    message = e.what();
+  }
+  // Short enough for the pipe's buffer, so the write never waits on the parent.
+  write_all(message_fd, std::string_view(message).substr(0, 4000));
+  ::_exit(code);
+}
+
+std::string read_all(int fd) {
+  std::string text;
+  char chunk[4096];
+  for (ssize_t got; (got = ::read(fd, chunk, sizeof chunk)) != 0;) {
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) break;
+    text.append(chunk, static_cast<std::size_t>(got));
+  }
+  return text;
+}
+
+struct Pipe {
+  int read = -1, write = -1;
+  Pipe() {
+    int fds[2];
+    if (::pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+    read = fds[0];
+    write = fds[1];
+  }
+};
+
+}  // namespace
+
+openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path) {
+  ensure_openvdb_initialized();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such file");
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory, not a .vdb file");
+  // OpenVDB's reader is run on the file in a child process: some broken files make it write past
+  // its buffers (fuzz/findings/: a segmentation fault in Release), which must not corrupt or end
+  // this process. The child streams back what it read as OpenVDB itself writes it, a stream whose
+  // lengths are right by construction, and this process reads that.
+  Pipe data, message;
+  const pid_t child = ::fork();
+  if (child < 0) throw std::runtime_error(std::string("cannot start the .vdb reading process: ") + std::strerror(errno));
+  if (child == 0) {
+    ::close(data.read);
+    ::close(message.read);
+    run_reader_process(path, data.write, message.write);
+  }
+  ::close(data.write);
+  ::close(message.write);
+  openvdb::GridPtrVecPtr grids;
+  std::string stream_problem;
+  try {
+    // Closing the read end (the buffer's destructor) before waiting lets a child that still writes
+    // die of SIGPIPE instead of waiting for a reader that stopped.
+    __gnu_cxx::stdio_filebuf<char> buffer(data.read, std::ios::in, std::size_t{1} << 16);
+    std::istream in(&buffer);
+    in.exceptions(std::ios::failbit | std::ios::badbit);
+    const AllocationCap allocation_cap(std::size_t{1} << 30);
+    openvdb::io::Stream stream(in, /*delayLoad=*/false);
+    grids = stream.getGrids();
+  } catch (const std::exception& e) {
+    stream_problem = e.what();
+  }
+  const std::string child_message = read_all(message.read);
+  ::close(message.read);
+  int status = 0;
+  while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFSIGNALED(status))
+    throw InputError(path, fmt::format("is not a readable OpenVDB file (OpenVDB's reader crashed on it: {}; it ran "
+                                       "in a separate process, so nothing else was harmed)",
+                                       ::strsignal(WTERMSIG(status))));
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (code == kBadFile) throw InputError(child_message);
+  if (code == kReaderBug) throw std::runtime_error(child_message);
+  if (code != kGridsStreamed)  // a sanitizer's report in the child ends it with its own code
+    throw InputError(path, fmt::format("is not a readable OpenVDB file (OpenVDB's reader stopped on it with exit code {})",
+                                       code));
+  if (!grids) throw std::runtime_error("reading the grids back from the .vdb reading process failed: " + stream_problem);
   bool any_float = false;
   for (const auto& base : *grids) {
     auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);

@@ -19,7 +19,18 @@ void write_vdb(const std::filesystem::path& path, const openvdb::FloatGrid::Ptr&
                const std::vector<std::filesystem::path>& inputs = {});
 
 // The first float level-set grid of a file. ts::InputError for: a missing file, a file that is not
-// a VDB, no float grid, a grid that is not a level set, an empty grid.
+// a VDB, no float grid, a grid that is not a level set, an empty grid, and a file that crashes
+// OpenVDB's reader: the file is read in a forked child process (OpenVDB 10 writes past its buffers
+// on some broken files), which streams the float grids back. Call it while no other thread holds a
+// lock the child would need (OpenVDB's grid registry, the log): fork copies only this thread.
 openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path);
+
+namespace detail {
+// What read_level_set's child process runs: every grid of the file, read by OpenVDB in the calling
+// process (with the allocation cap and the stream that stops at the file's end), InputError for a
+// file OpenVDB refuses. Not safe on files you do not trust; for fuzz_vdb, which needs the reader's
+// coverage in its own process.
+openvdb::GridPtrVecPtr read_grids_in_this_process(const std::filesystem::path& path);
+}  // namespace detail
 
 }  // namespace ts::sdf

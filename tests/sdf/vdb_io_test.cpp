@@ -2,6 +2,7 @@
 #include "sdf/vdb_io.h"
 
 #include <gtest/gtest.h>
+#include <openvdb/tools/LevelSetSphere.h>
 
 #include <cstdio>
 #include <fstream>
@@ -126,6 +127,24 @@ TEST(VdbIo, AFileThatEndsBeforeTheTilesItDeclaresIsAClearError) {
       std::filesystem::path(TETRASAND_SOURCE_DIR) / "tests/sdf/bad_vdb/root-tile-count-in-billions.vdb";
   EXPECT_EQ(read_error(file), file.string() + ": is not a readable OpenVDB file (it ends before the data it declares: it is "
                                      "cut short or a count in it is wrong)");
+}
+
+// Found by fuzz_vdb (2026-12-04): a chunk stored uncompressed whose length OpenVDB 10's bloscFromStream
+// checks only after copying it into the node's buffer (1355 bytes into 140): a segmentation fault in
+// Release, a heap overflow under ASan, inside OpenVDB. Read in a child process, the fault ends only that
+// process and this one reports the file.
+TEST(VdbIo, AFileThatCrashesOpenVdbsReaderIsAnErrorAndTheReadingProcessLivesOn) {
+  const std::filesystem::path file =
+      std::filesystem::path(TETRASAND_SOURCE_DIR) / "tests/sdf/bad_vdb/uncompressed-chunk-overflow.vdb";
+  const std::string message = read_error(file);
+  EXPECT_EQ(message.rfind(file.string() + ": is not a readable OpenVDB file (", 0), 0u) << message;
+  // This process reads a sound file afterwards as before.
+  const std::filesystem::path dir = test::temp_dir();
+  auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.0f), 0.1f);
+  write_vdb(dir / "sphere.vdb", sphere);
+  const openvdb::FloatGrid::Ptr read = read_level_set(dir / "sphere.vdb");
+  EXPECT_EQ(read->activeVoxelCount(), sphere->activeVoxelCount());
+  EXPECT_EQ(read->tree().getValue(openvdb::Coord(10, 0, 0)), sphere->tree().getValue(openvdb::Coord(10, 0, 0)));
 }
 
 }  // namespace
