@@ -151,8 +151,8 @@ def section(run, docs):
              f"(r = {sc['radius'] * 1e3:.0f} mm spheres, E = 1 MPa, mu = 0.5, tangential springs) in a smooth cylinder "
              f"of radius {sc['cylinder'] * 1e3:.0f} mm, pressed by a servo piston (`[prop.servo]`) seated at "
              f"{sc['seat_stress']:.0f} Pa, loaded {'along a graded ramp (stress rate about proportional to sigma^(1/2))' if sc['graded'] else 'linearly'} to {sc['peak_stress'] / 1e3:.0f} kPa over "
-             f"{sc['peak'] - sc['seat']:.1f} s and unloaded {'along its mirror ' if sc['graded'] else ''}to {sc['seat_stress']:.0f} Pa over "
-             f"{sc['end'] - sc['peak']:.1f} s. Strain from the piston's travel over the bed height at seating. "
+             f"{sc['peak'] - sc['seat']:.3g} s and unloaded {'along its mirror ' if sc['graded'] else ''}to {sc['seat_stress']:.0f} Pa over "
+             f"{sc['end'] - sc['peak']:.3g} s. Strain from the piston's travel over the bed height at seating. "
              f"The contrast run replaces each grain by one sphere of its volume and mass (radius 4^(1/3) r; the "
              f"`[grain]` table cannot say one sphere, so the bench swaps them in the initial world).\n",
              image + "\n",
