@@ -3,7 +3,7 @@
 // the literature. Usage:
 //   tetrasand_validation_runs OUT_DIR [restitution|repose|silo
 //   [SCENE]|column [R0_M,R0_M,...]|all|agreement[-heap|-silo|-bed]|
-//                                      oedometer[-tetrahedra|-spheres]]
+//                                      oedometer[-tetrahedra|-spheres] [SCENE]]
 // `all` is the physical report: restitution and repose take minutes, the column collapse (8 x 20,000
 // grains) and the Mankoc-sized silo (80,000 grains) tens of minutes each on two cores. `agreement`
 // (GPU pipeline against the CPU reference) is separate: on llvmpipe it is the slow part.
@@ -517,9 +517,11 @@ void grains_to_spheres(World& world) {
 
 // The oedometer of assets/scenes/validation/oedometer.toml (bench/validation/oedometer_criteria.md) with
 // `shape` "tetrahedra" (the scene's grains) or "spheres" (each grain one sphere of its volume and mass):
-// the servo's log as oedometer_SHAPE.csv, and a row of oedometer_runs_SHAPE.csv.
-void oedometer(const fs::path& out, const std::string& shape) {
-  const Scene scene = load_scene(ts::bench::reference_scene("../validation/oedometer.toml"));
+// the servo's log as oedometer_SHAPE.csv, and a row of oedometer_runs_SHAPE.csv. `scene_file`: a variant
+// of that scene instead (e.g. oedometer_stiff.toml), none: the scene itself.
+void oedometer(const fs::path& out, const std::string& shape, const fs::path& scene_file) {
+  const Scene scene =
+      load_scene(scene_file.empty() ? ts::bench::reference_scene("../validation/oedometer.toml") : scene_file);
   const bool spheres = shape == "spheres";
   const Run r = run(scene, out / "runs", "oedometer_" + shape, false, {},
                     spheres ? std::function<void(World&)>(grains_to_spheres) : std::function<void(World&)>());
@@ -605,7 +607,7 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|forces "
-                 "[GRAINS]|column [R0,R0,...]|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres]]\n",
+                 "[GRAINS]|column [R0,R0,...]|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres] [SCENE]]\n",
                  argv[0]);
     return 2;
   }
@@ -619,8 +621,9 @@ int main(int argc, char** argv) {
     if (what == "silo" || what == "all") silo(out, what == "silo" && argc > 3 ? fs::path(argv[3]) : fs::path());
     if (what == "forces" || what == "all") forces(out, what == "forces" && argc > 3 ? std::stoul(argv[3]) : 30000);
     if (what == "agreement") agreement(out, "all");
-    if (what == "oedometer" || what == "oedometer-tetrahedra") oedometer(out, "tetrahedra");
-    if (what == "oedometer" || what == "oedometer-spheres") oedometer(out, "spheres");
+    const fs::path oedometer_scene = what.rfind("oedometer", 0) == 0 && argc > 3 ? fs::path(argv[3]) : fs::path();
+    if (what == "oedometer" || what == "oedometer-tetrahedra") oedometer(out, "tetrahedra", oedometer_scene);
+    if (what == "oedometer" || what == "oedometer-spheres") oedometer(out, "spheres", oedometer_scene);
     if (what.rfind("agreement-", 0) == 0) agreement(out, what.substr(10));
     return 0;
   } catch (const std::exception& e) {
