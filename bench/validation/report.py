@@ -265,6 +265,11 @@ Grains 5 cm below the plate leave the simulation{leaked}. CPU reference, dt = {f
   {n_exp:.2f} (5/2 expected: **{'meets' if abs(n_exp - 2.5) < 0.5 else 'does not meet'}** it within 0.5,
   the tolerance set before the run). Informative, not a criterion (added after a run with the
   lattice-edge orifice found k ~ 0): with k fixed at 0 the free exponent is {n_exp_k0:.2f}. {orifice_note}
+- The same fit in other grain sizes (issue 18; informative, added after the run): the empty annulus is
+  k d = {k * COARSE_D_EQ * 1e3:.1f} mm whatever the unit; over the sphere diameter 2 r = {2 * COARSE_RADIUS * 1e3:.0f} mm it is
+  k = {k * COARSE_D_EQ / (2 * COARSE_RADIUS):.2f}, over the grain's bounding diameter {2 * BOUNDING_RADIUS * 1e3:.1f} mm k = {k * COARSE_D_EQ / (2 * BOUNDING_RADIUS):.2f}.
+  Beverloo's k ~ 1.5 is for spheres of diameter d; which of these a tetrahedral grain's k compares with
+  is what a spherical-grain silo would settle (not run).
 - What it can show: {'the silo meets all three size conditions, so the 5/2 law is the one to expect; ' if conforming else 'the silo does not meet every size condition, so the fit is no test of the law; '}
   the orifices span {D.min() / COARSE_D_EQ:.0f}-{D.max() / COARSE_D_EQ:.0f} d (the width, {width / COARSE_D_EQ:.0f} d, bounds D
   through D + 30 d; a tetrahedron is {2 * BOUNDING_RADIUS / COARSE_D_EQ:.1f} d across, so 4 d is under three grains and
