@@ -655,6 +655,9 @@ discharge rate 10 % (since 2026-12-02 on the mean of four fill seeds, before on 
 
 AGREEMENT_START, AGREEMENT_END = "<!-- section: agreement -->\n", "<!-- end: agreement -->\n"
 OEDOMETER_START, OEDOMETER_END = "<!-- section: oedometer -->\n", "<!-- end: oedometer -->\n"  # bench/validation/oedometer.py
+# Controlled runs written up by hand beside the sections they test (their commands are in the text):
+FORCES_BACKED_START, FORCES_BACKED_END = "<!-- section: forces-backed -->\n", "<!-- end: forces-backed -->\n"
+OEDOMETER_STIFF_START, OEDOMETER_STIFF_END = "<!-- section: oedometer-stiff -->\n", "<!-- end: oedometer-stiff -->\n"
 # The bidisperse bed against LAMMPS: written by hand from its test (tests/sim/export_lammps_test.cpp).
 BIDISPERSE_START, BIDISPERSE_END = "<!-- section: bidisperse -->\n", "<!-- end: bidisperse -->\n"
 # Repose magnitude (issue 18): written by hand from `scripts/bench.sh repose` (bench/validation/repose_sweep.py).
@@ -713,7 +716,8 @@ def main():
              section(column, ["column.csv"], "Column collapse: runout against aspect ratio"),
              section(silo, ["silo.csv", "silo_fill.csv"], "Silo discharge against orifice diameter (Beverloo)"),
              section(forces, ["contact_forces.csv", "silo_fill.csv"],
-                     "Normal contact forces in a sand pile at rest in a cylinder")]
+                     "Normal contact forces in a sand pile at rest in a cylinder"),
+             kept(FORCES_BACKED_START, FORCES_BACKED_END, "tetrasand_validation_runs OUT forces-backed")]
     fill = os.path.join(run, "silo_fill.csv")
     silo_grains = int(np.genfromtxt(fill, delimiter=",", names=True)["grains"]) if os.path.exists(fill) else 0
     columns = os.path.join(run, "column.csv")
@@ -724,12 +728,12 @@ def main():
     piles = f" and {extra_piles} more pil{'es' if extra_piles > 1 else 'e'}" if extra_piles else ""
     note = os.path.join(run, "NOTE.md")  # how this run was made, when it was not one plain command
     made = (": see the note below for which parts ran when" if os.path.exists(note)
-            else " in one run:\nevery section below except the last two (oedometer, agreement) comes from it")
+            else " in one run:\nevery section below except the hand-written controlled runs, the oedometer and the agreement comes from it")
     header = f"""# Physical validation
 
 Produced by `scripts/bench.sh validation` ({time.strftime('%Y-%m-%d')}, {os.cpu_count()} CPU cores){made}. All of them ran on the CPU reference (double
-precision; no NVIDIA GPU was lent to this project's sessions, and on Mesa's llvmpipe the GPU pipeline
-is slower than the CPU reference). Tetrahedral grains of four touching spheres, quartz density,
+precision; the one NVIDIA GPU lent to this project so far had 15 minutes, spent on docs/benchmarks.md's
+device run, and on Mesa's llvmpipe the GPU pipeline is slower than the CPU reference). Tetrahedral grains of four touching spheres, quartz density,
 E = 1 MPa in the scene runs. The restitution run is one r = 1 mm sphere; the angle of repose (4 heaps of
 3,000 grains), the column collapse ({column_count} columns of {column_grains:,} grains), the silo ({silo_grains:,} grains, sized to the
 conditions of Mankoc et al. 2007) and the contact forces (that silo's settled fill{piles}) use coarse r = 5 mm
@@ -742,6 +746,8 @@ produced by `scripts/bench.sh peers-sim`.
     if os.path.exists(note):
         header += "\n" + open(note).read()
     text = (header + "\n" + "\n".join(parts) + "\n" + kept(OEDOMETER_START, OEDOMETER_END, "scripts/bench.sh oedometer")
+            + kept(OEDOMETER_STIFF_START, OEDOMETER_STIFF_END,
+                   "tetrasand_validation_runs OUT oedometer-SHAPE assets/scenes/validation/oedometer_stiff.toml")
             + kept(AGREEMENT_START, AGREEMENT_END, "scripts/bench.sh agreement")
             + kept(BIDISPERSE_START, BIDISPERSE_END,
                    "ctest -R LammpsSettlesExportedBidisperseBedToTetrasandsHeightAndPacking"))
