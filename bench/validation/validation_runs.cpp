@@ -286,9 +286,14 @@ struct SettledFill {
   double settle_time = 0, fill = 0, wall_seconds = 0;  // s simulated, m (95th percentile of centre heights), s wall
 };
 
-SettledFill settle_fill(Scene& scene, const std::string& label, const fs::path& forces_file) {
+void grains_to_spheres(World& world);
+
+// `reshape`, when given, changes the initial world before it falls (grains_to_spheres).
+SettledFill settle_fill(Scene& scene, const std::string& label, const fs::path& forces_file,
+                        const std::function<void(World&)>& reshape = {}) {
   SettledFill f;
   f.world = make_world(scene);
+  if (reshape) reshape(f.world);
   CpuStepper settle = tall_scene_stepper(scene, f.world);
   const SettleDamping damping = damping_after_fall(scene, f.world);
   f.settings = settle.settings();
@@ -319,11 +324,15 @@ SettledFill settle_fill(Scene& scene, const std::string& label, const fs::path& 
 // silo has the plate's particles within D/2 of the axis taken away, a round rim lining the hole
 // (round_hole_rim), and discharges undamped for 0.35 s. The settled fill's contact forces are written
 // too. Discharged grains (5 cm below the plate) are parked far below as static bodies, so they cost
-// nothing and pile up nowhere.
-void silo(const fs::path& out, const fs::path& scene_file) {
+// nothing and pile up nowhere. `spheres`: each grain replaced by one sphere of its volume and mass
+// before the fill falls (grains_to_spheres; the Beverloo reference silo of
+// bench/validation/silo_spheres_criteria.md), so d is then the spheres' diameter.
+void silo(const fs::path& out, const fs::path& scene_file, bool spheres = false) {
   constexpr double kDischargeTime = 0.35;  // s after the orifice opens; the rate is fitted from 0.1 s
   Scene scene = scene_file.empty() ? reference("silo_mankoc.toml") : load_scene(scene_file);
-  const SettledFill filled = settle_fill(scene, "silo", out / "contact_forces.csv");
+  const SettledFill filled = settle_fill(scene, spheres ? "sphere silo" : "silo", out / "contact_forces.csv",
+                                         spheres ? std::function<void(World&)>(grains_to_spheres)
+                                                 : std::function<void(World&)>());
   const World& settled = filled.world;
   const double dt = filled.settings.dt;
   const std::size_t grains = filled.grains;
@@ -625,7 +634,7 @@ std::vector<double> radii_list(const std::string& text) {
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|forces-backed|forces "
+                 "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|silo-spheres|forces-backed|forces "
                  "[GRAINS]|column [R0,R0,...]|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres] [SCENE]]\n",
                  argv[0]);
     return 2;
@@ -640,6 +649,7 @@ int main(int argc, char** argv) {
     if (what == "silo" || what == "all") silo(out, what == "silo" && argc > 3 ? fs::path(argv[3]) : fs::path());
     if (what == "forces" || what == "all") forces(out, what == "forces" && argc > 3 ? std::stoul(argv[3]) : 30000);
     if (what == "forces-backed") forces_backed(out);
+    if (what == "silo-spheres") silo(out, {}, true);
     if (what == "agreement") agreement(out, "all");
     const fs::path oedometer_scene = what.rfind("oedometer", 0) == 0 && argc > 3 ? fs::path(argv[3]) : fs::path();
     if (what == "oedometer" || what == "oedometer-tetrahedra") oedometer(out, "tetrahedra", oedometer_scene);
