@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "core/allocation_cap.h"
 #include "core/atomic_file.h"
@@ -153,6 +154,7 @@ std::string read_all(int fd) {
   return text;
 }
 
+// Both ends are closed when it goes, unless closed or handed over before (a failed fork, a throw).
 struct Pipe {
   int read = -1, write = -1;
   Pipe() {
@@ -161,6 +163,17 @@ struct Pipe {
     read = fds[0];
     write = fds[1];
   }
+  ~Pipe() {
+    close_end(read);
+    close_end(write);
+  }
+  Pipe(const Pipe&) = delete;
+  Pipe& operator=(const Pipe&) = delete;
+  static void close_end(int& fd) {
+    if (fd >= 0) ::close(fd);
+    fd = -1;
+  }
+  int release_read() { return std::exchange(read, -1); }
 };
 
 }  // namespace
@@ -178,18 +191,18 @@ openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path) {
   const pid_t child = ::fork();
   if (child < 0) throw std::runtime_error(std::string("cannot start the .vdb reading process: ") + std::strerror(errno));
   if (child == 0) {
-    ::close(data.read);
-    ::close(message.read);
+    Pipe::close_end(data.read);
+    Pipe::close_end(message.read);
     run_reader_process(path, data.write, message.write);
   }
-  ::close(data.write);
-  ::close(message.write);
+  Pipe::close_end(data.write);
+  Pipe::close_end(message.write);
   openvdb::GridPtrVecPtr grids;
   std::string stream_problem;
   try {
     // Closing the read end (the buffer's destructor) before waiting lets a child that still writes
     // die of SIGPIPE instead of waiting for a reader that stopped.
-    __gnu_cxx::stdio_filebuf<char> buffer(data.read, std::ios::in, std::size_t{1} << 16);
+    __gnu_cxx::stdio_filebuf<char> buffer(data.release_read(), std::ios::in, std::size_t{1} << 16);
     std::istream in(&buffer);
     in.exceptions(std::ios::failbit | std::ios::badbit);
     const AllocationCap allocation_cap(std::size_t{1} << 30);
@@ -199,7 +212,7 @@ openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path) {
     stream_problem = e.what();
   }
   const std::string child_message = read_all(message.read);
-  ::close(message.read);
+  Pipe::close_end(message.read);
   int status = 0;
   while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
   }
