@@ -89,12 +89,21 @@ std::string granular_model(const PairModel& m) {
 
 bool is_dynamic(const World& w, std::size_t b) { return w.bodies.motion[b] == MotionType::Dynamic; }
 
-// Molecule IDs: dynamic bodies 1..D in world order, then the static and kinematic ones.
-std::vector<std::int64_t> molecule_ids(const World& w, std::size_t* dynamic_count) {
+// A dynamic body of one particle: LAMMPS integrates it as a plain sphere (fix rigid/small refuses
+// one-atom bodies).
+bool is_free_sphere(const World& w, std::size_t b) { return is_dynamic(w, b) && w.bodies.particle_count[b] == 1; }
+
+// Molecule IDs: rigid dynamic bodies 1..R, free spheres R+1..D, each in world order, then the
+// static and kinematic ones, so each group is one range of molecule IDs.
+std::vector<std::int64_t> molecule_ids(const World& w, std::size_t* rigid_count, std::size_t* dynamic_count) {
   std::vector<std::int64_t> ids(w.bodies.size());
   std::int64_t next = 1;
   for (std::size_t b = 0; b < w.bodies.size(); ++b) {
-    if (is_dynamic(w, b)) ids[b] = next++;
+    if (is_dynamic(w, b) && !is_free_sphere(w, b)) ids[b] = next++;
+  }
+  *rigid_count = static_cast<std::size_t>(next - 1);
+  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+    if (is_free_sphere(w, b)) ids[b] = next++;
   }
   *dynamic_count = static_cast<std::size_t>(next - 1);
   for (std::size_t b = 0; b < w.bodies.size(); ++b) {
@@ -113,7 +122,7 @@ struct Box {
 };
 
 std::string data_file(const World& w, const std::vector<std::int64_t>& mol, const std::vector<int>& body_type,
-                      std::size_t type_count, const Box& box) {
+                      std::size_t type_count, const Box& box, bool velocities) {
   const std::vector<Eigen::Vector3d> x = particle_positions(w);
   std::string out = "LAMMPS data file written by tetrasand export lammps (SI units: m, kg)\n\n";
   out += fmt::format("{} atoms\n{} atom types\n\n", x.size(), type_count);
@@ -139,6 +148,18 @@ std::string data_file(const World& w, const std::vector<std::int64_t>& mol, cons
     const int type = body_type[w.particles.body[i]] > 0 ? body_type[w.particles.body[i]] : m + 1;
     out += fmt::format("{} {} {} {} {}\n", i + 1, type, num(2 * w.particles.radius[i]), num(density), vec(x[i]));
   }
+  if (velocities) {
+    // Each atom moves with its body (fix rigid/small recomputes its rigid bodies' atoms from
+    // bodies.rigid; plain spheres keep these). Before Molecules: placed after that fix
+    // section, LAMMPS 29 Sep 2021 took the first velocity row for a section name.
+    out += "\nVelocities\n\n";
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const std::uint32_t b = w.particles.body[i];
+      const Eigen::Vector3d& omega = w.bodies.angular_velocity[b];
+      const Eigen::Vector3d v = w.bodies.linear_velocity[b] + omega.cross(x[i] - w.bodies.position[b]);
+      out += fmt::format("{} {} {}\n", i + 1, vec(v), vec(omega));
+    }
+  }
   out += "\nMolecules\n\n";
   for (std::size_t i = 0; i < x.size(); ++i) out += fmt::format("{} {}\n", i + 1, mol[w.particles.body[i]]);
   return out;
@@ -146,12 +167,12 @@ std::string data_file(const World& w, const std::vector<std::int64_t>& mol, cons
 
 // fix rigid/small infile: ID masstotal xcm ycm zcm ixx iyy izz ixy ixz iyz vxcm vycm vzcm lx ly lz
 // ixcm iycm izcm, inertia about the centre of mass in the world frame, angular momentum L = I w.
-std::string bodies_file(const World& w, const std::vector<std::int64_t>& mol, std::size_t dynamic_count) {
+std::string bodies_file(const World& w, const std::vector<std::int64_t>& mol, std::size_t rigid_count) {
   std::string out = "# tetrasand export lammps: explicit mass (kg), centre of mass (m), world-frame inertia (kg m^2)\n";
   out += "# ID masstotal xcm ycm zcm ixx iyy izz ixy ixz iyz vxcm vycm vzcm lx ly lz ixcm iycm izcm\n";
-  out += fmt::format("{}\n", dynamic_count);
+  out += fmt::format("{}\n", rigid_count);
   for (std::size_t b = 0; b < w.bodies.size(); ++b) {
-    if (!is_dynamic(w, b)) continue;
+    if (!is_dynamic(w, b) || is_free_sphere(w, b)) continue;
     const Eigen::Matrix3d r = w.bodies.orientation[b].toRotationMatrix();
     const Eigen::Matrix3d inertia = r * w.bodies.inverse_inertia[b].inverse() * r.transpose();
     const Eigen::Vector3d momentum = inertia * w.bodies.angular_velocity[b];
@@ -208,6 +229,17 @@ void check_exportable(const Scene& scene, const World& w) {
       refuse(scene, "a kinematic prop that both translates and spins (LAMMPS fix move does one or the other)");
     }
   }
+  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+    if (!is_free_sphere(w, b)) continue;
+    const std::uint32_t i = w.bodies.first_particle[b];
+    const double r = w.particles.radius[i];
+    const Eigen::Matrix3d solid = Eigen::Matrix3d::Identity() * w.bodies.inverse_mass[b] / (0.4 * r * r);
+    if (w.particles.offset[i].norm() > 1e-9 * r || !w.bodies.inverse_inertia[b].isApprox(solid, 1e-9)) {
+      refuse(scene, fmt::format("dynamic body {} is one particle off its centre of mass or with other than a solid "
+                                "sphere's inertia (LAMMPS's fix rigid/small refuses one-atom bodies, and fix "
+                                "nve/sphere integrates a centred solid sphere)", b));
+    }
+  }
   const bool pours = std::any_of(scene.emitters.begin(), scene.emitters.end(),
                                  [](const Emitter& e) { return e.type == EmitterType::Pour; });
   const bool dynamic_props = std::any_of(scene.props.begin(), scene.props.end(),
@@ -245,7 +277,9 @@ struct DeckPlan {
   double dt = 0;  // s
   std::int64_t steps = 0;
   std::vector<std::int64_t> mol;  // molecule id per body
-  std::size_t dynamic_count = 0, frozen_particles = 0;
+  // Molecules 1..rigid_count are rigid bodies, rigid_count+1..dynamic_count free spheres.
+  std::size_t rigid_count = 0, dynamic_count = 0, frozen_particles = 0;
+  const LammpsStateRun* state = nullptr;  // set when the deck continues a state (export_lammps_state)
   double max_radius = 0, max_body_extent = 0;  // m
   Box box;
   std::vector<PourEvent> pours;
@@ -361,6 +395,7 @@ std::pair<double, double> mean_grain(const DeckPlan& plan, std::optional<std::ui
   const World& w = plan.world;
   std::vector<std::pair<double, double>> grains;  // mass, radius
   for (std::size_t b = fixture_bodies(plan.scene, w); b < w.bodies.size(); ++b) {
+    if (!is_dynamic(w, b)) continue;  // a state may hold static bodies after the grains (a silo's rim)
     const std::uint32_t first = w.bodies.first_particle[b];
     if (!material || w.particles.material[first] == *material)
       grains.emplace_back(1.0 / w.bodies.inverse_mass[b], w.particles.radius[first]);
@@ -404,15 +439,19 @@ void plan_atom_types(DeckPlan& plan) {
   }
 }
 
-DeckPlan make_plan(const Scene& scene) {
-  DeckPlan plan(scene, make_world(scene));
+// The plan of the scene's initial world, or of `state` run as `run` says (export_lammps_state).
+DeckPlan make_plan(const Scene& scene, const World* state = nullptr, const LammpsStateRun* run = nullptr) {
+  DeckPlan plan(scene, state ? *state : make_world(scene));
+  plan.state = run;
   check_exportable(scene, plan.world);
   std::string warning;
-  plan.dt = resolve_time_step(scene, plan.world, &warning);
-  plan.steps = static_cast<std::int64_t>(std::ceil(scene.simulation.duration / plan.dt - 1e-9));
-  plan.mol = molecule_ids(plan.world, &plan.dynamic_count);
+  plan.dt = run && run->dt > 0 ? run->dt : resolve_time_step(scene, plan.world, &warning);
+  const double duration = run ? run->duration : scene.simulation.duration;
+  if (!(duration > 0)) refuse(scene, fmt::format("a duration of {} s to run the state for", duration));
+  plan.steps = static_cast<std::int64_t>(std::ceil(duration / plan.dt - 1e-9));
+  plan.mol = molecule_ids(plan.world, &plan.rigid_count, &plan.dynamic_count);
   plan_geometry(plan);
-  plan_pours(plan);
+  if (!run) plan_pours(plan);
   if (plan.dynamic_count == 0 && plan.pours.empty()) refuse(scene, "the scene has no dynamic bodies and no pour emitter");
   if (plan.box.lo.x() > plan.box.hi.x()) plan.box.add(Eigen::Vector3d::Zero(), plan.max_radius);
   plan.box.lo.array() -= 4 * plan.max_radius;
@@ -549,6 +588,11 @@ void setup_section(const DeckPlan& plan, Script& out) {
   const std::int64_t last_id = static_cast<std::int64_t>(plan.world.bodies.size());
   out.line(plan.dynamic_count > 0 ? fmt::format("group           dynamic molecule <> 1 {}", plan.dynamic_count)
                                   : "group           dynamic empty");
+  if (plan.dynamic_count > plan.rigid_count) {
+    out.line(plan.rigid_count > 0 ? fmt::format("group           rigid molecule <> 1 {}", plan.rigid_count)
+                                  : "group           rigid empty");
+    out.line(fmt::format("group           spheres molecule <> {} {}", plan.rigid_count + 1, plan.dynamic_count));
+  }
   out.line(first_frozen <= last_id ? fmt::format("group           frozen molecule <> {} {}", first_frozen, last_id)
                                    : "group           frozen empty");
   out.line(fmt::format("neighbor        {} bin", num(plan.skin())));
@@ -578,13 +622,20 @@ void contact_section(const DeckPlan& plan, Script& out) {
 void bodies_section(const DeckPlan& plan, Script& out) {
   const World& w = plan.world;
   if (plan.frozen_particles > 0) out.line("fix             freeze frozen freeze");
-  const std::string rigid_mol = plan.pours.empty() ? "" : " mol grain";
-  out.line(fmt::format("fix             rb dynamic rigid/small molecule{}{}",
-                       plan.dynamic_count > 0 ? " infile bodies.rigid" : "", rigid_mol));
+  // Gravity before the rigid bodies: fix rigid/small sums its atoms' forces in its setup, in the
+  // order the fixes were defined, so a gravity defined after it is missing from the first half-step
+  // (measured: every body 2.45 um high after 0.05 s at dt = 10 us, g dt t / 2).
   const double g = plan.scene.gravity.norm();
   if (g > 0) {
     out.line(fmt::format("fix             gravity dynamic gravity {} vector {}", num(g), vec(plan.scene.gravity / g)));
   }
+  const std::string rigid_mol = plan.pours.empty() ? "" : " mol grain";
+  const bool spheres = plan.dynamic_count > plan.rigid_count;
+  if (!spheres || plan.rigid_count > 0) {
+    out.line(fmt::format("fix             rb {} rigid/small molecule{}{}", spheres ? "rigid" : "dynamic",
+                         plan.rigid_count > 0 ? " infile bodies.rigid" : "", rigid_mol));
+  }
+  if (spheres) out.line("fix             spheres spheres nve/sphere");
   for (std::size_t b = 0; b < w.bodies.size(); ++b) {
     if (w.bodies.motion[b] != MotionType::Kinematic) continue;
     const std::int64_t id = plan.mol[b];
@@ -654,15 +705,36 @@ void walls_section(const DeckPlan& plan, Script& out) {
   out.line("");
 }
 
+// Thermo: the translational and rotational kinetic energies of the rigid bodies (c_ket, c_ker)
+// and of the free spheres (c_kes, c_kers), whichever the deck has.
 void output_section(const DeckPlan& plan, Script& out) {
   out.line(fmt::format("timestep        {}", num(plan.dt)));
-  out.line("compute         ket dynamic ke/rigid rb");
-  out.line("compute         ker dynamic erotate/rigid rb");
-  out.line("thermo_style    custom step time atoms c_ket c_ker");
+  const bool spheres = plan.dynamic_count > plan.rigid_count, rigid = !spheres || plan.rigid_count > 0;
+  std::string energies;
+  if (rigid) {
+    const std::string group = spheres ? "rigid" : "dynamic";
+    out.line(fmt::format("compute         ket {} ke/rigid rb", group));
+    out.line(fmt::format("compute         ker {} erotate/rigid rb", group));
+    energies += " c_ket c_ker";
+  }
+  if (spheres) {
+    out.line("compute         kes spheres ke");
+    out.line("compute         kers spheres erotate/sphere");
+    energies += " c_kes c_kers";
+  }
+  out.line("thermo_style    custom step time atoms" + energies);
   out.line("thermo_modify   norm no lost error");
-  out.line(fmt::format("thermo          {}", plan.scene.output.every));
-  out.line(fmt::format("dump            particles dynamic custom {} particles.dump id mol type x y z radius",
-                       plan.scene.output.every));
+  const std::int64_t every = plan.state && plan.state->thermo_every > 0 ? plan.state->thermo_every
+                                                                       : plan.scene.output.every;
+  out.line(fmt::format("thermo          {}", every));
+  const std::int64_t dump_every = plan.state ? plan.state->dump_every : plan.scene.output.every;
+  if (dump_every > 0) {
+    out.line(fmt::format("dump            particles dynamic custom {} particles.dump id mol type x y z radius",
+                         dump_every));
+  }
+  if (plan.state) {
+    for (const std::string& command : plan.state->before_run) out.line(command);
+  }
   out.line("");
 }
 
@@ -695,7 +767,8 @@ void run_section(const DeckPlan& plan, Script& out) {
         num(e.velocity.z()), num(e.velocity.z())));
   }
   if (plan.steps > at) out.line(fmt::format("run             {}", plan.steps - at));
-  out.line("write_dump      dynamic custom final.dump id mol type x y z radius");
+  // Full precision: the last state is what other codes compare against.
+  out.line("write_dump      dynamic custom final.dump id mol type x y z radius modify format float %.17g");
 }
 
 }  // namespace
@@ -720,8 +793,10 @@ double lammps_restitution_for_alpha(double alpha) {
   return 0.5 * (lo + hi);
 }
 
-LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
-  const DeckPlan plan = make_plan(scene);
+namespace {
+
+LammpsDeck write_deck(const DeckPlan& plan, const fs::path& dir) {
+  const Scene& scene = plan.scene;
   LammpsDeck deck;
   deck.dt = plan.dt;
   deck.steps = plan.steps;
@@ -740,9 +815,10 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
   fs::create_directories(dir);
   const std::vector<fs::path> inputs{scene.file};
   deck.input = dir / "in.tetrasand";
-  write_file_atomically(dir / "data.tetrasand", data_file(plan.world, plan.mol, plan.body_type, plan.types.size(), plan.box),
+  write_file_atomically(dir / "data.tetrasand",
+                        data_file(plan.world, plan.mol, plan.body_type, plan.types.size(), plan.box, plan.state != nullptr),
                         inputs);
-  write_file_atomically(dir / "bodies.rigid", bodies_file(plan.world, plan.mol, plan.dynamic_count), inputs);
+  write_file_atomically(dir / "bodies.rigid", bodies_file(plan.world, plan.mol, plan.rigid_count), inputs);
   write_file_atomically(deck.input, in.text(), inputs);
   deck.files = {deck.input, dir / "data.tetrasand", dir / "bodies.rigid"};
   const std::vector<std::string> files = template_files(plan);
@@ -754,6 +830,14 @@ LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) {
     deck.files.push_back(dir / files[k]);
   }
   return deck;
+}
+
+}  // namespace
+
+LammpsDeck export_lammps(const Scene& scene, const fs::path& dir) { return write_deck(make_plan(scene), dir); }
+
+LammpsDeck export_lammps_state(const Scene& scene, const World& state, const LammpsStateRun& run, const fs::path& dir) {
+  return write_deck(make_plan(scene, &state, &run), dir);
 }
 
 }  // namespace ts::sim

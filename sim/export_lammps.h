@@ -45,6 +45,26 @@ struct LammpsDeck {
 // normal damping, angular damping, kinematic props that both translate and spin, ...).
 LammpsDeck export_lammps(const Scene& scene, const std::filesystem::path& dir);
 
+// How a state is run (export_lammps_state).
+struct LammpsStateRun {
+  double duration = 0;                  // s simulated from the state
+  double dt = 0;                        // s; 0: the scene's automatic step for this state
+  std::int64_t thermo_every = 0;        // steps between thermo lines; 0: the scene's [output] every
+  std::int64_t dump_every = 0;          // steps between particles.dump frames; 0: none (final.dump only)
+  std::vector<std::string> before_run;  // LAMMPS commands placed just before the first `run` (computes,
+                                        // variables, a thermo_style that replaces the deck's)
+};
+
+// The deck of a state of `scene` (a world made by make_world(scene) and stepped or changed: an
+// orifice cut, grains removed) in place of the scene's initial world, so LAMMPS continues what
+// tetrasand started: positions, orientations, velocities and spins carry over (bodies.rigid holds
+// the rigid bodies' momenta, the data file's Velocities section every atom's). The scene's
+// emitters are not exported (the state holds the grains already released). Dynamic bodies of one
+// centred sphere with a solid sphere's inertia (0.4 m r^2) become plain LAMMPS spheres (fix
+// nve/sphere), since fix rigid/small refuses one-atom bodies; any other one-particle body is refused.
+LammpsDeck export_lammps_state(const Scene& scene, const World& state, const LammpsStateRun& run,
+                               const std::filesystem::path& dir);
+
 // LAMMPS's Tsuji damping coefficient alpha(e) (pair_granular.cpp: a sixth-order polynomial in the
 // restitution e), and its inverse on [0, 1] (alpha decreases from 1.2728 at e = 0 to ~0 at e = 1).
 // The inverse throws ts::InputError when alpha is out of that range.

@@ -109,4 +109,59 @@ Eigen::Vector3d angular_momentum(const World& world) {
   return l;
 }
 
+void grains_to_spheres(World& world) {
+  World spheres = world;
+  spheres.bodies = {};
+  spheres.particles = {};
+  spheres.springs = {};
+  const Bodies& b = world.bodies;
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    const std::uint32_t first = b.first_particle[k];
+    BodyDesc d{b.position[k],     b.orientation[k],     b.linear_velocity[k], b.angular_velocity[k],
+               b.inverse_mass[k], b.inverse_inertia[k], b.motion[k]};
+    std::vector<Eigen::Vector3d> offsets(world.particles.offset.begin() + first,
+                                         world.particles.offset.begin() + first + b.particle_count[k]);
+    std::vector<double> radii(world.particles.radius.begin() + first,
+                              world.particles.radius.begin() + first + b.particle_count[k]);
+    if (b.motion[k] == MotionType::Dynamic && b.particle_count[k] == 4) {
+      const double radius = std::cbrt(4.0) * radii[0];  // m
+      offsets = {Eigen::Vector3d::Zero()};
+      radii = {radius};
+      d.inverse_inertia = Eigen::Matrix3d::Identity() * b.inverse_mass[k] / (0.4 * radius * radius);
+    }
+    add_body(spheres, d, offsets, radii, world.particles.material[first]);
+  }
+  world = std::move(spheres);
+}
+
+World without_particles(const World& world, const std::function<bool(std::size_t)>& keep) {
+  World out = world;
+  out.bodies = {};
+  out.particles = {};
+  out.springs = {};
+  out.tracks = {};
+  const Bodies& b = world.bodies;
+  std::vector<std::int64_t> new_index(b.size(), -1);  // -1: dropped
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    const std::uint32_t first = b.first_particle[k];
+    std::vector<Eigen::Vector3d> offsets;
+    std::vector<double> radii;
+    for (std::uint32_t i = first; i < first + b.particle_count[k]; ++i) {
+      if (b.motion[k] == MotionType::Dynamic ? !keep(first) : !keep(i)) continue;
+      offsets.push_back(world.particles.offset[i]);
+      radii.push_back(world.particles.radius[i]);
+    }
+    if (offsets.empty()) continue;
+    const BodyDesc d{b.position[k],     b.orientation[k],     b.linear_velocity[k], b.angular_velocity[k],
+                     b.inverse_mass[k], b.inverse_inertia[k], b.motion[k]};
+    new_index[k] = add_body(out, d, offsets, radii, world.particles.material[first]);
+  }
+  for (KinematicTrack track : world.tracks) {
+    if (new_index[track.body] < 0) continue;
+    track.body = static_cast<std::uint32_t>(new_index[track.body]);
+    out.tracks.push_back(std::move(track));
+  }
+  return out;
+}
+
 }  // namespace ts::sim

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -114,6 +115,19 @@ std::uint32_t add_grain(World& world, const GrainShape& grain, std::uint16_t mat
                         const Eigen::Vector3d& position, const Eigen::Quaterniond& orientation,
                         const Eigen::Vector3d& linear_velocity = Eigen::Vector3d::Zero(),
                         const Eigen::Vector3d& angular_velocity = Eigen::Vector3d::Zero());
+
+// Each tetrahedral grain (a dynamic body of four particles) becomes one solid sphere of the same
+// volume and mass (radius 4^(1/3) r: the grain counts four whole spheres) at its centre of mass, so
+// a run can contrast grain shape with everything else equal (the oedometer's and the silo's sphere
+// runs); the other bodies keep their particles, in the same order. Contact springs are cleared.
+void grains_to_spheres(World& world);
+
+// The world without the particles `keep` rejects (called with the particle index): a static or
+// kinematic body keeps the rest of its particles, or goes when none is left; a dynamic body is
+// kept or dropped whole (its mass and inertia belong to all of its particles), by its first
+// particle. For handing a state to another code without what was parked out of play (grains and
+// plate particles moved far below a silo). Contact springs are cleared.
+World without_particles(const World& world, const std::function<bool(std::size_t)>& keep);
 
 // Sets every tracked body's pose and velocities to its track's at `time` (s).
 void apply_tracks(World& world, double time);

@@ -2,7 +2,8 @@
 // the GPU pipeline), written as CSV files that bench/validation/report.py plots and compares with
 // the literature. Usage:
 //   tetrasand_validation_runs OUT_DIR [restitution|repose|silo
-//   [SCENE]|column [R0_M,R0_M,...]|all|agreement[-heap|-silo|-bed]|
+//   [SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|column [R0_M,R0_M,...]|all|
+//   agreement[-heap|-silo|-bed]|
 //                                      oedometer[-tetrahedra|-spheres] [SCENE]]
 // `all` is the physical report: restitution and repose take minutes, the column collapse (8 x 20,000
 // grains) and the Mankoc-sized silo (80,000 grains) tens of minutes each on two cores. `agreement`
@@ -26,6 +27,7 @@
 #include "core/atomic_file.h"
 #include "gpu/context.h"
 #include "sim/cpu_reference.h"
+#include "sim/export_lammps.h"
 #include "sim/gpu_stepper.h"
 #include "sim/scene.h"
 #include "sim/scene_runner.h"
@@ -286,8 +288,6 @@ struct SettledFill {
   double settle_time = 0, fill = 0, wall_seconds = 0;  // s simulated, m (95th percentile of centre heights), s wall
 };
 
-void grains_to_spheres(World& world);
-
 // `reshape`, when given, changes the initial world before it falls (grains_to_spheres).
 SettledFill settle_fill(Scene& scene, const std::string& label, const fs::path& forces_file,
                         const std::function<void(World&)>& reshape = {}) {
@@ -317,6 +317,62 @@ SettledFill settle_fill(Scene& scene, const std::string& label, const fs::path& 
   return f;
 }
 
+// Grains leave a silo's simulation as static bodies 10 cm apart on a square 1 km down, so they touch
+// nothing and share no cell.
+struct Parking {
+  std::size_t slots = 0;
+  void park(World& world, std::size_t k) {
+    Bodies& b = world.bodies;
+    b.motion[k] = MotionType::Static;
+    b.inverse_mass[k] = 0;
+    b.inverse_inertia[k].setZero();
+    b.linear_velocity[k].setZero();
+    b.angular_velocity[k].setZero();
+    b.position[k] = Eigen::Vector3d(0.1 * static_cast<double>(slots % 200), 0.1 * static_cast<double>(slots / 200), -1e3);
+    ++slots;
+  }
+};
+
+struct OpenedOrifice {
+  std::size_t rim_spheres = 0, removed_on_rim = 0;
+};
+
+// Opens an orifice of diameter `orifice` (m) in a settled silo's plate (the scene's second
+// boundary): the plate's particles reaching into it move 1 km below, keeping x and y, and a round
+// rim of the plate's spheres lines the hole, so its opening is a disc of D, not the ragged lattice
+// edge (whose open area is that of a disc up to 0.9 d wider). A grain sphere resting in a lattice
+// hollow reaches below the plate's tops, where a rim sphere can now stand: such grains would start
+// deep in contact, so they are parked before the run starts.
+OpenedOrifice open_orifice(World& world, const Scene& scene, double orifice, Parking& parking) {
+  const Particles& p = world.particles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (world.bodies.motion[p.body[i]] != MotionType::Static) continue;
+    if (p.offset[i].head<2>().norm() < orifice / 2 + p.radius[i]) world.particles.offset[i].z() -= 1e3;
+  }
+  const Boundary& plate = scene.boundaries.at(1);
+  BodyDesc rim;
+  rim.position = plate.point;
+  rim.motion = MotionType::Static;
+  const auto rim_offsets = round_hole_rim(Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(),
+                                          orifice / 2, plate.particle_radius);
+  add_body(world, rim, rim_offsets, std::vector<double>(rim_offsets.size(), plate.particle_radius), plate.material);
+  std::vector<std::size_t> overlapping;
+  const auto positions = particle_positions(world);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (world.bodies.motion[p.body[i]] != MotionType::Dynamic) continue;
+    for (const Eigen::Vector3d& o : rim_offsets) {
+      if ((positions[i] - plate.point - o).norm() < p.radius[i] + plate.particle_radius) {
+        overlapping.push_back(p.body[i]);
+        break;
+      }
+    }
+  }
+  std::sort(overlapping.begin(), overlapping.end());
+  overlapping.erase(std::unique(overlapping.begin(), overlapping.end()), overlapping.end());
+  for (std::size_t k : overlapping) parking.park(world, k);
+  return {rim_offsets.size(), overlapping.size()};
+}
+
 // A large flat-bottomed silo within the size conditions of Mankoc et al. 2007
 // (reference/silo_mankoc.toml, or `scene_file`): filled and settled once on a closed rough plate,
 // damped once the lattice has landed (it falls ~4 m as one block, and the soft fill otherwise
@@ -327,20 +383,27 @@ SettledFill settle_fill(Scene& scene, const std::string& label, const fs::path& 
 // nothing and pile up nowhere. `spheres`: each grain replaced by one sphere of its volume and mass
 // before the fill falls (grains_to_spheres; the Beverloo reference silo of
 // bench/validation/silo_spheres_criteria.md), so d is then the spheres' diameter.
+constexpr double kDischargeTime = 0.35;  // s after a silo's orifice opens; the rate is fitted from 0.1 s
+
+// The silo's fill settled on its closed plate (grains or, with `spheres`, spheres), its contact
+// forces and silo_fill.csv written into `out`.
+SettledFill settled_silo(const fs::path& out, Scene& scene, bool spheres) {
+  SettledFill filled = settle_fill(scene, spheres ? "sphere silo" : "silo", out / "contact_forces.csv",
+                                   spheres ? std::function<void(World&)>(grains_to_spheres)
+                                           : std::function<void(World&)>());
+  ts::write_file_atomically(out / "silo_fill.csv",
+                            fmt::format("grains,settle_s,fill_m,width_m,dt_s,settle_wall_s\n{},{:.3f},{:.4f},{:.4f},{:.4g},{:.0f}\n",
+                                        filled.grains, filled.settle_time, filled.fill,
+                                        2 * scene.boundaries.at(0).radius, filled.settings.dt, filled.wall_seconds));
+  return filled;
+}
+
 void silo(const fs::path& out, const fs::path& scene_file, bool spheres = false) {
-  constexpr double kDischargeTime = 0.35;  // s after the orifice opens; the rate is fitted from 0.1 s
   Scene scene = scene_file.empty() ? reference("silo_mankoc.toml") : load_scene(scene_file);
-  const SettledFill filled = settle_fill(scene, spheres ? "sphere silo" : "silo", out / "contact_forces.csv",
-                                         spheres ? std::function<void(World&)>(grains_to_spheres)
-                                                 : std::function<void(World&)>());
+  const SettledFill filled = settled_silo(out, scene, spheres);
   const World& settled = filled.world;
   const double dt = filled.settings.dt;
   const std::size_t grains = filled.grains;
-  ts::write_file_atomically(out / "silo_fill.csv",
-                            fmt::format("grains,settle_s,fill_m,width_m,dt_s,settle_wall_s\n{},{:.3f},{:.4f},{:.4f},{:.4g},{:.0f}\n",
-                                        grains, filled.settle_time, filled.fill, 2 * scene.boundaries.at(0).radius, dt,
-                                        filled.wall_seconds));
-
   const double d = 2 * scene.grains.at(0).radius * std::cbrt(4.0);  // m, volume-equivalent diameter
   std::string csv = "orifice_m,time_s,discharged\n";
   std::string runs = "orifice_m,grains,rim_spheres,removed_on_rim,seconds\n";
@@ -348,50 +411,9 @@ void silo(const fs::path& out, const fs::path& scene_file, bool spheres = false)
     const double orifice = ratio * d;
     World world = settled;
     world.time = 0;
-    // Open the orifice: the plate's particles reaching into it move 1 km below, keeping x and y, and
-    // a round rim of the plate's spheres lines the hole, so its opening is a disc of D, not the
-    // ragged lattice edge (whose open area is that of a disc up to 0.9 d wider).
-    const Particles& p = world.particles;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      if (world.bodies.motion[p.body[i]] != MotionType::Static) continue;
-      if (p.offset[i].head<2>().norm() < orifice / 2 + p.radius[i]) world.particles.offset[i].z() -= 1e3;
-    }
-    const Boundary& plate = scene.boundaries.at(1);
-    BodyDesc rim;
-    rim.position = plate.point;
-    rim.motion = MotionType::Static;
-    const auto rim_offsets = round_hole_rim(Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(),
-                                            orifice / 2, plate.particle_radius);
-    add_body(world, rim, rim_offsets, std::vector<double>(rim_offsets.size(), plate.particle_radius), plate.material);
-    // Grains leave the simulation as static bodies 10 cm apart on a square 1 km down, so they touch
-    // nothing and share no cell.
-    std::size_t slots = 0;
-    auto park = [&](std::size_t k) {
-      Bodies& b = world.bodies;
-      b.motion[k] = MotionType::Static;
-      b.inverse_mass[k] = 0;
-      b.inverse_inertia[k].setZero();
-      b.linear_velocity[k].setZero();
-      b.angular_velocity[k].setZero();
-      b.position[k] = Eigen::Vector3d(0.1 * static_cast<double>(slots % 200), 0.1 * static_cast<double>(slots / 200), -1e3);
-      ++slots;
-    };
-    // A grain sphere resting in a lattice hollow reaches below the plate's tops, where a rim sphere
-    // can now stand: such grains would start deep in contact, so they leave before the run starts.
-    std::vector<std::size_t> overlapping;
-    const auto positions = particle_positions(world);
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      if (world.bodies.motion[p.body[i]] != MotionType::Dynamic) continue;
-      for (const Eigen::Vector3d& o : rim_offsets) {
-        if ((positions[i] - plate.point - o).norm() < p.radius[i] + plate.particle_radius) {
-          overlapping.push_back(p.body[i]);
-          break;
-        }
-      }
-    }
-    std::sort(overlapping.begin(), overlapping.end());
-    overlapping.erase(std::unique(overlapping.begin(), overlapping.end()), overlapping.end());
-    for (std::size_t k : overlapping) park(k);
+    Parking parking;
+    const OpenedOrifice opened = open_orifice(world, scene, orifice, parking);
+    auto park = [&](std::size_t k) { parking.park(world, k); };
     CpuStepper stepper(world, filled.settings);
     std::size_t parked = 0;
     const auto start = std::chrono::steady_clock::now();
@@ -409,10 +431,50 @@ void silo(const fs::path& out, const fs::path& scene_file, bool spheres = false)
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr, "silo D = %.1f mm (%.2f d): %zu grains out in %.2f s (%zu on the rim removed first), %.0f s wall\n",
-                 orifice * 1e3, ratio, parked, kDischargeTime, overlapping.size(), seconds);
-    runs += fmt::format("{:.5f},{},{},{},{:.1f}\n", orifice, grains, rim_offsets.size(), overlapping.size(), seconds);
+                 orifice * 1e3, ratio, parked, kDischargeTime, opened.removed_on_rim, seconds);
+    runs += fmt::format("{:.5f},{},{},{},{:.1f}\n", orifice, grains, opened.rim_spheres, opened.removed_on_rim, seconds);
     ts::write_file_atomically(out / "silo.csv", csv);  // after each orifice: a stopped run keeps its rows
     ts::write_file_atomically(out / "silo_runs.csv", runs);
+  }
+}
+
+// The silo's discharges handed to LAMMPS (bench/validation/silo_lammps_criteria.md): the fill settled
+// by tetrasand as `silo` settles it, each orifice opened as `silo` opens it (widest first, so a
+// partial run keeps the lever arm), and that state written as a LAMMPS deck into OUT/lammps_D<ratio>d
+// (export_lammps_state, run 0.35 s at tetrasand's dt; the parked grains and plate particles left
+// out). The deck logs the dynamic mass below z = -0.05 m every 2 ms as v_discharged (kg);
+// bench/validation/silo_lammps.py runs LAMMPS on each and fits the rates.
+void silo_lammps(const fs::path& out, bool spheres) {
+  Scene scene = reference("silo_mankoc.toml");
+  const SettledFill filled = settled_silo(out, scene, spheres);
+  const double d = 2 * scene.grains.at(0).radius * std::cbrt(4.0);  // m, volume-equivalent diameter
+  std::string decks = "orifice_m,ratio,deck,grains,rim_spheres,removed_on_rim,steps,dt_s\n";
+  for (double ratio : {8.0, 5.0, 7.0, 6.0}) {
+    const double orifice = ratio * d;
+    World world = filled.world;
+    world.time = 0;
+    Parking parking;
+    const OpenedOrifice opened = open_orifice(world, scene, orifice, parking);
+    const std::vector<Eigen::Vector3d> x = particle_positions(world);
+    const World handed = without_particles(world, [&](std::size_t i) { return x[i].z() > -100.0; });
+    LammpsStateRun run;
+    run.duration = kDischargeTime;
+    run.dt = filled.settings.dt;
+    run.thermo_every = std::max<std::int64_t>(1, std::llround(2e-3 / run.dt));
+    run.before_run = {
+        "region          below block INF INF INF INF INF -0.05 units box",
+        "variable        discharged equal mass(dynamic,below)",
+        "thermo_style    custom step time atoms v_discharged",
+    };
+    const std::string name = fmt::format("lammps_D{:.0f}d", ratio);
+    const LammpsDeck deck = export_lammps_state(scene, handed, run, out / name);
+    std::size_t grains = 0;
+    for (std::size_t b = 0; b < handed.bodies.size(); ++b) grains += handed.bodies.motion[b] == MotionType::Dynamic;
+    std::fprintf(stderr, "silo D = %.1f mm (%.0f d): LAMMPS deck %s, %zu grains, %zu on the rim removed, %lld steps\n",
+                 orifice * 1e3, ratio, name.c_str(), grains, opened.removed_on_rim, static_cast<long long>(deck.steps));
+    decks += fmt::format("{:.5f},{:.0f},{},{},{},{},{},{:.6g}\n", orifice, ratio, name, grains, opened.rim_spheres,
+                         opened.removed_on_rim, deck.steps, run.dt);
+    ts::write_file_atomically(out / "silo_lammps_decks.csv", decks);
   }
 }
 
@@ -515,34 +577,6 @@ void column(const fs::path& out, std::vector<double> radii) {
   }
 }
 
-// Each tetrahedral grain (a dynamic body of four particles) becomes one solid sphere of the same
-// volume and mass (radius 4^(1/3) r: the grain counts four whole spheres) at its centre of mass; the
-// other bodies (the piston) keep their particles and indices.
-void grains_to_spheres(World& world) {
-  World spheres = world;
-  spheres.bodies = {};
-  spheres.particles = {};
-  spheres.springs = {};
-  const Bodies& b = world.bodies;
-  for (std::size_t k = 0; k < b.size(); ++k) {
-    const std::uint32_t first = b.first_particle[k];
-    BodyDesc d{b.position[k],     b.orientation[k],     b.linear_velocity[k], b.angular_velocity[k],
-               b.inverse_mass[k], b.inverse_inertia[k], b.motion[k]};
-    std::vector<Eigen::Vector3d> offsets(world.particles.offset.begin() + first,
-                                         world.particles.offset.begin() + first + b.particle_count[k]);
-    std::vector<double> radii(world.particles.radius.begin() + first,
-                              world.particles.radius.begin() + first + b.particle_count[k]);
-    if (b.motion[k] == MotionType::Dynamic && b.particle_count[k] == 4) {
-      const double radius = std::cbrt(4.0) * radii[0];  // m
-      offsets = {Eigen::Vector3d::Zero()};
-      radii = {radius};
-      d.inverse_inertia = Eigen::Matrix3d::Identity() * b.inverse_mass[k] / (0.4 * radius * radius);
-    }
-    add_body(spheres, d, offsets, radii, world.particles.material[first]);
-  }
-  world = std::move(spheres);
-}
-
 // The oedometer of assets/scenes/validation/oedometer.toml (bench/validation/oedometer_criteria.md) with
 // `shape` "tetrahedra" (the scene's grains) or "spheres" (each grain one sphere of its volume and mass):
 // the servo's log as oedometer_SHAPE.csv, and a row of oedometer_runs_SHAPE.csv. `scene_file`: a variant
@@ -634,7 +668,7 @@ std::vector<double> radii_list(const std::string& text) {
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|silo-spheres|forces-backed|forces "
+                 "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|forces "
                  "[GRAINS]|column [R0,R0,...]|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres] [SCENE]]\n",
                  argv[0]);
     return 2;
@@ -650,6 +684,8 @@ int main(int argc, char** argv) {
     if (what == "forces" || what == "all") forces(out, what == "forces" && argc > 3 ? std::stoul(argv[3]) : 30000);
     if (what == "forces-backed") forces_backed(out);
     if (what == "silo-spheres") silo(out, {}, true);
+    if (what == "silo-lammps") silo_lammps(out, false);
+    if (what == "silo-spheres-lammps") silo_lammps(out, true);
     if (what == "agreement") agreement(out, "all");
     const fs::path oedometer_scene = what.rfind("oedometer", 0) == 0 && argc > 3 ? fs::path(argv[3]) : fs::path();
     if (what == "oedometer" || what == "oedometer-tetrahedra") oedometer(out, "tetrahedra", oedometer_scene);
