@@ -280,6 +280,9 @@ struct DeckPlan {
   // Molecules 1..rigid_count are rigid bodies, rigid_count+1..dynamic_count free spheres.
   std::size_t rigid_count = 0, dynamic_count = 0, frozen_particles = 0;
   const LammpsStateRun* state = nullptr;  // set when the deck continues a state (export_lammps_state)
+  // Bodies 0..fixtures-1 are the scene's props and rough walls, as make_world lays them out; a state
+  // may append static bodies after the grains (a silo's rim), which are not props.
+  std::size_t fixtures = 0;
   double max_radius = 0, max_body_extent = 0;  // m
   Box box;
   std::vector<PourEvent> pours;
@@ -394,7 +397,7 @@ void plan_pours(DeckPlan& plan) {
 std::pair<double, double> mean_grain(const DeckPlan& plan, std::optional<std::uint16_t> material) {
   const World& w = plan.world;
   std::vector<std::pair<double, double>> grains;  // mass, radius
-  for (std::size_t b = fixture_bodies(plan.scene, w); b < w.bodies.size(); ++b) {
+  for (std::size_t b = plan.fixtures; b < w.bodies.size(); ++b) {
     if (!is_dynamic(w, b)) continue;  // a state may hold static bodies after the grains (a silo's rim)
     const std::uint32_t first = w.bodies.first_particle[b];
     if (!material || w.particles.material[first] == *material)
@@ -430,7 +433,7 @@ void plan_atom_types(DeckPlan& plan) {
   plan.body_type.assign(w.bodies.size(), 0);
   for (const GrainKind& k : plan.kinds) plan.dynamic_types.insert(plan.scene.grains[k.type].material + 1);
   // Dynamic props (fixtures that move): one atom type each. Grains follow the fixtures.
-  for (std::size_t b = 0; b < fixture_bodies(plan.scene, w); ++b) {
+  for (std::size_t b = 0; b < plan.fixtures; ++b) {
     if (!is_dynamic(w, b)) continue;
     const std::uint32_t first = w.bodies.first_particle[b];
     plan.types.push_back({w.particles.material[first], 1.0 / w.bodies.inverse_mass[b], w.particles.radius[first]});
@@ -443,6 +446,7 @@ void plan_atom_types(DeckPlan& plan) {
 DeckPlan make_plan(const Scene& scene, const World* state = nullptr, const LammpsStateRun* run = nullptr) {
   DeckPlan plan(scene, state ? *state : make_world(scene));
   plan.state = run;
+  plan.fixtures = fixture_bodies(scene, state ? make_world(scene) : plan.world);
   check_exportable(scene, plan.world);
   std::string warning;
   plan.dt = run && run->dt > 0 ? run->dt : resolve_time_step(scene, plan.world, &warning);
@@ -732,8 +736,9 @@ void output_section(const DeckPlan& plan, Script& out) {
     out.line(fmt::format("dump            particles dynamic custom {} particles.dump id mol type x y z radius",
                          dump_every));
   }
-  if (plan.state) {
+  if (plan.state && !plan.state->before_run.empty()) {
     for (const std::string& command : plan.state->before_run) out.line(command);
+    out.line("thermo_modify   norm no lost error");  // a new thermo_style resets it
   }
   out.line("");
 }

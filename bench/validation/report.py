@@ -657,6 +657,7 @@ OEDOMETER_START, OEDOMETER_END = "<!-- section: oedometer -->\n", "<!-- end: oed
 # Controlled runs written up by hand beside the sections they test (their commands are in the text):
 FORCES_BACKED_START, FORCES_BACKED_END = "<!-- section: forces-backed -->\n", "<!-- end: forces-backed -->\n"
 SILO_SPHERES_START, SILO_SPHERES_END = "<!-- section: silo-spheres -->\n", "<!-- end: silo-spheres -->\n"
+SILO_LAMMPS_START, SILO_LAMMPS_END = "<!-- section: silo-lammps -->\n", "<!-- end: silo-lammps -->\n"  # silo_lammps.py
 OEDOMETER_STIFF_START, OEDOMETER_STIFF_END = "<!-- section: oedometer-stiff -->\n", "<!-- end: oedometer-stiff -->\n"
 # The bidisperse bed against LAMMPS: written by hand from its test (tests/sim/export_lammps_test.cpp).
 BIDISPERSE_START, BIDISPERSE_END = "<!-- section: bidisperse -->\n", "<!-- end: bidisperse -->\n"
@@ -716,6 +717,7 @@ def main():
              section(column, ["column.csv"], "Column collapse: runout against aspect ratio"),
              section(silo, ["silo.csv", "silo_fill.csv"], "Silo discharge against orifice diameter (Beverloo)"),
              kept(SILO_SPHERES_START, SILO_SPHERES_END, "tetrasand_validation_runs OUT silo-spheres"),
+             kept(SILO_LAMMPS_START, SILO_LAMMPS_END, "bench/validation/silo_lammps.py BIN OUT spheres"),
              section(forces, ["contact_forces.csv", "silo_fill.csv"],
                      "Normal contact forces in a sand pile at rest in a cylinder"),
              kept(FORCES_BACKED_START, FORCES_BACKED_END, "tetrasand_validation_runs OUT forces-backed")]

@@ -656,7 +656,9 @@ TEST(ExportLammps, StateDeckFliesRigidGrainsAndFreeSpheresOnWithTheirVelocitiesA
 // A bed of spheres (each grain of the reference bed made one sphere of its volume and mass) that
 // tetrasand has let fall for 0.25 s, handed to LAMMPS with a static body parked 1 km below left
 // out: LAMMPS continues it for 0.05 s to the mean height tetrasand continues it to, within 2 % of a
-// sphere's radius, so the state (overlaps, velocities) carries over without a jolt.
+// sphere's radius, so the state (overlaps, velocities) carries over without a jolt. A static body
+// appended after the grains (as a silo's rim is) stays a wall: no grain becomes a "dynamic prop"
+// with an atom type of its own.
 TEST(ExportLammps, StateDeckContinuesATetrasandSphereBedWhereTetrasandDoes) {
   const fs::path dir = test::temp_dir();
   const Scene scene = bed_scene(dir);
@@ -666,6 +668,9 @@ TEST(ExportLammps, StateDeckContinuesATetrasandSphereBedWhereTetrasandDoes) {
   parked.position = Eigen::Vector3d(0, 0, -1e3);
   parked.motion = MotionType::Static;
   add_body(world, parked, {Eigen::Vector3d::Zero()}, {1e-3}, 0);
+  BodyDesc post = parked;
+  post.position = Eigen::Vector3d(0.5, 0.5, 0.0);  // far from the box's grains, kept
+  add_body(world, post, {Eigen::Vector3d::Zero()}, {1e-3}, 0);
   StepSettings settings = scene.simulation.step;
   settings.dt = resolve_time_step(scene, world, nullptr);
   CpuStepper stepper(world, settings);
@@ -679,6 +684,8 @@ TEST(ExportLammps, StateDeckContinuesATetrasandSphereBedWhereTetrasandDoes) {
   run.duration = 0.05;
   run.dt = settings.dt;
   const LammpsDeck deck = export_lammps_state(scene, handed, run, dir / "deck");
+  EXPECT_NE(read_file(dir / "deck" / "data.tetrasand").find("\n1 atom types\n"), std::string::npos);
+  EXPECT_EQ(read_file(deck.input).find("dynamic prop"), std::string::npos) << read_file(deck.input);
   run_lammps(deck);
   if (HasFatalFailure()) return;
   const auto frames = dump_heights(dir / "deck" / "final.dump");
