@@ -59,17 +59,22 @@ def beverloo_k(D, W):
     return float(k), float(np.sqrt(grad @ cov @ grad))
 
 
+def tetrasand_series(shape):
+    """{D (m): (t s, discharged kg)} of tetrasand's published run, where its raw file was kept (spheres)."""
+    if shape != "spheres":
+        return {}
+    rows = list(csv.DictReader(open(os.path.join(HERE, "silo_spheres_2026-12-04", "silo.csv"))))
+    out = {}
+    for D in sorted({float(r["orifice_m"]) for r in rows}):
+        sel = [r for r in rows if float(r["orifice_m"]) == D]
+        out[D] = (np.array([float(r["time_s"]) for r in sel]), np.array([float(r["discharged"]) for r in sel]) * GRAIN_MASS)
+    return out
+
+
 def tetrasand_rates(shape):
     """{D (m): W (kg/s)} of tetrasand's published run on the same fill."""
     if shape == "spheres":
-        rows = list(csv.DictReader(open(os.path.join(HERE, "silo_spheres_2026-12-04", "silo.csv"))))
-        out = {}
-        for D in sorted({float(r["orifice_m"]) for r in rows}):
-            sel = [r for r in rows if float(r["orifice_m"]) == D]
-            t = [float(r["time_s"]) for r in sel]
-            n = [float(r["discharged"]) for r in sel]
-            out[D] = rate(t, np.array(n) * GRAIN_MASS)
-        return out
+        return {D: rate(t, m) for D, (t, m) in tetrasand_series(shape).items()}
     text = open(os.path.join(ROOT, "docs", "validation.md")).read()
     section = text[text.index("## Silo discharge against orifice diameter"):text.index("<!-- section: silo-spheres -->")]
     return {float(mm) * 1e-3: float(w) * 1e-3
@@ -94,6 +99,42 @@ def thermo(log):
             except ValueError:
                 pass
     return np.array(t), np.array(m)
+
+
+def plot(shape, out, lammps, reference, k, k_ref):
+    """OUT/silo_lammps_SHAPE.png: discharged mass against time, and W against D with both fits."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
+    ours = tetrasand_series(shape)
+    for i, D in enumerate(sorted(lammps)):
+        t, m = lammps[D]
+        colour = f"C{i}"
+        ax1.plot(t, m - m[0], "--", color=colour, label=f"LAMMPS, D = {D / D_EQ:.0f} d")
+        near = [x for x in ours if abs(x - D) < 1e-4]
+        if near:
+            tt, mm = ours[near[0]]
+            ax1.plot(tt, mm - mm[0], "-", color=colour, label=f"tetrasand, D = {D / D_EQ:.0f} d")
+    ax1.axvline(0.1, color="grey", ls=":")
+    ax1.set_xlabel("time after opening (s)")
+    ax1.set_ylabel("discharged mass (kg)")
+    ax1.legend(fontsize=7)
+    for label, rates, kk, style in (("LAMMPS", {D: rate(*lammps[D]) for D in lammps}, k, "s"),
+                                     ("tetrasand", reference, k_ref, "o")):
+        D = np.array(sorted(rates))
+        W = np.array([rates[x] for x in D])
+        a, b = np.polyfit(D, W ** 0.4, 1)
+        Dfit = np.linspace(D.min() * 0.9, D.max() * 1.1, 50)
+        line = ax2.plot(D * 1e3, W * 1e3, style, label=f"{label}, k = {kk:.2f}")[0]
+        ax2.plot(Dfit * 1e3, np.clip(a * Dfit + b, 0, None) ** 2.5 * 1e3, "-", color=line.get_color(), lw=0.8)
+    ax2.set_xlabel("orifice diameter D (mm)")
+    ax2.set_ylabel("discharge rate W (g/s)")
+    ax2.set_title(f"{shape}: the same settled fill, Beverloo fits at 5/2", fontsize=9)
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, f"silo_lammps_{shape}.png"), dpi=110)
+    plt.close(fig)
 
 
 def complete(log):
@@ -155,6 +196,8 @@ def main():
     lines += [f"- Rates: LAMMPS / tetrasand from {min(ratios):.3f} to {max(ratios):.3f} over {len(ratios)} orifices.",
               f"- k at exponent 5/2 (in d = {D_EQ * 1e3:.1f} mm): LAMMPS {k:.2f} (standard error {sk:.2f}, "
               f"{len(Ds)} orifices), tetrasand {k_ref:.2f} (standard error {sk_ref:.2f})."]
+    plot(args.shape, out, {D: (np.array([x[1] for x in series if x[0] == D]), np.array([x[2] for x in series if x[0] == D]))
+                           for D in measured}, reference, k, k_ref)
     summary = f"# The {args.shape} silo's discharges in LAMMPS\n\n" + "\n".join(table) + "\n\n" + "\n".join(lines) + "\n"
     with open(os.path.join(out, "silo_lammps_summary.md"), "w") as f:
         f.write(summary)
