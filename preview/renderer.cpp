@@ -190,6 +190,7 @@ struct Renderer::Impl {
   gpu::ShaderLibrary library;
   gpu::Queue queue;
   gpu::Program particles_program, raycast_program, shade_program;
+  std::vector<std::string> volume_defines;  // what raycast_program and shade_program were compiled with
   gpu::VertexArray vao;  // none of the passes reads vertex attributes, but GL draws need one bound
 
   // The SDF: the sparse field, its metadata, and the box of its surface.
@@ -284,7 +285,9 @@ void Renderer::Impl::upload_particles(const Eigen::Vector3d& new_origin) {
 }
 
 void Renderer::Impl::bind_volume(const gpu::Program& p) const {
-  field.bind(p, TS_PREVIEW_SPARSE_FIELD);
+  field.bind(p, {TS_PREVIEW_SPARSE_FIELD,
+                 {TS_PREVIEW_FIELD_CHUNK_1, TS_PREVIEW_FIELD_CHUNK_2, TS_PREVIEW_FIELD_CHUNK_3, TS_PREVIEW_FIELD_CHUNK_4,
+                  TS_PREVIEW_FIELD_CHUNK_5, TS_PREVIEW_FIELD_CHUNK_6, TS_PREVIEW_FIELD_CHUNK_7}});
   set_vec3(p, "volume_origin", Eigen::Vector3d(volume_spec.origin - origin));
   p.set("voxel_size", static_cast<float>(volume_spec.voxel_size));
   p.set("volume_dims", static_cast<float>(volume_spec.dims.x()), static_cast<float>(volume_spec.dims.y()),
@@ -465,14 +468,21 @@ void Renderer::Impl::colour_surface(const RenderSettings& s, const CameraState& 
 Renderer::Renderer(gpu::Context& context, bool timings) : impl_(std::make_unique<Impl>(context, timings)) {}
 Renderer::~Renderer() = default;
 
-void Renderer::set_volume(SdfVolume volume) {
+void Renderer::set_volume(SdfVolume volume, std::size_t field_block_bytes) {
   Impl& m = *impl_;
   const Eigen::Vector3i& d = volume.spec.dims;
   if (volume.empty() || d.minCoeff() < 2) {
     throw InputError("the SDF to preview is empty or smaller than 2 voxels along an axis");
   }
-  m.field = sdf::SparseField(std::move(volume.grid), volume.spec, volume.band);
+  m.field = sdf::SparseField(std::move(volume.grid), volume.spec, volume.band, field_block_bytes);
   m.check("preview SDF upload");
+  // The programs that read the field are compiled for its chunking (one storage block, or several).
+  if (m.field.shader_defines() != m.volume_defines) {
+    m.volume_defines = m.field.shader_defines();
+    m.raycast_program =
+        gpu::Program::graphics(m.library, "preview/raycast.vert", "", "preview/raycast.frag", m.volume_defines);
+    m.shade_program = gpu::Program::graphics(m.library, "preview/shade.vert", "", "preview/shade.frag", m.volume_defines);
+  }
   m.volume_spec = volume.spec;
   m.volume_band = volume.band;
   m.volume_box = volume.world_box();

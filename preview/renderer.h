@@ -9,6 +9,7 @@
 //      occlusion, a ground plane catching the shadows; read back as 8-bit RGBA.
 // Same input, same device, same pixels: no blending order, no atomics, no randomness.
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -78,9 +79,11 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Uploads the SDF's sparse NanoVDB grid as one storage buffer (sdf::SparseField): memory follows
-  // the band, not the box. GpuError naming the size when it exceeds the device's largest storage block.
-  void set_volume(SdfVolume volume);
+  // Uploads the SDF's sparse NanoVDB grid (sdf::SparseField): memory follows the band, not the box.
+  // One storage buffer, or up to 8 when the grid is larger than the device's largest storage block
+  // (`field_block_bytes` when not 0: tests cut a small grid into chunks); GpuError naming the size when
+  // even 8 cannot hold it.
+  void set_volume(SdfVolume volume, std::size_t field_block_bytes = 0);
   void set_particles(const Particles& particles);
 
   // The box of what is drawn: the SDF's surface (voxels at or inside the zero level) and the

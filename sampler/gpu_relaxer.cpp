@@ -15,8 +15,8 @@ GpuRelaxer::GpuRelaxer(gpu::Context& context, sdf::SparseField field, bool timin
       spec_(field.spec()),
       field_(std::move(field)),
       queue_(timings, context.debug()),
-      relax_(gpu::Program::compute(library_, "sampler/relax.comp")),
-      project_(gpu::Program::compute(library_, "sampler/project.comp")),
+      relax_(gpu::Program::compute(library_, "sampler/relax.comp", field_.shader_defines())),
+      project_(gpu::Program::compute(library_, "sampler/project.comp", field_.shader_defines())),
       reduce_(gpu::Program::compute(library_, "sampler/reduce_steps.comp")),
       grid_(library_) {
   if (field_.empty()) throw Error(ExitCode::Internal, "GpuRelaxer needs an uploaded sdf::SparseField");
@@ -26,7 +26,11 @@ std::size_t GpuRelaxer::gpu_bytes() const {
   return field_.gpu_bytes() + positions_[0].bytes() * 2 + step_info_.bytes() + partials_.bytes() + grid_.bytes();
 }
 
-void GpuRelaxer::bind_sdf(const gpu::Program& program) const { field_.bind(program, TS_SAMPLER_SPARSE_FIELD); }
+void GpuRelaxer::bind_sdf(const gpu::Program& program) const {
+  field_.bind(program, {TS_SAMPLER_SPARSE_FIELD,
+                        {TS_SAMPLER_FIELD_CHUNK_1, TS_SAMPLER_FIELD_CHUNK_2, TS_SAMPLER_FIELD_CHUNK_3, TS_SAMPLER_FIELD_CHUNK_4,
+                         TS_SAMPLER_FIELD_CHUNK_5, TS_SAMPLER_FIELD_CHUNK_6, TS_SAMPLER_FIELD_CHUNK_7}});
+}
 
 void GpuRelaxer::project(std::uint32_t count, int steps) {
   positions_[0].bind(TS_SAMPLER_POSITIONS);

@@ -64,7 +64,7 @@ int largest_fitting_resolution(const GridSpec& spec, std::size_t bytes, std::siz
 SparseField::SparseField(const openvdb::FloatGrid& level_set, const GridSpec& spec, double band_voxels)
     : SparseField(to_gpu_nanovdb(level_set, spec), spec, band_voxels) {}
 
-SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels)
+SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels, std::size_t block_bytes)
     : spec_(spec),
       band_(band_voxels),
       background_(static_cast<float>(band_voxels * spec.voxel_size)),
@@ -79,29 +79,58 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
               "\"The GPU field\"); on an NVIDIA GPU prefer a coarser voxel or the CPU path (--backend cpu)",
               spec.dims.maxCoeff());
   }
-  GLint64 max_block = 0;
-  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+  if (block_bytes == 0) {
+    GLint64 max_block = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+    block_bytes = static_cast<std::size_t>(std::max<GLint64>(max_block, 0));
+  }
   const std::size_t bytes = host_.size();
-  // PNanoVDB addresses the buffer with 32-bit byte offsets, and one storage block is all a kernel reads.
-  const std::size_t limit = std::min<std::size_t>(static_cast<std::size_t>(max_block), std::size_t{1} << 32);
-  if (bytes > limit) {
-    throw GpuError(fmt::format("the sparse SDF ({} band voxels, {:.1f} MiB) exceeds this GPU's largest storage "
-                               "block ({:.1f} MiB); the largest grid that fits has about {} voxels along its longest "
-                               "side (use a larger voxel)",
-                               band_voxels_, bytes / 1048576.0, limit / 1048576.0,
-                               largest_fitting_resolution(spec, bytes, limit)));
+  // PNanoVDB addresses the grid with 32-bit byte offsets, whatever the blocks.
+  const std::size_t address_limit = std::size_t{1} << 32;
+  // One block when the grid fits; else chunks of a power of two words (the GLSL splits an address
+  // with a shift and a mask), the largest that fits a block.
+  std::size_t chunk_bytes = bytes;
+  if (bytes > block_bytes) {
+    chunk_bytes = 4;
+    while (chunk_bytes * 2 <= block_bytes) chunk_bytes *= 2;
+  }
+  const std::size_t limit = std::min(address_limit, chunk_bytes * kMaxFieldChunks);
+  if (bytes > limit || block_bytes < 4) {
+    throw GpuError(fmt::format("the sparse SDF ({} band voxels, {:.1f} MiB) exceeds what this GPU's storage blocks "
+                               "hold ({} of {:.1f} MiB, {:.1f} MiB in all); the largest grid that fits has about {} "
+                               "voxels along its longest side (use a larger voxel)",
+                               band_voxels_, bytes / 1048576.0, kMaxFieldChunks, chunk_bytes / 1048576.0,
+                               limit / 1048576.0, largest_fitting_resolution(spec, bytes, limit)));
+  }
+  if (chunk_bytes < bytes) {
+    while ((std::size_t{4} << chunk_shift_) < chunk_bytes) ++chunk_shift_;
   }
   try {
-    buffer_ = gpu::Buffer(bytes, host_.data());
+    const auto* data = static_cast<const std::uint8_t*>(host_.data());
+    for (std::size_t offset = 0; offset < bytes; offset += chunk_bytes) {
+      chunks_.emplace_back(std::min(chunk_bytes, bytes - offset), data + offset);
+    }
   } catch (const GpuError& e) {
+    chunks_.clear();
     throw GpuError(fmt::format("{} for the sparse SDF ({} band voxels); the largest grid that might fit has about {} "
                                "voxels along its longest side",
                                e.what(), band_voxels_, largest_fitting_resolution(spec, bytes, bytes / 2)));
   }
 }
 
-void SparseField::bind(const gpu::Program& program, GLuint binding) const {
-  buffer_.bind(binding);
+std::size_t SparseField::gpu_bytes() const {
+  std::size_t bytes = 0;
+  for (const auto& chunk : chunks_) bytes += chunk.bytes();
+  return bytes;
+}
+
+std::vector<std::string> SparseField::shader_defines() const {
+  if (chunks_.size() <= 1) return {};
+  return {fmt::format("TS_FIELD_CHUNKS {}", chunks_.size()), fmt::format("TS_FIELD_CHUNK_SHIFT {}", chunk_shift_)};
+}
+
+void SparseField::bind(const gpu::Program& program, const FieldSlots& slots) const {
+  for (std::size_t c = 0; c < chunks_.size(); ++c) chunks_[c].bind(c == 0 ? slots.first : slots.more[c - 1]);
   const Eigen::Vector3i offset = gpu_index_offset();
   program.set("field_index_offset", offset.x(), offset.y(), offset.z());
   program.set("field_voxel_size", static_cast<float>(spec_.voxel_size));

@@ -1,7 +1,7 @@
 #pragma once
 // The narrow-band SDF where the GPU reads it: a NanoVDB float level set (signed distance in world
-// units in the band, +-band off it with the sign of the flood fill) in one shader storage buffer,
-// read in GLSL through NanoVDB's PNanoVDB.h (shaders/common/sparse_field.glsl: trilinear values and
+// units in the band, +-band off it with the sign of the flood fill) in one shader storage buffer, or
+// in up to kMaxFieldChunks of them when it is larger than the GPU's largest storage block, read in GLSL through NanoVDB's PNanoVDB.h (shaders/common/sparse_field.glsl: trilinear values and
 // central-difference gradients). GPU memory follows the band (its leaves), not the bounding box:
 // doubling the resolution multiplies it by about 4, not 8. Used by the sampler and the preview.
 #include <openvdb/openvdb.h>
@@ -9,6 +9,7 @@
 #include <nanovdb/util/GridHandle.h>
 #include <nanovdb/util/HostBuffer.h>
 
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <map>
@@ -40,6 +41,16 @@ Eigen::Vector3i gpu_index_shift(const GridSpec& spec);
 // The level set as the GPU reads it: to_nanovdb of the level set moved by gpu_index_shift(spec).
 NanoGrid to_gpu_nanovdb(const openvdb::FloatGrid& level_set, const GridSpec& spec);
 
+// At most this many storage blocks hold one field (shaders/common/sparse_field.glsl): 1 GiB on
+// llvmpipe's 128 MiB blocks. A kernel reads the field through chunk 0's slot and 7 more its stage names.
+inline constexpr int kMaxFieldChunks = 8;
+
+// Where a stage binds the field: chunk 0's slot and the slots of chunks 1-7 (shaders/<stage>/bindings.h).
+struct FieldSlots {
+  GLuint first = 0;
+  std::array<GLuint, kMaxFieldChunks - 1> more{};
+};
+
 class SparseField {
  public:
   SparseField() = default;
@@ -49,21 +60,29 @@ class SparseField {
   // hold it, naming the size and the largest resolution that would fit.
   SparseField(const openvdb::FloatGrid& level_set, const GridSpec& spec, double band_voxels);
   // The same from a grid already converted by to_gpu_nanovdb(level_set, spec) and checked by the caller.
-  SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels);
+  // `block_bytes`: the largest storage block to use, 0 for the GPU's own (GL_MAX_SHADER_STORAGE_BLOCK_SIZE);
+  // tests pass a small one to cut a small grid into chunks.
+  SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels, std::size_t block_bytes = 0);
 
   const GridSpec& spec() const { return spec_; }
   double band() const { return band_; }                 // half-width [voxels]
   float background() const { return background_; }      // +-this off the band [world units]
-  const gpu::Buffer& buffer() const { return buffer_; }  // the NanoVDB grid, as is
-  bool empty() const { return buffer_.id() == 0; }
-  std::size_t gpu_bytes() const { return buffer_.bytes(); }
+  bool empty() const { return chunks_.empty(); }
+  std::size_t gpu_bytes() const;
+  // Storage blocks holding the grid (1 when it fits one), each 2^chunk_shift() words but the last.
+  int chunk_count() const { return static_cast<int>(chunks_.size()); }
+  int chunk_shift() const { return chunk_shift_; }
+  // What a program that reads this field is compiled with (gpu::Program's defines): nothing for one
+  // block, else the chunk count and size that shaders/common/sparse_field.glsl branches on. A program
+  // compiled for one field reads another only if their defines are equal.
+  std::vector<std::string> shader_defines() const;
   std::size_t band_voxels() const { return band_voxels_; }  // active voxels of the level set
   const NanoGrid& host() const { return host_; }         // the uploaded bytes (tests), in the GPU's index space
   // NanoVDB index of spec's voxel (0, 0, 0) in the uploaded grid: spec.index_offset + gpu_index_shift(spec).
   Eigen::Vector3i gpu_index_offset() const { return spec_.index_offset + gpu_index_shift(spec_); }
 
-  // Binds the grid to `binding` and sets the uniforms shaders/common/sparse_field.glsl reads.
-  void bind(const gpu::Program& program, GLuint binding) const;
+  // Binds the grid's chunks to `slots` and sets the uniforms shaders/common/sparse_field.glsl reads.
+  void bind(const gpu::Program& program, const FieldSlots& slots) const;
 
  private:
   GridSpec spec_;
@@ -71,7 +90,8 @@ class SparseField {
   float background_ = 0.0f;
   std::size_t band_voxels_ = 0;
   NanoGrid host_;
-  gpu::Buffer buffer_;
+  int chunk_shift_ = 0;  // log2 of a chunk's words; 0 for one block
+  std::vector<gpu::Buffer> chunks_;
 };
 
 // Writes `grid` as a NanoVDB file (uncompressed, readable by nanovdb_print / nanovdb_validate),

@@ -7,6 +7,76 @@
 #ifndef TETRASAND_COMMON_SPARSE_FIELD_GLSL
 #define TETRASAND_COMMON_SPARSE_FIELD_GLSL
 
+// A grid larger than one storage block (llvmpipe's is 128 MiB) is uploaded in chunks of 2^TS_FIELD_CHUNK_SHIFT
+// words, TS_FIELD_CHUNKS of them (sdf::SparseField::shader_defines; at most 8): chunk 0 is the block the
+// kernel declares, chunk c > 0 is bound at TS_FIELD_CHUNK_<c>, a slot the kernel's stage header names.
+// PNanoVDB then reads through the branch below (PNANOVDB_BUF_CUSTOM) instead of one array. Only the
+// programs of a chunked grid are compiled with it: every PNanoVDB read inlines the branch, and a
+// single-block grid keeps the plain read it had.
+#if defined(TS_FIELD_CHUNKS) && TS_FIELD_CHUNKS > 1
+#if TS_FIELD_CHUNKS > 8
+#error "sdf::SparseField uploads at most 8 chunks"
+#endif
+layout(std430, binding = TS_FIELD_CHUNK_1) readonly buffer SparseFieldChunk1 { uint field_chunk1[]; };
+#if TS_FIELD_CHUNKS > 2
+layout(std430, binding = TS_FIELD_CHUNK_2) readonly buffer SparseFieldChunk2 { uint field_chunk2[]; };
+#endif
+#if TS_FIELD_CHUNKS > 3
+layout(std430, binding = TS_FIELD_CHUNK_3) readonly buffer SparseFieldChunk3 { uint field_chunk3[]; };
+#endif
+#if TS_FIELD_CHUNKS > 4
+layout(std430, binding = TS_FIELD_CHUNK_4) readonly buffer SparseFieldChunk4 { uint field_chunk4[]; };
+#endif
+#if TS_FIELD_CHUNKS > 5
+layout(std430, binding = TS_FIELD_CHUNK_5) readonly buffer SparseFieldChunk5 { uint field_chunk5[]; };
+#endif
+#if TS_FIELD_CHUNKS > 6
+layout(std430, binding = TS_FIELD_CHUNK_6) readonly buffer SparseFieldChunk6 { uint field_chunk6[]; };
+#endif
+#if TS_FIELD_CHUNKS > 7
+layout(std430, binding = TS_FIELD_CHUNK_7) readonly buffer SparseFieldChunk7 { uint field_chunk7[]; };
+#endif
+
+#define PNANOVDB_BUF_CUSTOM
+struct pnanovdb_buf_t {
+  uint unused;
+};
+uint pnanovdb_buf_read_uint32(pnanovdb_buf_t buf, uint byte_offset) {
+  uint word = byte_offset >> 2u;
+  uint chunk = word >> TS_FIELD_CHUNK_SHIFT;
+  uint index = word & ((1u << TS_FIELD_CHUNK_SHIFT) - 1u);
+  // A binary search over the chunks: three compares at most, where a chain would take seven.
+  if (chunk < 4u) {
+    if (chunk < 2u) return chunk == 0u ? pnanovdb_buf_data[index] : field_chunk1[index];
+#if TS_FIELD_CHUNKS > 3
+    return chunk == 2u ? field_chunk2[index] : field_chunk3[index];
+#elif TS_FIELD_CHUNKS > 2
+    return field_chunk2[index];
+#endif
+  }
+#if TS_FIELD_CHUNKS > 4
+  if (chunk < 6u) {
+#if TS_FIELD_CHUNKS > 5
+    return chunk == 4u ? field_chunk4[index] : field_chunk5[index];
+#else
+    return field_chunk4[index];
+#endif
+  }
+#if TS_FIELD_CHUNKS > 7
+  return chunk == 6u ? field_chunk6[index] : field_chunk7[index];
+#elif TS_FIELD_CHUNKS > 6
+  return field_chunk6[index];
+#endif
+#endif
+  return 0u;  // past the grid: PNanoVDB never asks
+}
+uvec2 pnanovdb_buf_read_uint64(pnanovdb_buf_t buf, uint byte_offset) {
+  return uvec2(pnanovdb_buf_read_uint32(buf, byte_offset), pnanovdb_buf_read_uint32(buf, byte_offset + 4u));
+}
+#define pnanovdb_grid_type_t uint
+#define PNANOVDB_GRID_TYPE_GET(grid_typeIn, nameIn) pnanovdb_grid_type_constants[grid_typeIn].nameIn
+#endif
+
 #define PNANOVDB_GLSL
 #include "nanovdb/PNanoVDB.h"
 

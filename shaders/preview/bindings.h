@@ -19,6 +19,14 @@
 #define TS_PREVIEW_SPHERES 27  // vec4[]: xyz centre relative to the scene centre [m], w radius [m]
 #define TS_PREVIEW_COLORS 28   // uint[]: sRGB colour per sphere, RGBA8 with red in the low byte
 #define TS_PREVIEW_SPARSE_FIELD 29  // uint[]: the NanoVDB level set (sdf::SparseField), as PNanoVDB.h reads it
+// Chunks 1-7 of a field larger than one storage block (sdf::SparseField, common/sparse_field.glsl).
+#define TS_PREVIEW_FIELD_CHUNK_1 30
+#define TS_PREVIEW_FIELD_CHUNK_2 31
+#define TS_PREVIEW_FIELD_CHUNK_3 32
+#define TS_PREVIEW_FIELD_CHUNK_4 33
+#define TS_PREVIEW_FIELD_CHUNK_5 34
+#define TS_PREVIEW_FIELD_CHUNK_6 35
+#define TS_PREVIEW_FIELD_CHUNK_7 36
 
 #define TS_PREVIEW_UNIT_PARTICLE_DEPTH 1  // sampler2D: window depth of the particle layer
 #define TS_PREVIEW_UNIT_ALBEDO 2          // sampler2D: G-buffer albedo (sRGB)

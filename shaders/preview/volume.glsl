@@ -7,6 +7,14 @@
 #include "preview/bindings.h"
 
 layout(std430, binding = TS_PREVIEW_SPARSE_FIELD) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
+// Chunks 1-7 of a field larger than one storage block, at this stage's slots.
+#define TS_FIELD_CHUNK_1 TS_PREVIEW_FIELD_CHUNK_1
+#define TS_FIELD_CHUNK_2 TS_PREVIEW_FIELD_CHUNK_2
+#define TS_FIELD_CHUNK_3 TS_PREVIEW_FIELD_CHUNK_3
+#define TS_FIELD_CHUNK_4 TS_PREVIEW_FIELD_CHUNK_4
+#define TS_FIELD_CHUNK_5 TS_PREVIEW_FIELD_CHUNK_5
+#define TS_FIELD_CHUNK_6 TS_PREVIEW_FIELD_CHUNK_6
+#define TS_FIELD_CHUNK_7 TS_PREVIEW_FIELD_CHUNK_7
 #include "common/sparse_field.glsl"
 
 uniform vec3 volume_origin;  // voxel (0,0,0)'s centre, relative to the scene centre [m]

@@ -39,5 +39,13 @@
 #define TS_CERT_HOLES 11                   // CertLeaf per sub-triangle left uncovered at this level
 
 #define TS_SAMPLER_SPARSE_FIELD 8  // uint[]: the NanoVDB level set (sdf::SparseField), as PNanoVDB.h reads it
+// Chunks 1-7 of a field larger than one storage block (sdf::SparseField, common/sparse_field.glsl).
+#define TS_SAMPLER_FIELD_CHUNK_1 9
+#define TS_SAMPLER_FIELD_CHUNK_2 10
+#define TS_SAMPLER_FIELD_CHUNK_3 11
+#define TS_SAMPLER_FIELD_CHUNK_4 12
+#define TS_SAMPLER_FIELD_CHUNK_5 13
+#define TS_SAMPLER_FIELD_CHUNK_6 14
+#define TS_SAMPLER_FIELD_CHUNK_7 15
 
 #endif

@@ -6,6 +6,14 @@
 #define TETRASAND_SAMPLER_SDF_SAMPLE_GLSL
 
 layout(std430, binding = TS_SAMPLER_SPARSE_FIELD) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
+// Chunks 1-7 of a field larger than one storage block, at this stage's slots.
+#define TS_FIELD_CHUNK_1 TS_SAMPLER_FIELD_CHUNK_1
+#define TS_FIELD_CHUNK_2 TS_SAMPLER_FIELD_CHUNK_2
+#define TS_FIELD_CHUNK_3 TS_SAMPLER_FIELD_CHUNK_3
+#define TS_FIELD_CHUNK_4 TS_SAMPLER_FIELD_CHUNK_4
+#define TS_FIELD_CHUNK_5 TS_SAMPLER_FIELD_CHUNK_5
+#define TS_FIELD_CHUNK_6 TS_SAMPLER_FIELD_CHUNK_6
+#define TS_FIELD_CHUNK_7 TS_SAMPLER_FIELD_CHUNK_7
 #include "common/sparse_field.glsl"
 
 // xyz: unit gradient (zero where undefined, as off the band), w: signed distance [m].

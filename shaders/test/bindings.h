@@ -22,5 +22,13 @@
 #define TS_TEST_FIELD_GRID 0    // uint[]: an sdf::SparseField's NanoVDB grid
 #define TS_TEST_FIELD_POINTS 1  // vec4: xyz grid-local position [voxels]
 #define TS_TEST_FIELD_VALUES 2  // vec4: what the probe read there (see the kernel)
+// Chunks 1-7 of a field cut into several storage blocks (sdf::SparseField).
+#define TS_TEST_FIELD_CHUNK_1 3
+#define TS_TEST_FIELD_CHUNK_2 4
+#define TS_TEST_FIELD_CHUNK_3 5
+#define TS_TEST_FIELD_CHUNK_4 6
+#define TS_TEST_FIELD_CHUNK_5 7
+#define TS_TEST_FIELD_CHUNK_6 8
+#define TS_TEST_FIELD_CHUNK_7 9
 
 #endif

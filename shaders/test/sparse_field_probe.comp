@@ -12,11 +12,26 @@
 #include "test/bindings.h"
 layout(local_size_x = 64) in;
 layout(std430, binding = TS_TEST_FIELD_GRID) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
+// Chunks 1-7 of a field larger than one storage block, at this stage's slots.
+#define TS_FIELD_CHUNK_1 TS_TEST_FIELD_CHUNK_1
+#define TS_FIELD_CHUNK_2 TS_TEST_FIELD_CHUNK_2
+#define TS_FIELD_CHUNK_3 TS_TEST_FIELD_CHUNK_3
+#define TS_FIELD_CHUNK_4 TS_TEST_FIELD_CHUNK_4
+#define TS_FIELD_CHUNK_5 TS_TEST_FIELD_CHUNK_5
+#define TS_FIELD_CHUNK_6 TS_TEST_FIELD_CHUNK_6
+#define TS_FIELD_CHUNK_7 TS_TEST_FIELD_CHUNK_7
 #include "common/sparse_field.glsl"
 layout(std430, binding = TS_TEST_FIELD_POINTS) readonly buffer Points { vec4 points[]; };
 layout(std430, binding = TS_TEST_FIELD_VALUES) writeonly buffer Values { vec4 values[]; };
 uniform uint count;
+// TS_PROBE_MODE, when defined, fixes the mode at compile time, so a program holds one mode's reads:
+// with a chunked field each PNanoVDB read inlines the chunk branch, and llvmpipe's compile time
+// follows the count (all modes at once: minutes).
+#ifdef TS_PROBE_MODE
+const int mode = TS_PROBE_MODE;
+#else
 uniform int mode;
+#endif
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= count) return;
