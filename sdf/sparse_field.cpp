@@ -135,6 +135,7 @@ void SparseField::bind(const gpu::Program& program, const FieldSlots& slots) con
   program.set("field_index_offset", offset.x(), offset.y(), offset.z());
   program.set("field_voxel_size", static_cast<float>(spec_.voxel_size));
   program.set("field_background", background_);
+  if (chunks_.size() > 1) program.set("field_corner_count", 8);
 }
 
 void write_nvdb(const std::filesystem::path& file, const NanoGrid& grid, const std::vector<std::filesystem::path>& inputs) {
