@@ -2,7 +2,8 @@
 // many particle impostors, and of both (the hybrid), each with the shadow map, on whatever device
 // the context picks. The SDF is OpenVDB's meshToLevelSet of the mesh (CPU, so the figure is the
 // renderer's, not the scan conversion's), as a sparse NanoVDB grid, as `tetrasand preview SDF.vdb` reads it. Usage:
-//   tetrasand_bench_preview [MESH] [--size 1024] [--resolution 512] [--particles 1000000] [--repeat 3]
+//   tetrasand_bench_preview [MESH] [--size 1024] [--resolution 512] [--particles 1000000] [--repeat 3] [--png PREFIX]
+// --png writes the last SDF, hybrid and impostor images as PREFIX-{sdf,hybrid,impostors}.png, to look at.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 
 #include "core/mesh_io.h"
 #include "gpu/context.h"
+#include "preview/image.h"
 #include "preview/renderer.h"
 #include "preview/volume.h"
 #include "sampler/surface_points.h"
@@ -25,13 +27,16 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 
 struct Timing {
   double first = 0.0, median = 0.0;  // s: the first render (allocations, shader warm-up) and the median of the rest
+  ts::preview::Image last;
 };
 
 Timing time_renders(ts::preview::Renderer& renderer, const ts::preview::RenderSettings& settings, int repeat) {
   Timing t;
   std::vector<double> times;
   for (int k = 0; k <= repeat; ++k) {
-    const double s = renderer.render(settings).seconds;  // render() reads the image back: the work is finished
+    ts::preview::RenderResult result = renderer.render(settings);
+    const double s = result.seconds;  // render() reads the image back: the work is finished
+    t.last = std::move(result.image);
     if (k == 0) {
       t.first = s;
     } else {
@@ -46,6 +51,7 @@ Timing time_renders(ts::preview::Renderer& renderer, const ts::preview::RenderSe
 int run(int argc, char** argv) {
   std::string mesh_path = TETRASAND_SOURCE_DIR "/assets/bunny.obj";
   int size = 1024, resolution = 512, repeat = 3;
+  std::string png_prefix;
   std::size_t particle_count = 1'000'000;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -58,10 +64,12 @@ int run(int argc, char** argv) {
       particle_count = std::stoull(next());
     } else if (a == "--repeat") {
       repeat = std::stoi(next());
+    } else if (a == "--png") {
+      png_prefix = next();
     } else if (!a.empty() && a[0] != '-') {
       mesh_path = a;
     } else {
-      fmt::print(stderr, "usage: tetrasand_bench_preview [MESH] [--size N] [--resolution N] [--particles N] [--repeat N]\n");
+      fmt::print(stderr, "usage: tetrasand_bench_preview [MESH] [--size N] [--resolution N] [--particles N] [--repeat N] [--png PREFIX]\n");
       return 2;
     }
   }
@@ -101,11 +109,16 @@ int run(int argc, char** argv) {
   particles_only.set_particles(particles);
   const Timing impostors = time_renders(particles_only, s, repeat);
 
+  if (!png_prefix.empty()) {
+    ts::preview::write_png(png_prefix + "-sdf.png", sdf_only.last);
+    ts::preview::write_png(png_prefix + "-hybrid.png", hybrid.last);
+    ts::preview::write_png(png_prefix + "-impostors.png", impostors.last);
+  }
   fmt::print("renderer: {}\n", context.summary());
   fmt::print("mesh {}: SDF {} x {} x {} voxels (sparse NanoVDB: {} band voxels, {:.1f} MiB on the GPU, against "
-             "{:.1f} MiB for a dense R32F texture; built by OpenVDB in {:.2f} s, uploaded in {:.2f} s), "
+             "{:.1f} MiB for a dense R32F texture; {} storage block(s); built by OpenVDB in {:.2f} s, uploaded in {:.2f} s), "
              "{} particles of radius {:.3g} m, images {} x {}, shadow map {} texels\n\n",
-             mesh_path, d.x(), d.y(), d.z(), band_voxels, sparse_mib, dense_mib, build, upload, particle_count,
+             mesh_path, d.x(), d.y(), d.z(), band_voxels, sparse_mib, dense_mib, renderer.field_chunks(), build, upload, particle_count,
              particles.radii[0], size, size, std::clamp(size, 512, 4096));
   fmt::print("| image {0} x {0} | first render [s] | median of {1} [s] |\n|---|---:|---:|\n", size, repeat);
   fmt::print("| SDF {}^3-class ray cast | {:.3f} | {:.3f} |\n", resolution, sdf_only.first, sdf_only.median);

@@ -97,7 +97,9 @@ def run_sample(exe, mesh_path, count, out, extra=(), timeout=None):
 
 
 def run_tetrasand(exe, mesh_path, count, out, extra=()):
-    body, seconds, _ = run_sample(exe, mesh_path, count, out, extra)
+    body, seconds, tail = run_sample(exe, mesh_path, count, out, extra)
+    if tail:  # e.g. --timings' stage table, when --tetrasand-args asked for it
+        print(tail, flush=True)
     stem = os.path.splitext(os.path.basename(mesh_path))[0]
     return body, read_ply_points(os.path.join(out, stem + ".particles.ply")), seconds
 
@@ -134,6 +136,8 @@ def main():
                     help="--max-iterations of the relaxation (needs a tetrasand that has the option)")
     ap.add_argument("--no-compare", action="store_true", help="only the trade")
     ap.add_argument("--no-trade", action="store_true", help="only the comparison with Open3D")
+    ap.add_argument("--tetrasand-args", default="",
+                    help="more options for the compared `tetrasand sample` runs, e.g. \"--timings\" (printed after each run)")
     ap.add_argument("--csv", help="also write every row to this CSV")
     ap.add_argument("--markdown", help="rewrite the sampler section of this markdown file (docs/benchmarks.md)")
     ap.add_argument("--command", default="", help="the command line to quote in the markdown section")
@@ -166,7 +170,8 @@ def main():
         path = resolve_mesh(name, tmp)
         mesh = o3d.io.read_triangle_mesh(path)
         probes = np.asarray(mesh.sample_points_uniformly(args.probes).points)
-        body, ours, t_ours = run_tetrasand(args.tetrasand, path, count, os.path.join(tmp, "out"))
+        body, ours, t_ours = run_tetrasand(args.tetrasand, path, count, os.path.join(tmp, "out"),
+                                           args.tetrasand_args.split())
         r = body["particle_radius"]
         t = time.perf_counter()
         theirs = np.asarray(mesh.sample_points_poisson_disk(body["particle_count"], init_factor=5).points)

@@ -490,6 +490,8 @@ void Renderer::set_volume(SdfVolume volume, std::size_t field_block_bytes) {
   m.surface_box = volume.surface;
 }
 
+int Renderer::field_chunks() const { return impl_->has_volume ? impl_->field.chunk_count() : 0; }
+
 void Renderer::set_particles(const Particles& particles) {
   Impl& m = *impl_;
   const std::size_t n = particles.centers.size();

@@ -85,6 +85,8 @@ class Renderer {
   // even 8 cannot hold it.
   void set_volume(SdfVolume volume, std::size_t field_block_bytes = 0);
   void set_particles(const Particles& particles);
+  // The storage blocks the SDF occupies on the GPU: 1, up to 8 when chunked, 0 before set_volume.
+  int field_chunks() const;
 
   // The box of what is drawn: the SDF's surface (voxels at or inside the zero level) and the
   // particle spheres. Invalid when nothing is loaded.

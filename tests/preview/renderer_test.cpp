@@ -210,6 +210,39 @@ TEST(PreviewRenderer, PixelsRepeatExactly) {
   EXPECT_EQ(a.rgba, again.render(s).image.rgba);
 }
 
+// A field larger than one storage block (a 2048-class level set on llvmpipe's 128 MiB) is uploaded in
+// chunks, and the ray cast and shading programs are recompiled to read through them: the image must be
+// the one a single block gives, pixel for pixel, shadows and particles included.
+TEST(PreviewRenderer, AFieldCutIntoChunksRendersTheSameImageAsOneBlock) {
+  Particles p;
+  p.centers = fibonacci_sphere(40, 0.035);
+  p.radii = {0.003f};
+  RenderSettings s;
+  s.width = 72;
+  s.height = 64;
+  s.up = Eigen::Vector3d::UnitZ();
+  s.keep_buffers = true;
+
+  Renderer whole(context());
+  whole.set_volume(mesh_volume("torus.obj", 40));
+  whole.set_particles(p);
+  s.camera = frame_box(whole.content_box(), view_direction(View::Iso, s.up), s.up, 1.2, false, 30.0);
+  const RenderResult a = whole.render(s);
+
+  SdfVolume volume = mesh_volume("torus.obj", 40);
+  const std::size_t bytes = volume.grid.size();
+  Renderer chunked(context());
+  chunked.set_volume(std::move(volume), bytes / 3);
+  chunked.set_particles(p);
+  const RenderResult b = chunked.render(s);
+
+  EXPECT_EQ(whole.field_chunks(), 1);
+  EXPECT_GE(chunked.field_chunks(), 3);
+  EXPECT_GT(count(a, Layer::Surface), 500u);  // the torus fills part of the frame
+  EXPECT_EQ(a.layers, b.layers);
+  EXPECT_EQ(a.image.rgba, b.image.rgba);
+}
+
 TEST(PreviewRenderer, ShadowsDarkenTheGroundUnderTheLight) {
   Renderer renderer(context());
   Particles ball;
