@@ -26,9 +26,11 @@ Runner add_devices_command(CLI::App& app, const GlobalOptions& global) {
     gpu::Context context(options);
     fmt::print("chosen: device {}: {}\n", context.device_index(), context.summary());
     const auto& l = context.limits();
-    fmt::print("limits: 3D texture {}, geometry output {} vertices / {} components, SSBO {} MiB\n",
-               l.max_3d_texture_size, l.max_geometry_output_vertices, l.max_geometry_total_output_components,
-               l.max_ssbo_bytes / 1048576);
+    fmt::print("limits: 2D texture {} (arrays of {} layers), 3D texture {}, framebuffer {} x {} x {} layers, geometry output "
+               "{} vertices / {} components, SSBO {} MiB\n",
+               l.max_texture_size, l.max_texture_layers, l.max_3d_texture_size, l.max_framebuffer_size[0],
+               l.max_framebuffer_size[1], l.max_framebuffer_layers, l.max_geometry_output_vertices,
+               l.max_geometry_total_output_components, l.max_ssbo_bytes / 1048576);
     return 0;
   };
 }

@@ -170,6 +170,7 @@ DeviceLimits read_limits() {
   glGetIntegerv(GL_MAX_VIEWPORT_DIMS, l.max_viewport_dims);
   glGetIntegerv(GL_MAX_FRAMEBUFFER_WIDTH, &l.max_framebuffer_size[0]);
   glGetIntegerv(GL_MAX_FRAMEBUFFER_HEIGHT, &l.max_framebuffer_size[1]);
+  glGetIntegerv(GL_MAX_FRAMEBUFFER_LAYERS, &l.max_framebuffer_layers);
   glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &l.max_vertex_shader_storage_blocks);
   GLint64 ssbo = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &ssbo);

@@ -28,7 +28,8 @@ struct ContextOptions {
 
 struct DeviceLimits {
   int max_3d_texture_size = 0;
-  int max_texture_layers = 0;
+  int max_texture_layers = 0;                // layers of a 2D array texture
+  int max_framebuffer_layers = 0;            // layers of a layered render target
   int max_geometry_output_vertices = 0;
   int max_geometry_total_output_components = 0;
   int max_compute_work_group_count[3] = {0, 0, 0};

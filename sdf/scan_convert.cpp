@@ -241,7 +241,7 @@ void fill_dense_off_band(DenseSdf& dense, const std::vector<std::uint8_t>& state
 
 // `max_items`: the most voxels one compute dispatch of the band compaction (and its scan) covers,
 // 256 per work group times the device's work-group count limit along x.
-int choose_slab_layers(const GridSpec& spec, std::size_t budget, std::size_t max_items) {
+int choose_slab_layers(const GridSpec& spec, std::size_t budget, std::size_t max_items, int max_layers) {
   const std::size_t per_layer = bytes_per_layer(spec);
   const std::size_t layer_voxels = static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y());
   if (layer_voxels > max_items) {
@@ -249,7 +249,8 @@ int choose_slab_layers(const GridSpec& spec, std::size_t budget, std::size_t max
                                "of this GPU covers; use a larger voxel size",
                                spec.dims.x(), spec.dims.y(), max_items));
   }
-  const int fit = static_cast<int>(std::min<std::size_t>({budget / per_layer, max_items / layer_voxels, 1u << 20}));
+  const int fit = static_cast<int>(std::min<std::size_t>(
+      {budget / per_layer, max_items / layer_voxels, static_cast<std::size_t>(std::max(max_layers, 1))}));
   if (fit < 1) {
     throw GpuError("one z-layer of the SDF grid (" + std::to_string(spec.dims.x()) + " x " +
                    std::to_string(spec.dims.y()) + " voxels, " + std::to_string(per_layer >> 20) +
@@ -269,8 +270,8 @@ struct ScanPlan {
   DrawLists lists;
 };
 
-ScanPlan plan_scan(std::size_t max_items, const TriangleMesh& mesh, const Pseudonormals& normals, const GridSpec& spec,
-                   const ScanConvertOptions& options) {
+ScanPlan plan_scan(std::size_t max_items, int max_layers, const TriangleMesh& mesh, const Pseudonormals& normals,
+                   const GridSpec& spec, const ScanConvertOptions& options) {
   ScanPlan plan;
   // Every voxel with |d| < band lies inside the triangle's prism grown by the band; a quarter voxel
   // more keeps rounding of the cross-sections (~1e-6 voxel) from losing one, and costs far fewer
@@ -278,7 +279,7 @@ ScanPlan plan_scan(std::size_t max_items, const TriangleMesh& mesh, const Pseudo
   // lies beyond depth_range.
   plan.margin = options.band + 0.25;
   plan.geometry = build_geometry(mesh, normals, spec, plan.margin);
-  plan.slab_layers = choose_slab_layers(spec, options.max_slab_bytes, max_items);
+  plan.slab_layers = choose_slab_layers(spec, options.max_slab_bytes, max_items, max_layers);
   plan.block = std::min(kLayersPerDraw, plan.slab_layers);
   plan.lists = bucket_by_block(plan.geometry, spec.dims.z(), plan.block);
   return plan;
@@ -548,11 +549,22 @@ void check_request(const gpu::Context& context, const GridSpec& spec, const Scan
     throw InputError("SDF band half-width must be at least 1 voxel (got " + std::to_string(options.band) +
                      ")");
   }
-  const int max_size = context.limits().max_3d_texture_size;
-  if (spec.dims.x() > max_size || spec.dims.y() > max_size) {
-    throw GpuError("SDF grid " + std::to_string(spec.dims.x()) + " x " + std::to_string(spec.dims.y()) +
-                   " exceeds this GPU's largest render target side (" + std::to_string(max_size) + ")");
+  // The slab is a layered 2D array target, so its side is bounded by 2D textures, framebuffers and the
+  // viewport, not by 3D textures (2048 on llvmpipe, where 2D goes to 16384).
+  const gpu::DeviceLimits& l = context.limits();
+  const int max_x = std::min({l.max_texture_size, l.max_framebuffer_size[0], l.max_viewport_dims[0]});
+  const int max_y = std::min({l.max_texture_size, l.max_framebuffer_size[1], l.max_viewport_dims[1]});
+  if (spec.dims.x() > max_x || spec.dims.y() > max_y) {
+    throw GpuError(fmt::format("SDF grid {} x {} (x by y) exceeds this GPU's largest layered render target ({} x {}); "
+                               "use a larger voxel",
+                               spec.dims.x(), spec.dims.y(), max_x, max_y));
   }
+}
+
+// Layers one slab target may have: 2D array layers and layered-framebuffer layers.
+int max_slab_layers(const gpu::Context& context) {
+  const gpu::DeviceLimits& l = context.limits();
+  return std::min(l.max_texture_layers, l.max_framebuffer_layers > 0 ? l.max_framebuffer_layers : l.max_texture_layers);
 }
 
 }  // namespace
@@ -566,7 +578,7 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
   const auto start = std::chrono::steady_clock::now();
   check_request(context, spec, options);
   const std::size_t max_items = 256u * static_cast<std::size_t>(context.limits().max_compute_work_group_count[0]);
-  const ScanPlan plan = plan_scan(max_items, mesh, normals, spec, options);
+  const ScanPlan plan = plan_scan(max_items, max_slab_layers(context), mesh, normals, spec, options);
   gpu::ShaderLibrary library;
   gpu::Queue queue(options.timings, context.debug());
   SlabScanner scanner(library, queue, spec, plan);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 
+#include "core/mesh_report.h"
 #include "core/primitives.h"
 #include "gpu/context.h"
 #include "gpu/gl.h"
@@ -191,6 +192,61 @@ TEST_F(ScanConvert, LongTrianglesSpanningHundredsOfLayersComeOutExact) {
   EXPECT_EQ(a.missing, 0u);
   EXPECT_EQ(a.sign_errors, 0u);
   EXPECT_LE(a.max_error_voxels, 1e-3);
+}
+
+// A square rod along `axis` (0: x, 2: z), side 2a, cut into `segments` rings so that no triangle is
+// much longer than its width: the point-triangle distance is evaluated in float, and on triangles
+// thousands of voxels long its cancellation alone reaches 1e-2 voxel, which is not what this is about.
+TriangleMesh segmented_rod(int axis, double length, double a, int segments) {
+  TriangleMesh m;
+  const double corners[4][2] = {{-a, -a}, {a, -a}, {a, a}, {-a, a}};  // counter-clockwise seen from +axis
+  for (int k = 0; k <= segments; ++k) {
+    const double along = -length / 2 + length * k / segments;
+    for (const auto& c : corners) {
+      const Eigen::Vector3d x(along, c[0], c[1]);  // along x; the cyclic permutation turns x into z
+      m.vertices.push_back(axis == 0 ? x : Eigen::Vector3d(x.y(), x.z(), x.x()));
+    }
+  }
+  const auto v = [](int k, int i) { return static_cast<std::uint32_t>(4 * k + i % 4); };
+  for (int k = 0; k < segments; ++k)
+    for (int i = 0; i < 4; ++i) {
+      m.triangles.push_back({v(k, i), v(k, i + 1), v(k + 1, i + 1)});
+      m.triangles.push_back({v(k, i), v(k + 1, i + 1), v(k + 1, i)});
+    }
+  m.triangles.push_back({v(0, 0), v(0, 2), v(0, 1)});
+  m.triangles.push_back({v(0, 0), v(0, 3), v(0, 2)});
+  m.triangles.push_back({v(segments, 0), v(segments, 1), v(segments, 2)});
+  m.triangles.push_back({v(segments, 0), v(segments, 2), v(segments, 3)});
+  return m;
+}
+
+// The slab is a layered 2D array target: a grid wider than the largest 3D texture (2048 on llvmpipe)
+// or taller than the most array layers is scanned all the same, in slabs of the layers the GPU allows.
+// Before, a side over GL_MAX_3D_TEXTURE_SIZE was refused and a column over GL_MAX_ARRAY_TEXTURE_LAYERS
+// layers failed in the driver.
+TEST_F(ScanConvert, RodsLongerThanTheLargest3DTextureAndTheMostLayersComeOutExact) {
+  const double h = 1.0 / 60.0;
+  const auto& limits = context.limits();
+  const int voxels = std::max(limits.max_3d_texture_size, limits.max_texture_layers) + 200;
+  const double length = voxels * h;
+  for (int axis : {0, 2}) {
+    const TriangleMesh rod = segmented_rod(axis, length, 0.05, voxels / 64);
+    const MeshReport report = analyze_mesh(rod);
+    ASSERT_TRUE(report.watertight()) << "axis " << axis;
+    const GridSpec spec = grid_around(rod, h, 4);
+    if (axis == 0) {
+      ASSERT_GT(spec.dims.x(), limits.max_3d_texture_size);
+    } else {
+      ASSERT_GT(spec.dims.z(), limits.max_texture_layers);
+    }
+    const auto result = run(rod, spec);
+    EXPECT_LE(result.stats.layers_per_slab, limits.max_texture_layers);
+    const Agreement a = compare_with_exact(rod, spec, result, 3.0);
+    EXPECT_GT(a.band_voxels, static_cast<std::size_t>(voxels) * 40) << "axis " << axis;
+    EXPECT_EQ(a.missing, 0u) << "axis " << axis;
+    EXPECT_EQ(a.sign_errors, 0u) << "axis " << axis;
+    EXPECT_LE(a.max_error_voxels, 1e-3) << "axis " << axis;
+  }
 }
 
 TEST_F(ScanConvert, SphereMatchesExactDistanceAndSigns) {
