@@ -138,6 +138,8 @@ def main():
     ap.add_argument("--no-trade", action="store_true", help="only the comparison with Open3D")
     ap.add_argument("--tetrasand-args", default="",
                     help="more options for the compared `tetrasand sample` runs, e.g. \"--timings\" (printed after each run)")
+    ap.add_argument("--criteria", action="store_true",
+                    help="exit 1 unless every tetrasand body meets issue 15's targets: c / r <= 1, rho >= 0.75, CV <= 0.05")
     ap.add_argument("--csv", help="also write every row to this CSV")
     ap.add_argument("--markdown", help="rewrite the sampler section of this markdown file (docs/benchmarks.md)")
     ap.add_argument("--command", default="", help="the command line to quote in the markdown section")
@@ -163,6 +165,7 @@ def main():
     print(f"Open3D {o3d.__version__}; probes per figure: {args.probes}\n")
     jobs = [] if args.no_compare else [(m, n) for m in args.meshes for n in args.counts]
     jobs += [] if args.no_compare else [(m, args.large_count) for m in args.large]
+    missed = []  # tetrasand bodies below the --criteria targets
     if jobs:
         say("| mesh | N | tool | time s | ratio | rho | CV | c / r | c / d_hex | max phi / r |")
         say("|---|---|---|---|---|---|---|---|---|---|")
@@ -179,6 +182,9 @@ def main():
         label = os.path.splitext(os.path.basename(path))[0]
         for tool, pts, secs in (("tetrasand", ours, t_ours), ("Open3D", theirs, t_theirs)):
             q = quality(pts, mesh, probes, r)
+            if tool == "tetrasand" and not (q["c_over_r"] <= 1.0 and q["rho"] >= 0.75 and q["cv"] <= 0.05):
+                missed.append(f"{os.path.basename(path)} at {count}: c / r {q['c_over_r']:.3f}, rho {q['rho']:.3f}, "
+                              f"CV {q['cv']:.3f}")
             say(f"| {label} | {q['n']} | {tool} | {secs:.2f} | {secs / t_theirs:.2f} | {q['rho']:.3f} | {q['cv']:.3f} | "
                 f"{q['c_over_r']:.3f} | {q['c_over_dhex']:.3f} | {q['phi_over_r']:.1e} |")
             out.row(kind="compare", mesh=label, requested=count, tool=tool, seconds=secs, **q,
@@ -212,6 +218,12 @@ def main():
     if args.markdown:
         out.close()
         write_markdown(args, report, started, load_start, gl, o3d.__version__)
+    if args.criteria:
+        for m in missed:
+            print(f"sample: below the targets (c / r <= 1, rho >= 0.75, CV <= 0.05): {m}", file=sys.stderr)
+        print("sample: every tetrasand body meets the targets" if not missed else "sample: targets missed")
+        if missed:
+            sys.exit(1)
 
 
 def write_markdown(args, report, started, load_start, gl, open3d_version):

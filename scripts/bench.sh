@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
-# Usage: scripts/bench.sh [peers|sdf|sparse|sample|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all]
+# Usage: scripts/bench.sh [peers|sdf|sparse|sample|sample-large|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all]
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #                        [--only TRADES]
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
@@ -18,6 +18,10 @@
 #               -> section peers-sim of docs/benchmarks.md                              (~5 min, 2 cores)
 #   sample      tetrasand sample against Open3D's sample_points_poisson_disk at equal counts, plus the
 #               sampler's rounds x iterations trade -> section sampler of docs/benchmarks.md (~10 min)
+#   sample-large  the bunny at 100,000 and 1,000,000 particles against Open3D, with tetrasand's --timings;
+#               exit 1 unless tetrasand's bodies meet c / r <= 1, rho >= 0.75, CV <= 0.05 (issue 15); prints
+#               the table, which bench/sample_notes.md quotes by hand (--quick: 100,000 only)
+#               (~20 min on 2 idle cores, llvmpipe)
 #   certificate the coverage certificate against the sampler's 1M-probe pass on bunny bodies of 1k, 10k,
 #               100k and 200k particles, an independent 10M-probe check of each, and the criteria of
 #               bench/certificate_criteria.md -> section certificate of docs/benchmarks.md
@@ -83,7 +87,7 @@ while [ $# -gt 0 ]; do
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in peers|sdf|sparse|sample|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all) ;;
+case "$what" in peers|sdf|sparse|sample|sample-large|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all) ;;
   *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;;
 esac
 [ "$quick" -eq 1 ] && sdf_cases="knot1@64,128 armadillo@64,128"
@@ -126,6 +130,13 @@ if runs sim-accuracy; then
 fi
 if runs peers-sim; then
   "$py" "$root/bench/peers/sim_peers.py" "$bin" "$work/peers-sim" --markdown "$root/docs/benchmarks.md" || status=1
+fi
+if runs sample-large; then
+  large_counts=(100000 1000000)
+  [ "$quick" -eq 1 ] && large_counts=(100000)
+  (cd "$root" && "$py" bench/sample_bench.py --tetrasand "$bin/tetrasand" --meshes assets/bunny.obj \
+    --counts "${large_counts[@]}" --large --no-trade --tetrasand-args=--timings --criteria \
+    --csv "$work/sample-large.csv") || status=1
 fi
 if runs sample; then
   sample_args=()
