@@ -61,6 +61,15 @@ SdfVolume volume_from_level_set(const openvdb::FloatGrid& grid, const std::files
   }
   const double background = std::abs(static_cast<double>(grid.background()));
   if (!(background > 0.0)) throw InputError(file, "the level set's background value is 0: no narrow band to ray-cast");
+  // The march's trilinear reads and the shading's central differences take values up to a voxel from
+  // the surface; a thinner band clamps them and the surface comes out stepped. `tetrasand sdf` writes
+  // at least 1 voxel for the same reason.
+  if (background < h * (1.0 - 1e-6)) {
+    throw InputError(file, fmt::format("the level set's narrow band is {:.3g} voxels wide on each side (background {:.4g}, "
+                                       "voxel {:.4g}), narrower than the 1 voxel the ray cast reads; rebuild it with "
+                                       "a wider band (tetrasand sdf --band 3, or OpenVDB's half width)",
+                                       background / h, background, h));
+  }
   openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
   if (box.empty()) throw InputError(file, "the level set has no active voxels: nothing to ray-cast");
   box.expand(2);

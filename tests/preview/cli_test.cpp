@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/LevelSetSphere.h>
 #include <algorithm>
 #include <cstdio>
@@ -81,6 +82,9 @@ TEST(CliPreview, BadInputsExitWithClearMessages) {
   empty->setGridClass(openvdb::GRID_LEVEL_SET);
   write_grid(dir / "empty.vdb", empty);
   write_grid(dir / "vector.vdb", openvdb::Vec3SGrid::create());
+  auto thin = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.0f), 0.1f, 3.0f);
+  openvdb::tools::changeLevelSetBackground(thin->tree(), 0.05f);  // half a voxel: below what OpenVDB's tools make
+  write_grid(dir / "thin.vdb", thin);
   const std::string sphere = q(test::asset("sphere.obj")), png = " -o " + q(dir / "x.png");
   struct Case {
     std::string args;
@@ -90,6 +94,7 @@ TEST(CliPreview, BadInputsExitWithClearMessages) {
   for (const Case& c : {Case{q(dir / "fog.vdb") + png, 1, "none is a level set"},
                         Case{q(dir / "empty.vdb") + png, 1, "is empty"},
                         Case{q(dir / "vector.vdb") + png, 1, "holds no float grid"},
+                        Case{q(dir / "thin.vdb") + png, 1, "narrower than the 1 voxel the ray cast reads; rebuild it with a wider band (tetrasand sdf --band 3"},
                         Case{q(dir / "missing.vdb") + png, 1, "no such file"},
                         Case{sphere + png + " --size 0x0", 1, "at least 1 pixel"},
                         Case{sphere + png + " --size 100000x100000", 1, "exceeds this GPU's largest render target"},
