@@ -214,9 +214,10 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
       ->capture_default_str();
   cmd->add_option(
          "--sdf-backend", o.sdf_backend,
-         "Where the SDF is built: gpu (scan conversion), cpu (exact distance, all cores) or auto (cpu on "
-         "a software renderer for grids up to 2^23 voxels, else gpu)")
-      ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
+         "Where the SDF is built: gpu (scan conversion), cpu (exact distance, all cores), openvdb "
+         "(OpenVDB's meshToVolume, all cores: approximate, closed meshes) or auto (on a software renderer "
+         "or without GL: cpu for grids up to 2^23 voxels, openvdb above; else gpu)")
+      ->check(CLI::IsMember({"auto", "gpu", "cpu", "openvdb"}))
       ->capture_default_str();
   cmd->add_option(
          "--sdf-budget-mib", o.sdf_budget_mib,
@@ -368,6 +369,31 @@ nlohmann::json thin_features_json(const sampler::ThinFeatures& thin) {
 }
 
 // The GL device, or what ran without one.
+// The SDF's path in the stage table and in the report's device line.
+const char* sdf_path_text(sampler::SdfPath path) {
+  switch (path) {
+    case sampler::SdfPath::Exact:
+      return "exact distance (CPU)";
+    case sampler::SdfPath::OpenVdb:
+      return "OpenVDB meshToVolume (CPU)";
+    case sampler::SdfPath::Scan:
+      break;
+  }
+  return "scan conversion";
+}
+
+const char* sdf_path_device_text(sampler::SdfPath path) {
+  switch (path) {
+    case sampler::SdfPath::Exact:
+      return "by exact distance on the CPU";
+    case sampler::SdfPath::OpenVdb:
+      return "by OpenVDB's meshToVolume on the CPU";
+    case sampler::SdfPath::Scan:
+      break;
+  }
+  return "by GPU scan conversion";
+}
+
 std::string device_name(const gpu::Context* context) {
   return context ? context->summary() : std::string("the CPU (no GL context)");
 }
@@ -393,7 +419,7 @@ nlohmann::json run_json(const sampler::SampleResult& result, const CommandSecond
   const sampler::StageSeconds& t = result.stages;
   return {{"device", device_name(context)},
           {"software_device", context ? nlohmann::json(context->software()) : nlohmann::json(nullptr)},
-          {"sdf_backend", result.sdf_on_cpu ? "cpu" : "gpu"},
+          {"sdf_backend", sampler::sdf_path_name(result.sdf_path)},
           {"relax_backend", result.relax_on_cpu ? "cpu" : "gpu"},
           {"certificate_backend", result.certificate_on_cpu ? "cpu" : "gpu"},
           {"probes", result.probes},
@@ -422,7 +448,7 @@ void print_stage_table(const sampler::SampleResult& result, const CommandSeconds
       {"GPU context creation", c.context},
       {"mesh load and checks", c.load},
       {"plan: exact-distance tree, sizing, mass", t.plan},
-      {fmt::format("SDF: {}, NanoVDB{}", result.sdf_on_cpu ? "exact distance (CPU)" : "scan conversion",
+      {fmt::format("SDF: {}, NanoVDB{}", sdf_path_text(result.sdf_path),
                    result.relax_on_cpu ? "" : ", upload"),
        t.sdf},
       {"seeds, programs and buffers", t.setup},
@@ -479,7 +505,7 @@ void print_body_report(const Options& o, const sampler::SampleResult& result,
   const sampler::StageSeconds& t = result.stages;
   fmt::print("  device           {}: SDF {} {:.2f} s, relaxation {:.2f} s, certificate {:.2f} s; {}\n",
              device_name(context),
-             result.sdf_on_cpu ? "by exact distance on the CPU" : "by GPU scan conversion", t.sdf,
+             sdf_path_device_text(result.sdf_path), t.sdf,
              t.relaxation, t.certificate, backend_text(result, o));
   fmt::print(
       "  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {} (certificate {:.2f} s "
@@ -504,9 +530,10 @@ int convert_one(const Options& o, gpu::Context* context, BatchRow& row) {
   seconds.context = o.context_seconds;
   sampler::SampleSettings settings = o.sampling;
   settings.max_sdf_bytes = o.sdf_budget_mib << 20;
-  settings.sdf_backend = o.sdf_backend == "cpu"   ? sampler::SdfBackend::Cpu
-                         : o.sdf_backend == "gpu" ? sampler::SdfBackend::Gpu
-                                                  : sampler::SdfBackend::Auto;
+  settings.sdf_backend = o.sdf_backend == "cpu"       ? sampler::SdfBackend::Cpu
+                         : o.sdf_backend == "gpu"     ? sampler::SdfBackend::Gpu
+                         : o.sdf_backend == "openvdb" ? sampler::SdfBackend::OpenVdb
+                                                      : sampler::SdfBackend::Auto;
   settings.backend = o.backend == "cpu"   ? sampler::SampleBackend::Cpu
                      : o.backend == "gpu" ? sampler::SampleBackend::Gpu
                                           : sampler::SampleBackend::Auto;
@@ -593,7 +620,7 @@ int run_batch(const Options& o, const std::vector<std::string>& meshes, gpu::Con
 
 // Whether a run needs a GL context at all: auto asks the device what it is, the GPU paths and
 // --preview use it. `--backend cpu` without them runs everything on the CPU, the SDF included
-// (--sdf-backend auto then means the exact CPU field), so it works where EGL does not.
+// (--sdf-backend auto then means a CPU field, exact or OpenVDB's), so it works where EGL does not.
 bool needs_gl_context(const Options& o) { return o.backend != "cpu" || o.sdf_backend == "gpu" || o.preview; }
 
 int run_sample(Options& o, const GlobalOptions& global) {

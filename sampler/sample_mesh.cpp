@@ -30,6 +30,7 @@
 #include "sdf/exact_sdf.h"
 #include "sdf/grid.h"
 #include "sdf/host_field.h"
+#include "sdf/openvdb_compare.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
 #include "sdf/settings.h"
@@ -255,16 +256,24 @@ SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& e
 }
 
 // Without a GL context the field can only come from the CPU.
-bool sdf_on_cpu(const gpu::Context* context, const sdf::GridSpec& spec, const SampleSettings& settings) {
+SdfPath choose_sdf_path(const gpu::Context* context, const sdf::GridSpec& spec, const SampleSettings& settings) {
   switch (settings.sdf_backend) {
     case SdfBackend::Cpu:
-      return true;
+      return SdfPath::Exact;
     case SdfBackend::Gpu:
-      return false;
+      return SdfPath::Scan;
+    case SdfBackend::OpenVdb:
+      if (settings.sign != sdf::SignMethod::Pseudonormal) {
+        throw InputError("--sdf-backend openvdb signs the field by OpenVDB's own flood fill, which needs a closed "
+                         "mesh: with --sign winding use --sdf-backend cpu or gpu");
+      }
+      return SdfPath::OpenVdb;
     case SdfBackend::Auto:
       break;
   }
-  return context == nullptr || (context->software() && spec.voxel_count() <= kCpuSdfMaxVoxels);
+  if (context != nullptr && !context->software()) return SdfPath::Scan;
+  const bool large = spec.voxel_count() > kCpuSdfMaxVoxels;
+  return large && settings.sign == sdf::SignMethod::Pseudonormal ? SdfPath::OpenVdb : SdfPath::Exact;
 }
 
 bool relax_on_cpu(const gpu::Context* context, const SampleSettings& settings) {
@@ -286,12 +295,17 @@ gpu::Context& needed_context(gpu::Context* context, const char* stage) {
 }
 
 // The level set of the band in index space: by GPU scan conversion, or by exact distance on the CPU
-// (both signed by pseudonormals, as the relaxation expects).
+// (both signed by pseudonormals, as the relaxation expects), or by OpenVDB on the CPU (its own signs).
 openvdb::FloatGrid::Ptr band_level_set(gpu::Context* context, const TriangleMesh& mesh,
                                        const sdf::ExactDistance& exact, const sdf::GridSpec& spec,
                                        const SampleSettings& settings, SampleResult& result) {
   FieldStats& f = result.field;
-  if (result.sdf_on_cpu) {
+  if (result.sdf_path == SdfPath::OpenVdb) {
+    openvdb::FloatGrid::Ptr grid = sdf::openvdb_index_level_set(mesh, spec, kBandVoxels);
+    f.band_voxels = grid->activeVoxelCount();
+    return grid;
+  }
+  if (result.sdf_path == SdfPath::Exact) {
     openvdb::FloatGrid::Ptr grid =
         sdf::exact_sdf_grid(exact, mesh, spec, kBandVoxels, sdf::SignMethod::Pseudonormal, true);
     f.band_voxels = grid->activeVoxelCount();
@@ -318,7 +332,8 @@ using RelaxField = std::variant<sdf::SparseField, sdf::HostField>;
 RelaxField make_field(gpu::Context* context, const TriangleMesh& mesh, const sdf::ExactDistance& exact,
                       const sdf::GridSpec& spec, const SamplingPlan& plan, const SampleSettings& settings,
                       SampleResult& result) {
-  result.sdf_on_cpu = sdf_on_cpu(context, spec, settings);
+  result.sdf_path = choose_sdf_path(context, spec, settings);
+  result.sdf_on_cpu = result.sdf_path != SdfPath::Scan;
   const openvdb::FloatGrid::Ptr grid = band_level_set(context, mesh, exact, spec, settings, result);
   // The CPU reads the level set's own index space, the GPU a moved copy (sdf::gpu_index_shift says why).
   sdf::NanoGrid nano = result.relax_on_cpu ? sdf::to_nanovdb(*grid) : sdf::to_gpu_nanovdb(*grid, spec);
@@ -634,6 +649,18 @@ std::string round_trip_report(const gpu::HostSyncCounts& scan, const ParticleRel
 }
 
 }  // namespace
+
+const char* sdf_path_name(SdfPath path) {
+  switch (path) {
+    case SdfPath::Exact:
+      return "cpu";
+    case SdfPath::OpenVdb:
+      return "openvdb";
+    case SdfPath::Scan:
+      break;
+  }
+  return "gpu";
+}
 
 std::size_t probe_count(std::size_t particles, const SampleSettings& settings) {
   const std::size_t cap = std::max<std::size_t>(settings.probes, 1);

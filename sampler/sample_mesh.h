@@ -27,12 +27,20 @@
 
 namespace ts::sampler {
 
-// Where the SDF is built: by GPU scan conversion (sdf/scan_convert.h) or on the CPU by exact distance
-// (sdf::exact_sdf_grid: CGAL AABB tree, TBB). Auto: the CPU on a software renderer (llvmpipe runs
-// the scan conversion's geometry and fragment work on the same cores, slower than the exact path up
-// to grids of kCpuSdfMaxVoxels; docs/benchmarks.md, "sample fixed costs"), the GPU otherwise.
-enum class SdfBackend { Auto, Gpu, Cpu };
+// Where the SDF is built: by GPU scan conversion (sdf/scan_convert.h), on the CPU by exact distance
+// (sdf::exact_sdf_grid: CGAL AABB tree, TBB), or on the CPU by OpenVDB's meshToVolume
+// (sdf::openvdb_index_level_set; approximate, about 0.01 voxel on average and a few wrong signs next to
+// the surface, docs/benchmarks.md "SDF"; closed meshes only). Auto: on a software renderer or without a
+// GL context (llvmpipe runs the scan conversion's geometry and fragment work on the same cores), the
+// exact path for grids up to kCpuSdfMaxVoxels and OpenVDB above (the 1M-particle bunny's band in 23 s
+// against 180 s of scan conversion on llvmpipe; docs/benchmarks.md, "Sampling"), unless the sign is by
+// winding number; the GPU scan otherwise.
+enum class SdfBackend { Auto, Gpu, Cpu, OpenVdb };
 inline constexpr std::size_t kCpuSdfMaxVoxels = std::size_t{1} << 23;
+// What built a run's field.
+enum class SdfPath { Scan, Exact, OpenVdb };
+// "gpu", "cpu", "openvdb": the --sdf-backend value that names the path.
+const char* sdf_path_name(SdfPath path);
 
 // Where the relaxation and the coverage certificate run: GL compute kernels (sampler/gpu_relaxer.h,
 // sampler/coverage_certificate.h) or the same algorithms on the CPU with TBB (sampler/cpu_relaxer.h,
@@ -127,7 +135,8 @@ struct SampleResult {
   double certificate_seconds = 0.0;   // s, wall time of those
   double probe_seconds = 0.0;         // s, wall time of the statistical probe pass
   std::size_t probes = 0;             // surface points of that pass (probe_count)
-  bool sdf_on_cpu = false;            // the field came from the exact CPU path (SdfBackend)
+  bool sdf_on_cpu = false;            // the field came from a CPU path, exact or OpenVDB (SdfBackend)
+  SdfPath sdf_path = SdfPath::Scan;   // which path built it
   bool relax_on_cpu = false;          // the relaxation ran on the CPU (SampleBackend)
   bool certificate_on_cpu = false;    // the coverage certificate ran on the CPU (SampleBackend)
   StageSeconds stages;
@@ -137,7 +146,7 @@ struct SampleResult {
 };
 
 // `context` may be null when no stage needs the GPU: SampleBackend Cpu or Auto (then the CPU), and
-// SdfBackend Cpu or Auto (then the exact CPU field); a GPU stage without one is an internal error.
+// SdfBackend Cpu, OpenVdb or Auto (then a CPU field); a GPU stage without one is an internal error.
 SampleResult sample_mesh(gpu::Context* context, const TriangleMesh& mesh, const SampleSettings& settings,
                          const std::function<void(const SampleProgress&)>& progress = {});
 inline SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh,

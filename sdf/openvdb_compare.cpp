@@ -1,7 +1,9 @@
 #include "sdf/openvdb_compare.h"
 
 #include <fmt/format.h>
+#include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tools/ValueTransformer.h>
 
 #include <algorithm>
 #include <vector>
@@ -28,6 +30,31 @@ openvdb::FloatGrid::Ptr openvdb_level_set(const TriangleMesh& mesh, double h, do
   openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(index_points, triangles);
   return openvdb::tools::meshToVolume<openvdb::FloatGrid>(adapter, *transform, static_cast<float>(band), static_cast<float>(band),
                                                           openvdb::tools::DISABLE_RENORMALIZATION);
+}
+
+openvdb::FloatGrid::Ptr openvdb_index_level_set(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels) {
+  ensure_openvdb_initialized();
+  const double h = spec.voxel_size;
+  std::vector<openvdb::Vec3s> points;
+  std::vector<openvdb::Vec3I> triangles;
+  points.reserve(mesh.vertex_count());
+  triangles.reserve(mesh.triangle_count());
+  // Voxel centres sit at integer coordinates (make_grid: origin = h * index_offset).
+  for (const auto& v : mesh.vertices) points.emplace_back(static_cast<float>(v.x() / h), static_cast<float>(v.y() / h),
+                                                          static_cast<float>(v.z() / h));
+  for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+  openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(points, triangles);
+  // Voxel size 1 throughout, so OpenVDB's smallest voxel (about 1.3e-5) never applies; distances come
+  // out in voxels and are scaled to world units after.
+  const auto unit = openvdb::math::Transform::createLinearTransform(1.0);
+  const float band = static_cast<float>(band_voxels);
+  openvdb::FloatGrid::Ptr grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(adapter, *unit, band, band);
+  const float scale = static_cast<float>(h);
+  openvdb::tools::foreach(grid->beginValueOn(), [scale](const openvdb::FloatGrid::ValueOnIter& it) { it.setValue(*it * scale); });
+  openvdb::tools::changeLevelSetBackground(grid->tree(), band * scale);
+  grid->setGridClass(openvdb::GRID_LEVEL_SET);
+  grid->setName("surface");
+  return grid;
 }
 
 GridComparison compare_grids(const openvdb::FloatGrid& a, const openvdb::FloatGrid& reference, double voxel_size,

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/mesh.h"
+#include "sdf/grid.h"
 
 namespace ts::sdf {
 
@@ -17,6 +18,14 @@ namespace ts::sdf {
 // 0.8 voxel outside the surface that is a local maximum of the distance (a ridge between two nearby
 // sheets), which is where its max error of exactly 1.000 voxel comes from (docs/benchmarks.md, sdf).
 openvdb::FloatGrid::Ptr openvdb_level_set(const TriangleMesh& mesh, double h, double band, bool renormalize = true);
+
+// The same conversion as a band for the sampler on a machine without a GPU: an index-space level set on
+// `spec` (voxel (i, j, k) at coordinate spec.index_offset + (i, j, k), transform of voxel size 1, values
+// in world units: what ScanConvertOptions::index_space_grid gives), half-width `band_voxels`. The mesh
+// goes to voxel units in double before OpenVDB sees it, so any voxel size works; signs are OpenVDB's
+// (closed meshes only: no pseudonormals, no winding number).
+openvdb::FloatGrid::Ptr openvdb_index_level_set(const TriangleMesh& mesh, const GridSpec& spec,
+                                                double band_voxels);
 
 struct GridComparison {
   std::size_t voxels = 0;              // compared: |value| < band in either grid

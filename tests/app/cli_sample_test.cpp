@@ -390,6 +390,13 @@ TEST(CliSample, ReportNamesTheDeviceAndTheStageTimes) {
   EXPECT_GT(t.at("relaxation").get<double>(), 0.0);
   EXPECT_LE(stages, t.at("total").get<double>() * 1.001 + 1e-3);  // the stages do not overlap
   EXPECT_GE(stages, 0.5 * t.at("total").get<double>());           // and are most of the run
+  ASSERT_EQ(test::run_tetrasand("sample " + sphere + " -o " + quoted(test::temp_dir()) + kFast +
+                                    "--sdf-backend openvdb --backend cpu --timings",
+                                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("SDF by OpenVDB's meshToVolume on the CPU"), std::string::npos) << out;
+  EXPECT_NE(out.find("SDF: OpenVDB meshToVolume (CPU), NanoVDB"), std::string::npos) << out;
   EXPECT_NE(test::run_tetrasand(
                 "sample " + sphere + " -o " + quoted(test::temp_dir()) + kFast + "--sdf-backend cuda", &out),
             0);

@@ -364,23 +364,51 @@ TEST(SampleMesh, ProportionalProbesFindAKnownHoleWithinTheStatedBound) {
   EXPECT_LT(delta, 0.15 * h);  // the bound is worth having at this count: 0.1 h
 }
 
-// Both SDF paths give a body that meets the targets: the exact CPU field (the default on a software
-// renderer, SdfBackend::Auto) and the GPU scan conversion; the result says which one ran.
-TEST(SampleMesh, CpuAndGpuSdfBothMeetTheTargets) {
+// Every SDF path gives a body that meets the targets: the exact CPU field (the default on a software
+// renderer for small grids, SdfBackend::Auto), OpenVDB's on the CPU and the GPU scan conversion; the
+// result says which one ran.
+TEST(SampleMesh, CpuOpenVdbAndGpuSdfAllMeetTheTargets) {
   const TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));
-  for (const SdfBackend backend : {SdfBackend::Cpu, SdfBackend::Gpu, SdfBackend::Auto}) {
+  for (const SdfBackend backend : {SdfBackend::Cpu, SdfBackend::OpenVdb, SdfBackend::Gpu, SdfBackend::Auto}) {
     SampleSettings settings;
     settings.count = 300;
     settings.sdf_backend = backend;
     const SampleResult result = sample_mesh(shared_context(), mesh, settings);
-    const bool cpu =
-        backend == SdfBackend::Cpu || (backend == SdfBackend::Auto && shared_context().software());
+    const bool cpu = backend == SdfBackend::Cpu || backend == SdfBackend::OpenVdb ||
+                     (backend == SdfBackend::Auto && shared_context().software());
     EXPECT_EQ(result.sdf_on_cpu, cpu);
+    EXPECT_EQ(result.sdf_path == SdfPath::OpenVdb, backend == SdfBackend::OpenVdb);  // auto: exact at this size
     EXPECT_GT(result.field.band_voxels, 0u);
     EXPECT_GT(result.stages.sdf, 0.0);
     EXPECT_GT(result.stages.relaxation, 0.0);
     EXPECT_EQ(result.probes, probe_count(result.body.positions.size(), settings));
     expect_meets_quality_targets(mesh, result, settings.density);
+  }
+}
+
+// On a software renderer, a grid above kCpuSdfMaxVoxels takes OpenVDB's field (the exact one's time
+// grows with the band, and llvmpipe's scan conversion is slower still); the body meets the targets.
+// The winding-number sign keeps the exact path (OpenVDB's signs need a closed mesh), and asking for
+// OpenVDB with it is refused.
+TEST(SampleMesh, LargeGridsOnASoftwareRendererTakeOpenVdbsField) {
+  if (!shared_context().software()) GTEST_SKIP() << "auto takes the GPU scan on a hardware GPU";
+  const TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));  // radius 5 cm
+  SampleSettings settings;
+  settings.count = 300;
+  settings.voxel_size = 0.1 / 220.0;  // 220+ voxels a side: above 2^23
+  const SampleResult result = sample_mesh(shared_context(), mesh, settings);
+  EXPECT_EQ(result.sdf_path, SdfPath::OpenVdb);
+  EXPECT_GT(result.field.band_voxels, 100'000u);
+  expect_meets_quality_targets(mesh, result, settings.density);
+
+  settings.sign = sdf::SignMethod::Winding;
+  EXPECT_EQ(sample_mesh(shared_context(), mesh, settings).sdf_path, SdfPath::Exact);
+  settings.sdf_backend = SdfBackend::OpenVdb;
+  try {
+    sample_mesh(shared_context(), mesh, settings);
+    FAIL() << "--sdf-backend openvdb with the winding-number sign ran";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--sdf-backend openvdb"), std::string::npos) << e.what();
   }
 }
 
