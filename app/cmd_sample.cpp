@@ -368,32 +368,24 @@ nlohmann::json thin_features_json(const sampler::ThinFeatures& thin) {
           {"regions_not_listed", thin.regions.size() - regions.size()}};
 }
 
+// How the SDF's path reads in the stage table and in the report's device line.
+struct SdfPathWords {
+  const char* stage;
+  const char* device;
+};
+SdfPathWords sdf_path_words(sampler::SdfPath path) {
+  switch (path) {
+    case sampler::SdfPath::Exact:
+      return {"exact distance (CPU)", "by exact distance on the CPU"};
+    case sampler::SdfPath::OpenVdb:
+      return {"OpenVDB meshToVolume (CPU)", "by OpenVDB's meshToVolume on the CPU"};
+    case sampler::SdfPath::Scan:
+      break;
+  }
+  return {"scan conversion", "by GPU scan conversion"};
+}
+
 // The GL device, or what ran without one.
-// The SDF's path in the stage table and in the report's device line.
-const char* sdf_path_text(sampler::SdfPath path) {
-  switch (path) {
-    case sampler::SdfPath::Exact:
-      return "exact distance (CPU)";
-    case sampler::SdfPath::OpenVdb:
-      return "OpenVDB meshToVolume (CPU)";
-    case sampler::SdfPath::Scan:
-      break;
-  }
-  return "scan conversion";
-}
-
-const char* sdf_path_device_text(sampler::SdfPath path) {
-  switch (path) {
-    case sampler::SdfPath::Exact:
-      return "by exact distance on the CPU";
-    case sampler::SdfPath::OpenVdb:
-      return "by OpenVDB's meshToVolume on the CPU";
-    case sampler::SdfPath::Scan:
-      break;
-  }
-  return "by GPU scan conversion";
-}
-
 std::string device_name(const gpu::Context* context) {
   return context ? context->summary() : std::string("the CPU (no GL context)");
 }
@@ -448,7 +440,7 @@ void print_stage_table(const sampler::SampleResult& result, const CommandSeconds
       {"GPU context creation", c.context},
       {"mesh load and checks", c.load},
       {"plan: exact-distance tree, sizing, mass", t.plan},
-      {fmt::format("SDF: {}, NanoVDB{}", sdf_path_text(result.sdf_path),
+      {fmt::format("SDF: {}, NanoVDB{}", sdf_path_words(result.sdf_path).stage,
                    result.relax_on_cpu ? "" : ", upload"),
        t.sdf},
       {"seeds, programs and buffers", t.setup},
@@ -505,7 +497,7 @@ void print_body_report(const Options& o, const sampler::SampleResult& result,
   const sampler::StageSeconds& t = result.stages;
   fmt::print("  device           {}: SDF {} {:.2f} s, relaxation {:.2f} s, certificate {:.2f} s; {}\n",
              device_name(context),
-             sdf_path_device_text(result.sdf_path), t.sdf,
+             sdf_path_words(result.sdf_path).device, t.sdf,
              t.relaxation, t.certificate, backend_text(result, o));
   fmt::print(
       "  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {} (certificate {:.2f} s "

@@ -333,7 +333,6 @@ RelaxField make_field(gpu::Context* context, const TriangleMesh& mesh, const sdf
                       const sdf::GridSpec& spec, const SamplingPlan& plan, const SampleSettings& settings,
                       SampleResult& result) {
   result.sdf_path = choose_sdf_path(context, spec, settings);
-  result.sdf_on_cpu = result.sdf_path != SdfPath::Scan;
   const openvdb::FloatGrid::Ptr grid = band_level_set(context, mesh, exact, spec, settings, result);
   // The CPU reads the level set's own index space, the GPU a moved copy (sdf::gpu_index_shift says why).
   sdf::NanoGrid nano = result.relax_on_cpu ? sdf::to_nanovdb(*grid) : sdf::to_gpu_nanovdb(*grid, spec);

@@ -135,14 +135,15 @@ struct SampleResult {
   double certificate_seconds = 0.0;   // s, wall time of those
   double probe_seconds = 0.0;         // s, wall time of the statistical probe pass
   std::size_t probes = 0;             // surface points of that pass (probe_count)
-  bool sdf_on_cpu = false;            // the field came from a CPU path, exact or OpenVDB (SdfBackend)
-  SdfPath sdf_path = SdfPath::Scan;   // which path built it
+  SdfPath sdf_path = SdfPath::Scan;   // which path built the field (SdfBackend)
   bool relax_on_cpu = false;          // the relaxation ran on the CPU (SampleBackend)
   bool certificate_on_cpu = false;    // the coverage certificate ran on the CPU (SampleBackend)
   StageSeconds stages;
   std::vector<std::string> warnings;
   FieldStats field;
   std::string timing_report;
+
+  bool sdf_on_cpu() const { return sdf_path != SdfPath::Scan; }  // exact or OpenVDB's
 };
 
 // `context` may be null when no stage needs the GPU: SampleBackend Cpu or Auto (then the CPU), and

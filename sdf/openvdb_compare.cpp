@@ -11,16 +11,32 @@
 #include "sdf/vdb_io.h"
 
 namespace ts::sdf {
+namespace {
+
+// The mesh as OpenVDB takes it: float points (each coordinate times `scale`, in double first) and
+// index triples.
+struct OpenVdbMesh {
+  std::vector<openvdb::Vec3s> points;
+  std::vector<openvdb::Vec3I> triangles;
+};
+OpenVdbMesh to_openvdb_mesh(const TriangleMesh& mesh, double scale) {
+  OpenVdbMesh m;
+  m.points.reserve(mesh.vertex_count());
+  m.triangles.reserve(mesh.triangle_count());
+  for (const auto& v : mesh.vertices) {
+    m.points.emplace_back(static_cast<float>(v.x() * scale), static_cast<float>(v.y() * scale),
+                          static_cast<float>(v.z() * scale));
+  }
+  for (const auto& t : mesh.triangles) m.triangles.emplace_back(t[0], t[1], t[2]);
+  return m;
+}
+
+}  // namespace
 
 openvdb::FloatGrid::Ptr openvdb_level_set(const TriangleMesh& mesh, double h, double band, bool renormalize) {
   ensure_openvdb_initialized();
-  std::vector<openvdb::Vec3s> points;
-  std::vector<openvdb::Vec3I> triangles;
-  points.reserve(mesh.vertex_count());
-  triangles.reserve(mesh.triangle_count());
   // OpenVDB works in float world coordinates; the transform carries the voxel size.
-  for (const auto& v : mesh.vertices) points.emplace_back(v.x(), v.y(), v.z());
-  for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+  auto [points, triangles] = to_openvdb_mesh(mesh, 1.0);
   const auto transform = openvdb::math::Transform::createLinearTransform(h);
   if (renormalize) return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*transform, points, triangles, static_cast<float>(band));
   // What meshToLevelSet does, with the renormalisation pass switched off: points to index space first.
@@ -35,15 +51,9 @@ openvdb::FloatGrid::Ptr openvdb_level_set(const TriangleMesh& mesh, double h, do
 openvdb::FloatGrid::Ptr openvdb_index_level_set(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels) {
   ensure_openvdb_initialized();
   const double h = spec.voxel_size;
-  std::vector<openvdb::Vec3s> points;
-  std::vector<openvdb::Vec3I> triangles;
-  points.reserve(mesh.vertex_count());
-  triangles.reserve(mesh.triangle_count());
   // Voxel centres sit at integer coordinates (make_grid: origin = h * index_offset).
-  for (const auto& v : mesh.vertices) points.emplace_back(static_cast<float>(v.x() / h), static_cast<float>(v.y() / h),
-                                                          static_cast<float>(v.z() / h));
-  for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-  openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(points, triangles);
+  const OpenVdbMesh m = to_openvdb_mesh(mesh, 1.0 / h);
+  openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(m.points, m.triangles);
   // Voxel size 1 throughout, so OpenVDB's smallest voxel (about 1.3e-5) never applies; distances come
   // out in voxels and are scaled to world units after.
   const auto unit = openvdb::math::Transform::createLinearTransform(1.0);

@@ -376,7 +376,7 @@ TEST(SampleMesh, CpuOpenVdbAndGpuSdfAllMeetTheTargets) {
     const SampleResult result = sample_mesh(shared_context(), mesh, settings);
     const bool cpu = backend == SdfBackend::Cpu || backend == SdfBackend::OpenVdb ||
                      (backend == SdfBackend::Auto && shared_context().software());
-    EXPECT_EQ(result.sdf_on_cpu, cpu);
+    EXPECT_EQ(result.sdf_on_cpu(), cpu);
     EXPECT_EQ(result.sdf_path == SdfPath::OpenVdb, backend == SdfBackend::OpenVdb);  // auto: exact at this size
     EXPECT_GT(result.field.band_voxels, 0u);
     EXPECT_GT(result.stages.sdf, 0.0);
@@ -440,7 +440,7 @@ TEST(SampleMesh, CpuBackendNeedsNoGlContext) {
     settings.count = 300;
     settings.backend = backend;
     const SampleResult result = sample_mesh(nullptr, mesh, settings);
-    EXPECT_TRUE(result.sdf_on_cpu);
+    EXPECT_TRUE(result.sdf_on_cpu());
     EXPECT_TRUE(result.relax_on_cpu);
     EXPECT_TRUE(result.certificate_on_cpu);
     expect_meets_quality_targets(mesh, result, settings.density);
