@@ -2,7 +2,7 @@
 // the GPU pipeline), written as CSV files that bench/validation/report.py plots and compares with
 // the literature. Usage:
 //   tetrasand_validation_runs OUT_DIR [restitution|repose|silo
-//   [SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|column [R0_M,R0_M,...]|all|
+//   [SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|forces-gentle [BATCHES]|column [R0_M,R0_M,...]|all|
 //   agreement[-heap|-silo|-bed]|
 //                                      oedometer[-tetrahedra|-spheres] [SCENE]]
 // `all` is the physical report: restitution and repose take minutes, the column collapse (8 x 20,000
@@ -513,6 +513,121 @@ void forces_backed(const fs::path& out) {
                                         f.settle_time, f.fill, f.wall_seconds));
 }
 
+// A grain taken out of a world, to be put back later at another height.
+struct HeldGrain {
+  BodyDesc body;
+  std::vector<Eigen::Vector3d> offsets;
+  std::vector<double> radii;
+  std::uint16_t material = 0;
+  double bound = 0;  // m, bounding radius
+};
+
+// Takes the grains (bodies from `first_grain` on, which only emitters append) out of `world`, in
+// the order of their height; the bodies before them stay.
+std::vector<HeldGrain> take_grains(World& world, std::size_t first_grain) {
+  const Bodies& b = world.bodies;
+  const Particles& p = world.particles;
+  std::vector<HeldGrain> held;
+  for (std::size_t k = first_grain; k < b.size(); ++k) {
+    HeldGrain g;
+    g.body.position = b.position[k];
+    g.body.orientation = b.orientation[k];
+    g.body.inverse_mass = b.inverse_mass[k];
+    g.body.inverse_inertia = b.inverse_inertia[k];
+    g.bound = b.bounding_radius[k];
+    for (std::uint32_t i = b.first_particle[k]; i < b.first_particle[k] + b.particle_count[k]; ++i) {
+      g.offsets.push_back(p.offset[i]);
+      g.radii.push_back(p.radius[i]);
+    }
+    g.material = p.material[b.first_particle[k]];
+    held.push_back(std::move(g));
+  }
+  std::stable_sort(held.begin(), held.end(),
+                   [](const HeldGrain& a, const HeldGrain& c) { return a.body.position.z() < c.body.position.z(); });
+  if (first_grain < b.size()) {
+    const std::size_t particles = b.first_particle[first_grain];
+    Bodies& bodies = world.bodies;
+    for (auto* v : {&bodies.first_particle, &bodies.particle_count}) v->resize(first_grain);
+    bodies.position.resize(first_grain);
+    bodies.orientation.resize(first_grain);
+    bodies.linear_velocity.resize(first_grain);
+    bodies.angular_velocity.resize(first_grain);
+    bodies.inverse_mass.resize(first_grain);
+    bodies.inverse_inertia.resize(first_grain);
+    bodies.bounding_radius.resize(first_grain);
+    bodies.motion.resize(first_grain);
+    Particles& q = world.particles;
+    q.body.resize(particles);
+    q.offset.resize(particles);
+    q.radius.resize(particles);
+    q.material.resize(particles);
+    world.springs = {};
+  }
+  return held;
+}
+
+// The silo's own fill (80,000 grains, seed 17, on the unbacked plate) released gently
+// (bench/validation/forces_gentle_criteria.md): its lattice cut in height order into `batches`,
+// each moved down to start one bounding radius above the pile's top and released once the pile
+// before it has settled, damped from when its top grain would land, with the single lattice's time
+// step. contact_forces.csv and silo_fill.csv, as the silo run writes them, and gentle_batches.csv.
+void forces_gentle(const fs::path& out, std::size_t batches) {
+  Scene scene = reference("silo_mankoc.toml");
+  World world = make_world(scene);
+  CpuStepper stepper = tall_scene_stepper(scene, world);  // dt for the 4 m fall: the same step as the silo's fill
+  const std::vector<HeldGrain> held = take_grains(world, fixture_bodies(scene, world));
+  const double g = scene.gravity.norm();
+  auto fill_height = [&] {
+    std::vector<double> tops;
+    for (std::size_t b = 0; b < world.bodies.size(); ++b) {
+      if (world.bodies.motion[b] == MotionType::Dynamic) tops.push_back(world.bodies.position[b].z());
+    }
+    return tops.empty() ? 0.0 : percentile(tops, 0.95);
+  };
+  std::fprintf(stderr, "gentle silo fill: %zu grains in %zu batches, dt = %.3g s\n", held.size(), batches,
+               stepper.settings().dt);
+  const auto wall = std::chrono::steady_clock::now();
+  std::string csv = "batch,grains,drop_m,impact_speed_m_s,settle_s,fill_m,wall_s\n";
+  double settle_time = 0;
+  for (std::size_t k = 0; k < batches; ++k) {
+    const std::size_t from = held.size() * k / batches, to = held.size() * (k + 1) / batches;
+    double pile_top = 0;  // m: the plate's sphere tops are at z = 0
+    for (std::size_t b = 0; b < world.bodies.size(); ++b) {
+      if (world.bodies.motion[b] != MotionType::Dynamic) continue;
+      pile_top = std::max(pile_top, world.bodies.position[b].z() + world.bodies.bounding_radius[b]);
+    }
+    double lowest = 1e300, highest = -1e300;
+    for (std::size_t i = from; i < to; ++i) {
+      lowest = std::min(lowest, held[i].body.position.z() - held[i].bound);
+      highest = std::max(highest, held[i].body.position.z() + held[i].bound);
+    }
+    const double shift = std::min(0.0, pile_top + held[from].bound - lowest);  // never up
+    for (std::size_t i = from; i < to; ++i) {
+      BodyDesc body = held[i].body;
+      body.position.z() += shift;
+      add_body(world, body, held[i].offsets, held[i].radii, held[i].material);
+    }
+    stepper.reset_energy_reference(world);
+    const double drop = std::max(0.0, highest + shift - pile_top);  // m: the batch's highest grain to the pile's top
+    SettleDamping damping;
+    damping.from_time = std::sqrt(2 * drop / g);
+    const std::string label = fmt::format("gentle fill batch {}/{}", k + 1, batches);
+    settle_time += run_until_rest(stepper, world, damping.from_time + 0.2, scene.simulation.duration, 0.02, label,
+                                  fill_height, damping);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall).count();
+    std::fprintf(stderr, "%s: %zu grains dropped up to %.3f m (%.2f m/s), fill %.4f m, %.0f s wall\n", label.c_str(),
+                 to - from, drop, std::sqrt(2 * g * drop), fill_height(), seconds);
+    csv += fmt::format("{},{},{:.4f},{:.3f},{:.3f},{:.4f},{:.0f}\n", k + 1, to - from, drop, std::sqrt(2 * g * drop),
+                       settle_time, fill_height(), seconds);
+    ts::write_file_atomically(out / "gentle_batches.csv", csv);  // after each batch: a stopped run keeps its rows
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall).count();
+  write_contact_forces(world, stepper.settings(), out / "contact_forces.csv");
+  ts::write_file_atomically(out / "silo_fill.csv",
+                            fmt::format("grains,settle_s,fill_m,settle_wall_s\n{},{:.3f},{:.4f},{:.0f}\n", held.size(),
+                                        settle_time, fill_height(), seconds));
+}
+
 // Granular column collapse (reference/column.toml scaled up): a column of `count` grains settled in
 // a smooth cylinder of radius r0 (m) on a rough floor, then released by removing the cylinder; both
 // phases run until the grains are at rest. H0 is the settled column's height, R_inf the deposit's
@@ -668,7 +783,7 @@ std::vector<double> radii_list(const std::string& text) {
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|forces "
+                 "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|forces-gentle [BATCHES]|forces "
                  "[GRAINS]|column [R0,R0,...]|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres] [SCENE]]\n",
                  argv[0]);
     return 2;
@@ -683,6 +798,7 @@ int main(int argc, char** argv) {
     if (what == "silo" || what == "all") silo(out, what == "silo" && argc > 3 ? fs::path(argv[3]) : fs::path());
     if (what == "forces" || what == "all") forces(out, what == "forces" && argc > 3 ? std::stoul(argv[3]) : 30000);
     if (what == "forces-backed") forces_backed(out);
+    if (what == "forces-gentle") forces_gentle(out, argc > 3 ? std::stoul(argv[3]) : 8);
     if (what == "silo-spheres") silo(out, {}, true);
     if (what == "silo-lammps") silo_lammps(out, false);
     if (what == "silo-spheres-lammps") silo_lammps(out, true);
