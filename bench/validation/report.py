@@ -656,6 +656,7 @@ AGREEMENT_START, AGREEMENT_END = "<!-- section: agreement -->\n", "<!-- end: agr
 OEDOMETER_START, OEDOMETER_END = "<!-- section: oedometer -->\n", "<!-- end: oedometer -->\n"  # bench/validation/oedometer.py
 # Controlled runs written up by hand beside the sections they test (their commands are in the text):
 FORCES_BACKED_START, FORCES_BACKED_END = "<!-- section: forces-backed -->\n", "<!-- end: forces-backed -->\n"
+FORCES_GENTLE_START, FORCES_GENTLE_END = "<!-- section: forces-gentle -->\n", "<!-- end: forces-gentle -->\n"
 SILO_SPHERES_START, SILO_SPHERES_END = "<!-- section: silo-spheres -->\n", "<!-- end: silo-spheres -->\n"
 SILO_LAMMPS_START, SILO_LAMMPS_END = "<!-- section: silo-lammps -->\n", "<!-- end: silo-lammps -->\n"  # silo_lammps.py
 OEDOMETER_STIFF_START, OEDOMETER_STIFF_END = "<!-- section: oedometer-stiff -->\n", "<!-- end: oedometer-stiff -->\n"
@@ -720,7 +721,8 @@ def main():
              kept(SILO_LAMMPS_START, SILO_LAMMPS_END, "bench/validation/silo_lammps.py BIN OUT spheres"),
              section(forces, ["contact_forces.csv", "silo_fill.csv"],
                      "Normal contact forces in a sand pile at rest in a cylinder"),
-             kept(FORCES_BACKED_START, FORCES_BACKED_END, "tetrasand_validation_runs OUT forces-backed")]
+             kept(FORCES_BACKED_START, FORCES_BACKED_END, "tetrasand_validation_runs OUT forces-backed"),
+             kept(FORCES_GENTLE_START, FORCES_GENTLE_END, "tetrasand_validation_runs OUT forces-gentle")]
     fill = os.path.join(run, "silo_fill.csv")
     silo_grains = int(np.genfromtxt(fill, delimiter=",", names=True)["grains"]) if os.path.exists(fill) else 0
     columns = os.path.join(run, "column.csv")
