@@ -216,7 +216,7 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
          "--sdf-backend", o.sdf_backend,
          "Where the SDF is built: gpu (scan conversion), cpu (exact distance, all cores), openvdb "
          "(OpenVDB's meshToVolume, all cores: approximate, closed meshes) or auto (on a software renderer "
-         "or without GL: cpu for grids up to 2^23 voxels, openvdb above; else gpu)")
+         "or without GL: cpu; else gpu)")
       ->check(CLI::IsMember({"auto", "gpu", "cpu", "openvdb"}))
       ->capture_default_str();
   cmd->add_option(

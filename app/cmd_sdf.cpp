@@ -82,8 +82,8 @@ void add_options(CLI::App* cmd, Options& o) {
       ->check(finite());
   cmd->add_option(
          "--backend", o.backend,
-         "gpu: scan conversion on the GL device; cpu: the exact SDF (CGAL AABB tree, double precision, "
-         "TBB on every core; no GL device needed). On llvmpipe cpu is faster in most runs of "
+         "gpu: scan conversion on the GL device; cpu: the exact SDF (a sweep over the triangles, double "
+         "precision, TBB on every core; no GL device needed). On llvmpipe cpu is faster in most runs of "
          "docs/benchmarks.md (SDF)")
       ->check(CLI::IsMember({"gpu", "cpu"}))
       ->capture_default_str();
@@ -281,7 +281,7 @@ sdf::ScanConvertResult gpu_level_set(const Options& o, const GlobalOptions& glob
 // the flood-filled level set. *device: what ran it.
 sdf::ScanConvertResult cpu_level_set(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
                                      std::string* device) {
-  *device = fmt::format("CPU exact SDF (CGAL AABB tree, double precision, {} TBB threads)",
+  *device = fmt::format("CPU exact SDF (triangle sweep, double precision, {} TBB threads)",
                         tbb::this_task_arena::max_concurrency());
   const auto start = std::chrono::steady_clock::now();
   sdf::ScanConvertResult result;

@@ -1,5 +1,5 @@
 // SDF construction three ways on the same mesh, voxel size and band, in one run: tetrasand's GPU scan
-// conversion, the CPU exact SDF (CGAL AABB tree, TBB on all cores) and OpenVDB's meshToLevelSet (all
+// conversion, the CPU exact SDF (triangle sweep, double precision, TBB on all cores) and OpenVDB's meshToLevelSet (all
 // cores), with the error of the GPU path and of OpenVDB against exact distance. Usage:
 //   tetrasand_bench_sdf CASE... [--band 3] [--csv FILE] [--markdown] [--openvdb-ridges]
 // --openvdb-ridges also runs OpenVDB without its renormalisation pass and prints, per case, both

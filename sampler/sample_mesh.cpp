@@ -256,7 +256,7 @@ SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& e
 }
 
 // Without a GL context the field can only come from the CPU.
-SdfPath choose_sdf_path(const gpu::Context* context, const sdf::GridSpec& spec, const SampleSettings& settings) {
+SdfPath choose_sdf_path(const gpu::Context* context, const SampleSettings& settings) {
   switch (settings.sdf_backend) {
     case SdfBackend::Cpu:
       return SdfPath::Exact;
@@ -271,9 +271,7 @@ SdfPath choose_sdf_path(const gpu::Context* context, const sdf::GridSpec& spec, 
     case SdfBackend::Auto:
       break;
   }
-  if (context != nullptr && !context->software()) return SdfPath::Scan;
-  const bool large = spec.voxel_count() > kCpuSdfMaxVoxels;
-  return large && settings.sign == sdf::SignMethod::Pseudonormal ? SdfPath::OpenVdb : SdfPath::Exact;
+  return context != nullptr && !context->software() ? SdfPath::Scan : SdfPath::Exact;
 }
 
 bool relax_on_cpu(const gpu::Context* context, const SampleSettings& settings) {
@@ -332,7 +330,7 @@ using RelaxField = std::variant<sdf::SparseField, sdf::HostField>;
 RelaxField make_field(gpu::Context* context, const TriangleMesh& mesh, const sdf::ExactDistance& exact,
                       const sdf::GridSpec& spec, const SamplingPlan& plan, const SampleSettings& settings,
                       SampleResult& result) {
-  result.sdf_path = choose_sdf_path(context, spec, settings);
+  result.sdf_path = choose_sdf_path(context, settings);
   const openvdb::FloatGrid::Ptr grid = band_level_set(context, mesh, exact, spec, settings, result);
   // The CPU reads the level set's own index space, the GPU a moved copy (sdf::gpu_index_shift says why).
   sdf::NanoGrid nano = result.relax_on_cpu ? sdf::to_nanovdb(*grid) : sdf::to_gpu_nanovdb(*grid, spec);

@@ -28,15 +28,13 @@
 namespace ts::sampler {
 
 // Where the SDF is built: by GPU scan conversion (sdf/scan_convert.h), on the CPU by exact distance
-// (sdf::exact_sdf_grid: CGAL AABB tree, TBB), or on the CPU by OpenVDB's meshToVolume
+// (sdf::exact_sdf_grid: a sweep over the triangles, TBB), or on the CPU by OpenVDB's meshToVolume
 // (sdf::openvdb_index_level_set; approximate, about 0.01 voxel on average and a few wrong signs next to
-// the surface, docs/benchmarks.md "SDF"; closed meshes only). Auto: on a software renderer or without a
-// GL context (llvmpipe runs the scan conversion's geometry and fragment work on the same cores), the
-// exact path for grids up to kCpuSdfMaxVoxels and OpenVDB above (the 1M-particle bunny's band in 23 s
-// against 180 s of scan conversion on llvmpipe; docs/benchmarks.md, "Sampling"), unless the sign is by
-// winding number; the GPU scan otherwise.
+// the surface, docs/benchmarks.md "SDF"; closed meshes only). Auto: the exact CPU path on a software
+// renderer or without a GL context (llvmpipe runs the scan conversion's geometry and fragment work on
+// the same cores; the exact sweep is also faster than OpenVDB at every size measured, the 1M-particle
+// bunny's band in 12 s; docs/benchmarks.md, "sample fixed costs"), the GPU scan otherwise.
 enum class SdfBackend { Auto, Gpu, Cpu, OpenVdb };
-inline constexpr std::size_t kCpuSdfMaxVoxels = std::size_t{1} << 23;
 // What built a run's field.
 enum class SdfPath { Scan, Exact, OpenVdb };
 // "gpu", "cpu", "openvdb": the --sdf-backend value that names the path.

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <cmath>
+#include <limits>
 
 namespace ts::sdf {
 namespace {
@@ -57,6 +58,31 @@ void classify(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::V
   }
 }
 
+// The point of triangle (a, b, c) closest to p, by the Voronoi regions of its vertices, edges and
+// face (Ericson, Real-Time Collision Detection, 5.1.5), in double. A degenerate triangle falls
+// into a vertex or edge region, so no division by its zero area happens.
+Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+  const double denom = 1.0 / (va + vb + vc);
+  if (!std::isfinite(denom)) return a;  // all three vertices coincide
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
 }  // namespace
 
 struct ExactDistance::Tree {
@@ -86,6 +112,17 @@ ClosestPoint ExactDistance::closest(const Eigen::Vector3d& p) const {
   out.triangle = static_cast<std::uint32_t>(hit.second - tree_->triangles.cbegin());
   const auto& t = mesh_.triangles[out.triangle];
   classify(mesh_.vertices[t[0]], mesh_.vertices[t[1]], mesh_.vertices[t[2]], out.point, out);
+  return out;
+}
+
+ClosestPoint ExactDistance::closest_on(const Eigen::Vector3d& p, std::uint32_t triangle) const {
+  const auto& t = mesh_.triangles[triangle];
+  const Eigen::Vector3d &a = mesh_.vertices[t[0]], &b = mesh_.vertices[t[1]], &c = mesh_.vertices[t[2]];
+  ClosestPoint out;
+  out.point = closest_on_triangle(p, a, b, c);
+  out.distance = (p - out.point).norm();
+  out.triangle = triangle;
+  classify(a, b, c, out.point, out);
   return out;
 }
 
@@ -135,31 +172,66 @@ struct BandVoxel {
   float value;
 };
 
-// The band voxels of slice k: candidates are the voxels under the grown xy boxes of the slice's
-// triangles; each gets one closest-point query.
+// The band voxels of slice k, by a sweep over the slice's triangles (the CPU form of the scan
+// conversion): each triangle visits the voxels of the slice within the band of its plane and under
+// its xy box grown by the band, keeping the nearest triangle of each voxel; then each voxel's
+// closest point on that triangle gives the distance, the feature and the sign. Equal distances go
+// to the lowest triangle index (the slice's triangles are in index order), so threads do not
+// change the result.
 std::vector<BandVoxel> slice_band(const ExactDistance& exact, const TriangleMesh& mesh, const GridSpec& spec,
                                   const std::vector<std::uint32_t>& triangles, int k, double band, SignMethod sign) {
   const int nx = spec.dims.x(), ny = spec.dims.y();
-  std::vector<std::uint8_t> candidate(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), 0);
+  const std::size_t row = static_cast<std::size_t>(nx);
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  std::vector<double> nearest_sq(row * static_cast<std::size_t>(ny), band * band);
+  std::vector<std::uint32_t> nearest(nearest_sq.size(), kNone);
+  const double z = spec.voxel_center(0, 0, k).z();
   for (std::uint32_t t : triangles) {
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = Eigen::Vector3d::Constant(-INFINITY);
-    for (auto v : mesh.triangles[t]) {
-      lo = lo.cwiseMin(mesh.vertices[v]);
-      hi = hi.cwiseMax(mesh.vertices[v]);
+    const Eigen::Vector3d& a = mesh.vertices[mesh.triangles[t][0]];
+    const Eigen::Vector3d& b = mesh.vertices[mesh.triangles[t][1]];
+    const Eigen::Vector3d& c = mesh.vertices[mesh.triangles[t][2]];
+    const Eigen::Vector3d lo = a.cwiseMin(b).cwiseMin(c) - Eigen::Vector3d::Constant(band);
+    const Eigen::Vector3d hi = a.cwiseMax(b).cwiseMax(c) + Eigen::Vector3d::Constant(band);
+    const Eigen::Vector3d vlo = spec.to_voxel(lo), vhi = spec.to_voxel(hi);
+    const int i0 = std::max(0, static_cast<int>(std::ceil(vlo.x()))), i1 = std::min(nx - 1, static_cast<int>(std::floor(vhi.x())));
+    const int j0 = std::max(0, static_cast<int>(std::ceil(vlo.y()))), j1 = std::min(ny - 1, static_cast<int>(std::floor(vhi.y())));
+    // Only voxels within the band of the triangle's plane can be within the band of the triangle:
+    // on each row that is an interval of x (when the plane is not parallel to x), which keeps a
+    // large slanted triangle from visiting its whole box.
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    const double length = n.norm();
+    const bool prune = length > 0 && std::abs(n.x()) > 1e-3 * length;
+    if (prune) n /= length;
+    for (int j = j0; j <= j1; ++j) {
+      int from = i0, to = i1;
+      if (prune) {
+        const double y = spec.voxel_center(0, j, k).y();
+        // n . (p - a) = 0 at x0; |n . (p - a)| < band for |x - x0| < band / |n.x|.
+        const double x0 = a.x() - (n.y() * (y - a.y()) + n.z() * (z - a.z())) / n.x();
+        const double reach = band / std::abs(n.x());
+        const Eigen::Vector3d e = spec.to_voxel(Eigen::Vector3d(x0, y, z));
+        const double half = reach / spec.voxel_size;
+        from = std::max(from, static_cast<int>(std::ceil(e.x() - half)) - 1);
+        to = std::min(to, static_cast<int>(std::floor(e.x() + half)) + 1);
+      }
+      for (int i = from; i <= to; ++i) {
+        const Eigen::Vector3d p = spec.voxel_center(i, j, k);
+        const double d_sq = (closest_on_triangle(p, a, b, c) - p).squaredNorm();
+        const std::size_t v = static_cast<std::size_t>(i) + row * static_cast<std::size_t>(j);
+        if (d_sq < nearest_sq[v]) {
+          nearest_sq[v] = d_sq;
+          nearest[v] = t;
+        }
+      }
     }
-    const Eigen::Vector3d a = spec.to_voxel(lo - Eigen::Vector3d::Constant(band));
-    const Eigen::Vector3d b = spec.to_voxel(hi + Eigen::Vector3d::Constant(band));
-    const int i0 = std::max(0, static_cast<int>(std::ceil(a.x()))), i1 = std::min(nx - 1, static_cast<int>(std::floor(b.x())));
-    const int j0 = std::max(0, static_cast<int>(std::ceil(a.y()))), j1 = std::min(ny - 1, static_cast<int>(std::floor(b.y())));
-    for (int j = j0; j <= j1; ++j)
-      for (int i = i0; i <= i1; ++i) candidate[static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * static_cast<std::size_t>(j)] = 1;
   }
   std::vector<BandVoxel> out;
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
-      if (!candidate[static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * static_cast<std::size_t>(j)]) continue;
+      const std::uint32_t t = nearest[static_cast<std::size_t>(i) + row * static_cast<std::size_t>(j)];
+      if (t == kNone) continue;
       const Eigen::Vector3d p = spec.voxel_center(i, j, k);
-      const ClosestPoint c = exact.closest(p);
+      const ClosestPoint c = exact.closest_on(p, t);
       if (!(c.distance < band)) continue;
       out.push_back({openvdb::Coord(spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k),
                      static_cast<float>(exact.signed_distance(p, c, sign))});

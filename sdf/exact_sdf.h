@@ -1,7 +1,10 @@
 #pragma once
-// The accuracy end of the SDF trade and the ground truth in tests: exact closest points through a
-// CGAL AABB tree in double precision, signed by angle-weighted pseudonormals or by the generalised
-// winding number (robust to holes), TBB-parallel over the grid.
+// The accuracy end of the SDF trade and the ground truth in tests: exact closest points in double
+// precision, signed by angle-weighted pseudonormals or by the generalised winding number (robust to
+// holes). Single points go through a CGAL AABB tree; a grid is swept triangle by triangle (the
+// CPU form of the scan conversion: each triangle visits the voxels within the band of its plane),
+// TBB-parallel over z slices, which gives the tree's field 4-11x faster (docs/benchmarks.md,
+// "sample fixed costs").
 #include <openvdb/openvdb.h>
 
 #include <Eigen/Core>
@@ -34,6 +37,8 @@ class ExactDistance {
   ExactDistance& operator=(const ExactDistance&) = delete;
 
   ClosestPoint closest(const Eigen::Vector3d& p) const;
+  // The closest point to p on one given triangle of the mesh, its feature classified as closest() does.
+  ClosestPoint closest_on(const Eigen::Vector3d& p, std::uint32_t triangle) const;
   double signed_distance(const Eigen::Vector3d& p, SignMethod method) const;
   // The same, reusing a closest point already found for p.
   double signed_distance(const Eigen::Vector3d& p, const ClosestPoint& c, SignMethod method) const;
@@ -54,7 +59,9 @@ class ExactDistance {
 
 // Every voxel with |d| < band * h, in world units, as an OpenVDB level set (background band * h,
 // transform createLinearTransform(h), coordinates index_offset + (i, j, k), name "surface"); voxels
-// outside the band get +-band by a signed flood fill. TBB-parallel over z slices.
+// outside the band get +-band by a signed flood fill. TBB-parallel over z slices; each slice keeps
+// the nearest of its triangles per voxel (equal distances: the lowest index), so the field does not
+// depend on the thread count.
 openvdb::FloatGrid::Ptr exact_sdf_grid(const TriangleMesh& mesh, const GridSpec& spec, double band_voxels,
                                        SignMethod sign);
 // The same from a tree already built over `mesh` (`exact`'s own mesh). index_space: transform of voxel

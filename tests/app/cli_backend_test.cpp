@@ -172,7 +172,7 @@ TEST(SdfBackend, NamesTheDeviceAndTheTimeAndTheCpuPathGivesTheSameBand) {
             0)
       << cpu;
   EXPECT_TRUE(
-      std::regex_search(cpu, std::regex(R"(\ndevice: CPU exact SDF \(CGAL AABB tree, double precision, \d+ )"
+      std::regex_search(cpu, std::regex(R"(\ndevice: CPU exact SDF \(triangle sweep, double precision, \d+ )"
                                         R"(TBB threads\); exact SDF \d+\.\d{3} s\n)")))
       << cpu;
   EXPECT_TRUE(std::filesystem::exists(dir / "cpu.vdb"));

@@ -1,5 +1,6 @@
 #include "sdf/exact_sdf.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -111,6 +112,59 @@ TEST(ExactSdf, DenseFieldIsTheBandClampedWithFloodFilledSigns) {
         const double expected = std::clamp(d, -band, band);
         ASSERT_NEAR(dense[spec.linear_index(i, j, k)], expected, 1e-6 * spec.voxel_size) << i << " " << j << " " << k;
       }
+}
+
+// The grid is built by a sweep over the triangles (each visits the voxels within the band of its
+// plane); single points by the AABB tree. Large slanted faces (whose boxes hold far more voxels than
+// their band), faces parallel and perpendicular to x, and degenerate triangles must all give the
+// tree's distance and sign at every voxel.
+TEST(ExactSdf, TriangleSweepGivesTheTreesDistanceAtEveryVoxel) {
+  TriangleMesh base = test::box_mesh({0, 0, 0}, {1, 1, 1});
+  const auto v = static_cast<std::uint32_t>(base.vertices.size());
+  base.vertices.push_back({0.2, 0.3, 1.0});
+  base.vertices.push_back({0.4, 0.3, 1.0});
+  base.vertices.push_back({0.6, 0.3, 1.0});
+  base.triangles.push_back({v, v + 1, v + 2});  // collinear: zero area
+  base.triangles.push_back({v, v, v + 1});      // a repeated corner
+  base.triangles.push_back({v, v, v});          // a point
+  const Eigen::Quaterniond turns[] = {Eigen::Quaterniond::Identity(),
+                                      Eigen::Quaterniond(0.9, 0.3, -0.2, 0.25).normalized()};
+  for (const Eigen::Quaterniond& turn : turns) {
+    TriangleMesh mesh = base;
+    for (Eigen::Vector3d& x : mesh.vertices) x = turn * x;
+    SdfSettings settings;
+    settings.resolution = 40;
+    settings.padding = 5;
+    const GridSpec spec = make_grid(bounding_box(mesh), settings);
+    const double band_voxels = 3.0, band = band_voxels * spec.voxel_size;
+    const std::vector<float> dense = exact_sdf_dense(mesh, spec, band_voxels, SignMethod::Pseudonormal);
+    const ExactDistance exact(mesh);
+    std::size_t in_band = 0;
+    for (int k = 0; k < spec.dims.z(); ++k)
+      for (int j = 0; j < spec.dims.y(); ++j)
+        for (int i = 0; i < spec.dims.x(); ++i) {
+          const double d = exact.signed_distance(spec.voxel_center(i, j, k), SignMethod::Pseudonormal);
+          in_band += std::abs(d) < band;
+          ASSERT_NEAR(dense[spec.linear_index(i, j, k)], std::clamp(d, -band, band), 1e-6 * spec.voxel_size)
+              << i << " " << j << " " << k << " turned " << turn.coeffs().transpose();
+        }
+    EXPECT_GT(in_band, 1000u);
+  }
+}
+
+TEST(ExactDistance, ClosestOnAGivenTriangleIsTheTreesAnswerOnTheTreesTriangle) {
+  const TriangleMesh mesh = test::icosphere(0.5, 2);
+  const ExactDistance exact(mesh);
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(-0.8, 0.8);
+  for (int k = 0; k < 500; ++k) {
+    const Eigen::Vector3d p(u(rng), u(rng), u(rng));
+    const ClosestPoint tree = exact.closest(p);
+    const ClosestPoint given = exact.closest_on(p, tree.triangle);
+    EXPECT_NEAR(given.distance, tree.distance, 1e-12) << p.transpose();
+    EXPECT_LT((given.point - tree.point).norm(), 1e-12) << p.transpose();
+    EXPECT_EQ(given.feature, tree.feature) << p.transpose();
+  }
 }
 
 }  // namespace
