@@ -67,7 +67,8 @@ TEST(ExactSdf, GpuScanConversionMatchesTheExactGrid) {
   }
 }
 
-TEST(ExactDistance, DegenerateTrianglesGiveFiniteDistancesAndSigns) {
+// The unit box with three degenerate triangles on its top face: collinear, a repeated corner, a point.
+TriangleMesh box_with_degenerate_triangles() {
   TriangleMesh mesh = test::box_mesh({0, 0, 0}, {1, 1, 1});
   const auto v = static_cast<std::uint32_t>(mesh.vertices.size());
   mesh.vertices.push_back({0.2, 0.3, 1.0});
@@ -76,6 +77,11 @@ TEST(ExactDistance, DegenerateTrianglesGiveFiniteDistancesAndSigns) {
   mesh.triangles.push_back({v, v + 1, v + 2});  // collinear: zero area
   mesh.triangles.push_back({v, v, v + 1});      // a repeated corner
   mesh.triangles.push_back({v, v, v});          // a point
+  return mesh;
+}
+
+TEST(ExactDistance, DegenerateTrianglesGiveFiniteDistancesAndSigns) {
+  TriangleMesh mesh = box_with_degenerate_triangles();
   const ExactDistance exact(mesh);
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> u(-0.5, 1.5);
@@ -119,14 +125,7 @@ TEST(ExactSdf, DenseFieldIsTheBandClampedWithFloodFilledSigns) {
 // their band), faces parallel and perpendicular to x, and degenerate triangles must all give the
 // tree's distance and sign at every voxel.
 TEST(ExactSdf, TriangleSweepGivesTheTreesDistanceAtEveryVoxel) {
-  TriangleMesh base = test::box_mesh({0, 0, 0}, {1, 1, 1});
-  const auto v = static_cast<std::uint32_t>(base.vertices.size());
-  base.vertices.push_back({0.2, 0.3, 1.0});
-  base.vertices.push_back({0.4, 0.3, 1.0});
-  base.vertices.push_back({0.6, 0.3, 1.0});
-  base.triangles.push_back({v, v + 1, v + 2});  // collinear: zero area
-  base.triangles.push_back({v, v, v + 1});      // a repeated corner
-  base.triangles.push_back({v, v, v});          // a point
+  const TriangleMesh base = box_with_degenerate_triangles();
   const Eigen::Quaterniond turns[] = {Eigen::Quaterniond::Identity(),
                                       Eigen::Quaterniond(0.9, 0.3, -0.2, 0.25).normalized()};
   for (const Eigen::Quaterniond& turn : turns) {
