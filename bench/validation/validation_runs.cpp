@@ -279,6 +279,15 @@ void write_contact_forces(const World& world, const StepSettings& settings, cons
   ts::write_file_atomically(file, csv);
 }
 
+// m: a fill's height, the 95th percentile of its grains' centre heights (0 without grains).
+double fill_height_of(const World& world) {
+  std::vector<double> tops;
+  for (std::size_t b = 0; b < world.bodies.size(); ++b) {
+    if (world.bodies.motion[b] == MotionType::Dynamic) tops.push_back(world.bodies.position[b].z());
+  }
+  return tops.empty() ? 0.0 : percentile(tops, 0.95);
+}
+
 // A silo scene's fill (its first emitter) dropped as a lattice and settled on the closed plate,
 // damped once the lattice has landed; its contact forces go to `forces_file`.
 struct SettledFill {
@@ -300,13 +309,7 @@ SettledFill settle_fill(Scene& scene, const std::string& label, const fs::path& 
   f.grains = scene.emitters.at(0).count;
   std::fprintf(stderr, "%s: %zu grains, dt = %.3g s, settling\n", label.c_str(), f.grains, f.settings.dt);
   const auto wall = std::chrono::steady_clock::now();
-  auto fill_height = [&] {
-    std::vector<double> tops;
-    for (std::size_t b = 0; b < f.world.bodies.size(); ++b) {
-      if (f.world.bodies.motion[b] == MotionType::Dynamic) tops.push_back(f.world.bodies.position[b].z());
-    }
-    return percentile(tops, 0.95);
-  };
+  auto fill_height = [&] { return fill_height_of(f.world); };
   f.settle_time = run_until_rest(settle, f.world, damping.from_time + 0.2, scene.simulation.duration, 0.02,
                                  label + " settle", fill_height, damping);
   f.fill = fill_height();
@@ -544,25 +547,8 @@ std::vector<HeldGrain> take_grains(World& world, std::size_t first_grain) {
   }
   std::stable_sort(held.begin(), held.end(),
                    [](const HeldGrain& a, const HeldGrain& c) { return a.body.position.z() < c.body.position.z(); });
-  if (first_grain < b.size()) {
-    const std::size_t particles = b.first_particle[first_grain];
-    Bodies& bodies = world.bodies;
-    for (auto* v : {&bodies.first_particle, &bodies.particle_count}) v->resize(first_grain);
-    bodies.position.resize(first_grain);
-    bodies.orientation.resize(first_grain);
-    bodies.linear_velocity.resize(first_grain);
-    bodies.angular_velocity.resize(first_grain);
-    bodies.inverse_mass.resize(first_grain);
-    bodies.inverse_inertia.resize(first_grain);
-    bodies.bounding_radius.resize(first_grain);
-    bodies.motion.resize(first_grain);
-    Particles& q = world.particles;
-    q.body.resize(particles);
-    q.offset.resize(particles);
-    q.radius.resize(particles);
-    q.material.resize(particles);
-    world.springs = {};
-  }
+  const std::vector<std::uint32_t> owner = p.body;
+  world = without_particles(world, [&](std::size_t i) { return owner[i] < first_grain; });
   return held;
 }
 
@@ -577,13 +563,7 @@ void forces_gentle(const fs::path& out, std::size_t batches) {
   CpuStepper stepper = tall_scene_stepper(scene, world);  // dt for the 4 m fall: the same step as the silo's fill
   const std::vector<HeldGrain> held = take_grains(world, fixture_bodies(scene, world));
   const double g = scene.gravity.norm();
-  auto fill_height = [&] {
-    std::vector<double> tops;
-    for (std::size_t b = 0; b < world.bodies.size(); ++b) {
-      if (world.bodies.motion[b] == MotionType::Dynamic) tops.push_back(world.bodies.position[b].z());
-    }
-    return tops.empty() ? 0.0 : percentile(tops, 0.95);
-  };
+  auto fill_height = [&] { return fill_height_of(world); };
   std::fprintf(stderr, "gentle silo fill: %zu grains in %zu batches, dt = %.3g s\n", held.size(), batches,
                stepper.settings().dt);
   const auto wall = std::chrono::steady_clock::now();
