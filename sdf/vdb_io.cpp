@@ -21,6 +21,7 @@
 #include "core/allocation_cap.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "sdf/vdb_layout.h"
 
 namespace ts::sdf {
 namespace {
@@ -72,7 +73,13 @@ enum ReaderExit : int { kGridsStreamed = 0, kBadFile = 3, kReaderBug = 4 };
 
 }  // namespace
 
-openvdb::GridPtrVecPtr detail::read_grids_in_this_process(const std::filesystem::path& path) {
+openvdb::GridPtrVecPtr detail::read_grids_in_this_process(const std::filesystem::path& path,
+                                                          UncheckedGrids unchecked) {
+  // Every length, count and chunk OpenVDB's reader would trust, compared with the file first: the
+  // reader overruns its buffers on some broken files (fuzz/findings/README.md).
+  const VdbLayout layout = check_vdb_layout(path);
+  if (!layout.complete() && unchecked == UncheckedGrids::Refuse)
+    throw InputError(path, "holds " + layout.unchecked + ", whose layout tetrasand's check does not cover");
   std::error_code ec;
   // No single allocation of a sound read comes near the file's size; one far above it is a length
   // field the reader trusts (core/allocation_cap.h): refuse it at once instead of reserving it.

@@ -26,11 +26,17 @@ void write_vdb(const std::filesystem::path& path, const openvdb::FloatGrid::Ptr&
 openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path);
 
 namespace detail {
-// What read_level_set's child process runs: every grid of the file, read by OpenVDB in the calling
-// process (with the allocation cap and the stream that stops at the file's end), InputError for a
-// file OpenVDB refuses. Not safe on files you do not trust; for fuzz_vdb, which needs the reader's
-// coverage in its own process.
-openvdb::GridPtrVecPtr read_grids_in_this_process(const std::filesystem::path& path);
+// What to do with a file whose layout check (sdf/vdb_layout.h) stopped at a grid type it does not
+// know (bool, mask, points): read it with OpenVDB all the same, or refuse it.
+enum class UncheckedGrids { Read, Refuse };
+
+// What read_level_set's child process runs: the file's layout checked (check_vdb_layout), then
+// every grid read by OpenVDB in the calling process (with the allocation cap and the stream that
+// stops at the file's end); InputError for a file the check or OpenVDB refuses. With
+// UncheckedGrids::Read, not safe on files you do not trust: grids the check could not walk reach
+// OpenVDB unchecked. fuzz_vdb, which needs the reader's coverage in its own process, refuses them.
+openvdb::GridPtrVecPtr read_grids_in_this_process(const std::filesystem::path& path,
+                                                  UncheckedGrids unchecked = UncheckedGrids::Read);
 }  // namespace detail
 
 }  // namespace ts::sdf
