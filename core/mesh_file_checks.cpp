@@ -1,10 +1,13 @@
 #include "core/mesh_file_checks.h"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -244,6 +247,221 @@ void check_glb_file(const std::filesystem::path& path, std::string_view bytes) {
                                          chunk, chunk_length, at, bytes.size()));
     }
     at += kChunkHeader + static_cast<std::size_t>(chunk_length);
+  }
+  const std::uint64_t json_length = read_u32_le(bytes, kHeader);
+  const std::size_t bin_at = kHeader + kChunkHeader + static_cast<std::size_t>(json_length);
+  std::optional<std::uint64_t> bin_length;
+  if (bin_at + kChunkHeader <= bytes.size() && read_u32_le(bytes, bin_at + 4) == 0x004E4942u)
+    bin_length = read_u32_le(bytes, bin_at);
+  check_gltf_json(path, bytes.substr(kHeader + kChunkHeader, static_cast<std::size_t>(json_length)),
+                  bin_length.value_or(0));
+}
+
+namespace {
+
+using Json = nlohmann::json;
+
+// glTF's sizes and offsets are JSON numbers; anything that is not a whole number from 0 to 2^53 is
+// refused. Lengths are compared in long double: exact below 2^64, and far past any buffer above.
+class GltfChecker {
+ public:
+  GltfChecker(const std::filesystem::path& path, const Json& doc) : path_(path), doc_(doc) {}
+
+  [[noreturn]] void fail(const std::string& problem) const { throw InputError(path_, "glTF: " + problem); }
+
+  const Json& array(const char* key) const {
+    static const Json kEmpty = Json::array();
+    if (!doc_.contains(key)) return kEmpty;
+    if (!doc_[key].is_array()) fail(fmt::format("'{}' is not an array", key));
+    return doc_[key];
+  }
+
+  std::uint64_t number(const Json& object, const char* key, const std::string& what,
+                       std::optional<std::uint64_t> fallback = std::nullopt) const {
+    if (!object.is_object()) fail(what + " is not an object");
+    if (!object.contains(key)) {
+      if (fallback) return *fallback;
+      fail(fmt::format("{} has no '{}'", what, key));
+    }
+    const Json& value = object[key];
+    constexpr double kLargest = 9007199254740992.0;  // 2^53
+    if (!value.is_number() || value.get<double>() < 0 || value.get<double>() > kLargest ||
+        std::floor(value.get<double>()) != value.get<double>())
+      fail(fmt::format("{}: '{}' is {}, not a whole number from 0 to 2^53", what, key, value.dump().substr(0, 40)));
+    return static_cast<std::uint64_t>(value.get<double>());
+  }
+
+  // An index into doc_[key], checked.
+  std::uint64_t index(const Json& object, const char* key, const char* into, const std::string& what) const {
+    const std::uint64_t i = number(object, key, what);
+    if (i >= array(into).size())
+      fail(fmt::format("{} refers to {}[{}]; there are {}", what, into, i, array(into).size()));
+    return i;
+  }
+
+ private:
+  const std::filesystem::path& path_;
+  const Json& doc_;
+};
+
+std::uint64_t accessor_component_bytes(const GltfChecker& gltf, std::uint64_t type, const std::string& what) {
+  switch (type) {
+    case 5120: case 5121: return 1;  // (unsigned) byte
+    case 5122: case 5123: return 2;  // (unsigned) short
+    case 5125: case 5126: return 4;  // unsigned int, float
+    default: gltf.fail(fmt::format("{} has componentType {}, which glTF 2.0 does not define", what, type));
+  }
+}
+
+std::uint64_t accessor_components(const GltfChecker& gltf, const Json& accessor, const std::string& what) {
+  static const std::map<std::string, std::uint64_t> kComponents = {
+      {"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4}, {"MAT2", 4}, {"MAT3", 9}, {"MAT4", 16}};
+  if (!accessor.contains("type") || !accessor["type"].is_string()) gltf.fail(what + " has no type");
+  const auto it = kComponents.find(accessor["type"].get<std::string>());
+  if (it == kComponents.end()) gltf.fail(fmt::format("{} has type {}", what, accessor["type"].dump().substr(0, 40)));
+  return it->second;
+}
+
+// The bytes behind a buffer: the GLB's BIN chunk, a data: URI's decoded payload, or a file beside the
+// glTF (its name percent-decoded). nullopt when the file cannot be found (assimp reports that).
+std::optional<std::uint64_t> buffer_bytes(const std::filesystem::path& path, const Json& buffer, std::size_t i,
+                                          std::optional<std::uint64_t> glb_binary) {
+  if (!buffer.contains("uri")) return i == 0 && glb_binary ? glb_binary : std::optional<std::uint64_t>(0);
+  if (!buffer["uri"].is_string()) return 0;
+  const std::string uri = buffer["uri"].get<std::string>();
+  if (uri.starts_with("data:")) {
+    const std::size_t comma = uri.find(',');
+    if (comma == std::string::npos) return 0;
+    const std::string_view payload = std::string_view(uri).substr(comma + 1);
+    if (std::string_view(uri).substr(0, comma).ends_with(";base64")) {
+      // 3 bytes for every 4 characters, padded or not; '=' padding carries none.
+      std::size_t padding = 0;
+      for (std::size_t k = payload.size(); k > 0 && payload[k - 1] == '=' && padding < 2; --k) ++padding;
+      const std::uint64_t decoded = static_cast<std::uint64_t>(payload.size()) * 3 / 4;
+      return decoded - std::min<std::uint64_t>(padding, decoded);
+    }
+    return payload.size();
+  }
+  std::string name;
+  for (std::size_t k = 0; k < uri.size(); ++k) {
+    if (uri[k] == '%' && k + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[k + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(uri[k + 2]))) {
+      name += static_cast<char>(std::stoi(uri.substr(k + 1, 2), nullptr, 16));
+      k += 2;
+    } else {
+      name += uri[k];
+    }
+  }
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path.parent_path() / name, ec);
+  if (ec) return std::nullopt;
+  return size;
+}
+
+}  // namespace
+
+void check_gltf_json(const std::filesystem::path& path, std::string_view json,
+                     std::optional<std::uint64_t> glb_binary) {
+  const Json doc = Json::parse(json, nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded()) throw InputError(path, "glTF: its JSON does not parse");
+  if (!doc.is_object()) throw InputError(path, "glTF: its JSON is not an object");
+  // glTF 1.0 (asset.version "1.x") has another layout; assimp's reader of it is left as it is.
+  if (doc.contains("asset") && doc["asset"].is_object() && doc["asset"].contains("version") &&
+      doc["asset"]["version"].is_string() && !doc["asset"]["version"].get<std::string>().starts_with("2"))
+    return;
+  const GltfChecker gltf(path, doc);
+
+  std::vector<std::uint64_t> buffer_lengths;
+  for (std::size_t i = 0; i < gltf.array("buffers").size(); ++i) {
+    const Json& buffer = gltf.array("buffers")[i];
+    const std::string what = fmt::format("buffer {}", i);
+    const std::uint64_t declared = gltf.number(buffer, "byteLength", what);
+    const auto available = buffer_bytes(path, buffer, i, glb_binary);
+    if (available && declared > *available)
+      gltf.fail(fmt::format("{} declares {} bytes; its data has {}", what, declared, *available));
+    buffer_lengths.push_back(declared);
+  }
+
+  struct View {
+    std::uint64_t length;
+    std::optional<std::uint64_t> stride;
+  };
+  std::vector<View> views;
+  for (std::size_t i = 0; i < gltf.array("bufferViews").size(); ++i) {
+    const Json& view = gltf.array("bufferViews")[i];
+    const std::string what = fmt::format("bufferView {}", i);
+    const std::uint64_t buffer = gltf.index(view, "buffer", "buffers", what);
+    const std::uint64_t offset = gltf.number(view, "byteOffset", what, 0);
+    const std::uint64_t length = gltf.number(view, "byteLength", what);
+    if (static_cast<long double>(offset) + length > buffer_lengths[buffer])
+      gltf.fail(fmt::format("{} spans bytes {} to {} of buffer {}, which has {}", what, offset,
+                            static_cast<long double>(offset) + length, buffer, buffer_lengths[buffer]));
+    std::optional<std::uint64_t> stride;
+    if (view.contains("byteStride")) stride = gltf.number(view, "byteStride", what);
+    views.push_back({length, stride});
+  }
+
+  // Where assimp copies an accessor's elements from: `count` elements of `element` bytes, `stride`
+  // apart, from `offset` into a bufferView.
+  const auto check_span = [&](const std::string& what, std::uint64_t view, std::uint64_t offset, std::uint64_t count,
+                              std::uint64_t element, std::uint64_t stride) {
+    if (count == 0) return;
+    const long double end = static_cast<long double>(offset) + static_cast<long double>(count - 1) * stride + element;
+    if (end > views[view].length)
+      gltf.fail(fmt::format("{} reads {} elements of {} bytes, {} apart, from byte {} of bufferView {}: up to byte "
+                            "{}, past its {} bytes",
+                            what, count, element, stride, offset, view, end, views[view].length));
+  };
+  for (std::size_t i = 0; i < gltf.array("accessors").size(); ++i) {
+    const Json& accessor = gltf.array("accessors")[i];
+    const std::string what = fmt::format("accessor {}", i);
+    const std::uint64_t component = accessor_component_bytes(gltf, gltf.number(accessor, "componentType", what), what);
+    const std::uint64_t element = component * accessor_components(gltf, accessor, what);
+    const std::uint64_t count = gltf.number(accessor, "count", what);
+    if (accessor.contains("bufferView")) {
+      const std::uint64_t view = gltf.index(accessor, "bufferView", "bufferViews", what);
+      check_span(what, view, gltf.number(accessor, "byteOffset", what, 0), count, element,
+                 views[view].stride.value_or(element));
+    }
+    if (accessor.contains("sparse")) {
+      const Json& sparse = accessor["sparse"];
+      const std::string sparse_what = what + "'s sparse";
+      const std::uint64_t sparse_count = gltf.number(sparse, "count", sparse_what);
+      if (!sparse.contains("indices") || !sparse.contains("values")) gltf.fail(sparse_what + " lacks indices or values");
+      const Json& indices = sparse["indices"];
+      const Json& values = sparse["values"];
+      const std::uint64_t index_bytes = accessor_component_bytes(
+          gltf, gltf.number(indices, "componentType", sparse_what + " indices"), sparse_what + " indices");
+      const std::uint64_t index_view = gltf.index(indices, "bufferView", "bufferViews", sparse_what + " indices");
+      check_span(sparse_what + " indices", index_view, gltf.number(indices, "byteOffset", sparse_what, 0),
+                 sparse_count, index_bytes, index_bytes);
+      const std::uint64_t value_view = gltf.index(values, "bufferView", "bufferViews", sparse_what + " values");
+      check_span(sparse_what + " values", value_view, gltf.number(values, "byteOffset", sparse_what, 0), sparse_count,
+                 element, element);
+    }
+  }
+
+  // The accessors the meshes name exist.
+  for (std::size_t m = 0; m < gltf.array("meshes").size(); ++m) {
+    const Json& mesh = gltf.array("meshes")[m];
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    for (std::size_t p = 0; p < mesh["primitives"].size(); ++p) {
+      const Json& primitive = mesh["primitives"][p];
+      const std::string what = fmt::format("mesh {} primitive {}", m, p);
+      if (!primitive.is_object()) gltf.fail(what + " is not an object");
+      if (primitive.contains("indices")) gltf.index(primitive, "indices", "accessors", what);
+      std::vector<const Json*> attribute_sets;
+      if (primitive.contains("attributes")) attribute_sets.push_back(&primitive["attributes"]);
+      if (primitive.contains("targets") && primitive["targets"].is_array())
+        for (const Json& target : primitive["targets"]) attribute_sets.push_back(&target);
+      for (const Json* attributes : attribute_sets) {
+        if (!attributes->is_object()) gltf.fail(what + ": attributes are not an object");
+        for (const auto& [name, value] : attributes->items()) {
+          const Json holder = {{"accessor", value}};
+          gltf.index(holder, "accessor", "accessors", what + " attribute " + name);
+        }
+      }
+    }
   }
 }
 

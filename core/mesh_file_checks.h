@@ -6,6 +6,8 @@
 // through the file (a PLY through the one PLY parser, core/ply.h), never trusting a declared count
 // for an allocation, and throw ts::InputError naming the file, the line (text files) and the problem.
 #include <filesystem>
+#include <cstdint>
+#include <optional>
 #include <string_view>
 
 namespace ts::detail {
@@ -20,6 +22,16 @@ void check_ply_file(const std::filesystem::path& path, std::string_view bytes);
 // reader trusts: the header's total length is the file's, and every chunk lies inside the file
 // (assimp read a chunk length past the end of the file into its JSON parser, an over-read ASan
 // reports; fuzz_mesh, 2026-12-04). Other versions are left to assimp.
+// Its JSON then goes through check_gltf_json with the BIN chunk's length.
 void check_glb_file(const std::filesystem::path& path, std::string_view bytes);
+
+// `json` is a glTF 2.0 document (a .gltf file, or a GLB's JSON chunk whose BIN chunk has `glb_binary`
+// bytes). Checks what assimp's glTF 2 reader copies from without looking: every buffer holds the bytes
+// it declares (the BIN chunk, a data: URI, a file beside `path`), every bufferView lies inside its
+// buffer, and every accessor (sparse ones too) reads only inside its bufferView. An accessor 5 bytes
+// past its view made assimp read past the BIN chunk's block (fuzz_mesh, 2026-12-05). The indices the
+// meshes name exist. glTF 1.0 documents are left to assimp.
+void check_gltf_json(const std::filesystem::path& path, std::string_view json,
+                     std::optional<std::uint64_t> glb_binary = std::nullopt);
 
 }  // namespace ts::detail

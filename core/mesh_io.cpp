@@ -48,25 +48,42 @@ std::string file_start(const fs::path& path, std::size_t count) {
 
 bool starts_as_ply(std::string_view bytes) { return bytes.starts_with("ply\n") || bytes.starts_with("ply\r\n"); }
 
-// OFF and PLY get a strict pass first (core/mesh_file_checks.h): assimp's readers trust declared
-// counts for allocations and clamp out-of-range indices without an error. A PLY is told by its
-// content too, whatever its name: assimp falls back to reading a file by its signature when the
-// reader its extension names refuses it, so a PLY named .glb reached assimp's PLY reader unchecked
-// and hung it (fuzz_mesh, 2026-12-04: 112 bytes, more than 2 minutes; tests/core/bad_meshes/).
+// assimp's OFF reader claims a file by its first 3 bytes, "off" in any case.
+bool starts_as_off(std::string_view bytes) {
+  if (bytes.size() < 3) return false;
+  std::string head(bytes.substr(0, 3));
+  std::transform(head.begin(), head.end(), head.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return head == "off";
+}
+
+// OFF, PLY and glTF get a strict pass first (core/mesh_file_checks.h): assimp's readers trust declared
+// counts for allocations, offsets for copies, and clamp out-of-range indices without an error. A PLY,
+// an OFF and a GLB are told by their content too, whatever their name: assimp falls back to reading a
+// file by its signature when the reader its extension names refuses it, so a PLY named .glb reached
+// assimp's PLY reader unchecked and hung it (fuzz_mesh, 2026-12-04), and an OFF named .glb its OFF
+// reader (2026-12-05: a crash, and 48 GB asked for). A file named .glb that is no binary glTF is
+// refused outright: any of assimp's forty readers could claim it.
 void check_before_assimp(const fs::path& path) {
   const std::string ext = lowercase_extension(path);
   const std::string start = file_start(path, 8);
   const bool ply_content = starts_as_ply(start);
+  const bool off_content = starts_as_off(start);
   const bool glb_content = start.starts_with("glTF");  // binary glTF's magic, whatever the name
-  if (ext != ".off" && ext != ".ply" && !ply_content && !glb_content) return;
+  if (ext != ".off" && ext != ".ply" && ext != ".gltf" && ext != ".glb" && !ply_content && !off_content &&
+      !glb_content)
+    return;
   const std::string bytes = read_file(path);
   if (glb_content) {
     detail::check_glb_file(path, bytes);
   } else if (ply_content || ext == ".ply") {
     detail::check_ply_file(path, bytes);
-  } else {
+  } else if (off_content || ext == ".off") {
     detail::check_off_file(path, bytes);
+  } else if (ext == ".gltf") {
+    detail::check_gltf_json(path, bytes);
   }
+  if (ext == ".glb" && !glb_content)
+    throw InputError(path, "is named .glb but is not a binary glTF file (it does not start with 'glTF')");
 }
 
 struct PositionHash {

@@ -236,6 +236,13 @@ TEST(MeshIo, InputsThatCrashedOrWereMisreadAreClearErrors) {
        "line 6: 'property float y' follows line 5 ('comment a wrapped comment') inside element 'vertex'"},
       {"ply-content-named-glb-hangs-assimp.glb", "the PLY header has no end_header line"},
       {"glb-chunk-longer-than-the-file.glb", "the GLB header says the file is 1900 bytes long; it is 267"},
+      {"off-content-named-glb-huge-count.glb",
+       "line 2: vertex and face counts must be non-negative integers (got '3999"},
+      {"off-content-named-glb-crashes-assimp.glb",
+       "line 11: face 0 must start with its number of corners, at least 3 (got '0.500000')"},
+      {"glb-accessor-past-its-buffer-view.glb",
+       "glTF: accessor 2 reads 24 elements of 12 bytes, 12 apart, from byte 5 of bufferView 2: up to byte 293, "
+       "past its 288 bytes"},
   };
   const std::filesystem::path dir = std::filesystem::path(TETRASAND_SOURCE_DIR) / "tests/core/bad_meshes";
   std::size_t checked = 0;
@@ -254,6 +261,65 @@ TEST(MeshIo, InputsThatCrashedOrWereMisreadAreClearErrors) {
         << entry.path() << ": " << error;
   }
   EXPECT_GE(files, checked);
+}
+
+// assimp's glTF 2 reader copies `count` elements from the offsets a file declares without comparing
+// them with the buffer (an accessor 5 bytes past its view read past the GLB's BIN block: fuzz_mesh).
+TEST(MeshIo, GltfOffsetsAndLengthsMustLieInsideTheirBuffers) {
+  const auto dir = test::temp_dir();
+  // One triangle's 36 bytes of float positions, base64: the same bytes as tri.bin below.
+  const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::ofstream(dir / "tri.bin", std::ios::binary).write(reinterpret_cast<const char*>(positions), sizeof positions);
+  const std::string base64 = "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA";
+  const auto gltf = [](const std::string& buffer, const std::string& view, const std::string& accessor,
+                       const std::string& primitive = R"({"attributes": {"POSITION": 0}})") {
+    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+      "meshes": [{"primitives": [)" + primitive + R"(]}], "buffers": [)" + buffer + R"(], "bufferViews": [)" + view +
+           R"(], "accessors": [)" + accessor + "]}";
+  };
+  const std::string data_buffer = R"({"uri": "data:application/octet-stream;base64,)" + base64 + R"(", "byteLength": 36})";
+  const std::string good_view = R"({"buffer": 0, "byteLength": 36})";
+  const std::string good_accessor = R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                                        "min": [0, 0, 0], "max": [1, 1, 0]})";
+  write_text(dir / "good.gltf", gltf(data_buffer, good_view, good_accessor));
+  EXPECT_EQ(load_mesh(dir / "good.gltf").triangle_count(), 1u);
+  write_text(dir / "good_file.gltf", gltf(R"({"uri": "tri.bin", "byteLength": 36})", good_view, good_accessor));
+  EXPECT_EQ(load_mesh(dir / "good_file.gltf").triangle_count(), 1u);
+
+  const std::pair<std::string, std::string> cases[] = {
+      {gltf(R"({"uri": "data:application/octet-stream;base64,)" + base64 + R"(", "byteLength": 48})", good_view,
+            good_accessor),
+       "glTF: buffer 0 declares 48 bytes; its data has 36"},
+      {gltf(R"({"uri": "tri.bin", "byteLength": 40})", good_view, good_accessor),
+       "glTF: buffer 0 declares 40 bytes; its data has 36"},
+      {gltf(data_buffer, R"({"buffer": 0, "byteOffset": 4, "byteLength": 36})", good_accessor),
+       "glTF: bufferView 0 spans bytes 4 to 40 of buffer 0, which has 36"},
+      {gltf(data_buffer, R"({"buffer": 1, "byteLength": 36})", good_accessor),
+       "glTF: bufferView 0 refers to buffers[1]; there are 1"},
+      {gltf(data_buffer, good_view, R"({"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"})"),
+       "glTF: accessor 0 reads 4 elements of 12 bytes, 12 apart, from byte 0 of bufferView 0: up to byte 48, past "
+       "its 36 bytes"},
+      {gltf(data_buffer, R"({"buffer": 0, "byteLength": 36, "byteStride": 16})",
+            R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"})"),
+       "glTF: accessor 0 reads 3 elements of 12 bytes, 16 apart, from byte 0 of bufferView 0: up to byte 44"},
+      {gltf(data_buffer, good_view,
+            R"({"bufferView": 0, "byteOffset": -4, "componentType": 5126, "count": 3, "type": "VEC3"})"),
+       "glTF: accessor 0: 'byteOffset' is -4, not a whole number from 0 to 2^53"},
+      {gltf(data_buffer, good_view, R"({"bufferView": 0, "componentType": 5127, "count": 3, "type": "VEC3"})"),
+       "glTF: accessor 0 has componentType 5127, which glTF 2.0 does not define"},
+      {gltf(data_buffer, good_view, good_accessor, R"({"attributes": {"POSITION": 0}, "indices": 5})"),
+       "glTF: mesh 0 primitive 0 refers to accessors[5]; there are 1"},
+      {gltf(data_buffer, good_view, good_accessor, R"({"attributes": {"POSITION": 2}})"),
+       "glTF: mesh 0 primitive 0 attribute POSITION refers to accessors[2]; there are 1"},
+      {"{\"asset\": ", "glTF: its JSON does not parse"},
+  };
+  int n = 0;
+  for (const auto& [text, expected] : cases) {
+    const std::string name = "bad" + std::to_string(n++) + ".gltf";
+    write_text(dir / name, text);
+    const std::string error = load_error(dir / name);
+    EXPECT_NE(error.find(name + ": " + expected), std::string::npos) << "case " << n - 1 << ": " << error;
+  }
 }
 
 TEST(MeshIo, PlyFacesNeedThreeCornersAndAsciiRowsALineEach) {
