@@ -3,6 +3,7 @@
 // extension, which is how the loader and assimp choose a reader); the rest is the file.
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -15,6 +16,13 @@ namespace {
 constexpr const char* kExtensions[] = {"obj", "ply", "stl", "off", "gltf", "glb"};
 
 }  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  // assimp's OBJ reader allocates and fills 16 MiB for every read; see fuzz_support.h.
+  if (ts::fuzz::reuse_large_blocks_in("libassimp.so") != 3)
+    std::fprintf(stderr, "fuzz_mesh: assimp's operator new/delete not found; large blocks not reused\n");
+  return 0;
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
