@@ -450,6 +450,11 @@ void check_gltf_json(const std::filesystem::path& path, std::string_view json,
       const std::string what = fmt::format("mesh {} primitive {}", m, p);
       if (!primitive.is_object()) gltf.fail(what + " is not an object");
       if (primitive.contains("indices")) gltf.index(primitive, "indices", "accessors", what);
+      // assimp's reader builds a primitive's faces on its positions: a line loop without them
+      // dereferenced a null vertex array (SIGSEGV, fuzz_mesh, 2026-12-06).
+      if (!primitive.contains("attributes") || !primitive["attributes"].is_object() ||
+          !primitive["attributes"].contains("POSITION"))
+        gltf.fail(what + " has no POSITION attribute: its faces would have no vertices");
       std::vector<const Json*> attribute_sets;
       if (primitive.contains("attributes")) attribute_sets.push_back(&primitive["attributes"]);
       if (primitive.contains("targets") && primitive["targets"].is_array())

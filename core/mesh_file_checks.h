@@ -30,7 +30,7 @@ void check_glb_file(const std::filesystem::path& path, std::string_view bytes);
 // it declares (the BIN chunk, a data: URI, a file beside `path`), every bufferView lies inside its
 // buffer, and every accessor (sparse ones too) reads only inside its bufferView. An accessor 5 bytes
 // past its view made assimp read past the BIN chunk's block (fuzz_mesh, 2026-12-05). The indices the
-// meshes name exist. glTF 1.0 documents are left to assimp.
+// meshes name exist, and every primitive has positions. glTF 1.0 documents are left to assimp.
 void check_gltf_json(const std::filesystem::path& path, std::string_view json,
                      std::optional<std::uint64_t> glb_binary = std::nullopt);
 

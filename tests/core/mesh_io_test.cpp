@@ -243,6 +243,8 @@ TEST(MeshIo, InputsThatCrashedOrWereMisreadAreClearErrors) {
       {"glb-accessor-past-its-buffer-view.glb",
        "glTF: accessor 2 reads 24 elements of 12 bytes, 12 apart, from byte 5 of bufferView 2: up to byte 293, "
        "past its 288 bytes"},
+      {"glb-line-loop-without-positions.glb",
+       "glTF: mesh 0 primitive 0 has no POSITION attribute: its faces would have no vertices"},
   };
   const std::filesystem::path dir = std::filesystem::path(TETRASAND_SOURCE_DIR) / "tests/core/bad_meshes";
   std::size_t checked = 0;
@@ -312,6 +314,8 @@ TEST(MeshIo, GltfOffsetsAndLengthsMustLieInsideTheirBuffers) {
       {gltf(data_buffer, good_view, good_accessor, R"({"attributes": {"POSITION": 2}})"),
        "glTF: mesh 0 primitive 0 attribute POSITION refers to accessors[2]; there are 1"},
       {"{\"asset\": ", "glTF: its JSON does not parse"},
+      {gltf(data_buffer, good_view, good_accessor, R"({"attributes": {"NORMAL": 0}, "mode": 2})"),
+       "glTF: mesh 0 primitive 0 has no POSITION attribute"},
   };
   int n = 0;
   for (const auto& [text, expected] : cases) {
