@@ -60,6 +60,8 @@ def main():
     ap.add_argument("--single-counts", nargs="*", type=int, default=[])
     ap.add_argument("--probes", type=int, default=1_000_000)
     ap.add_argument("--extra", nargs="*", default=[], help="more tetrasand sample arguments")
+    ap.add_argument("--backends", nargs="+", choices=["cpu", "gpu"], default=["cpu", "gpu"],
+                    help="tetrasand backends to run (gpu on llvmpipe at 1M takes most of an hour)")
     ap.add_argument("--csv")
     args = ap.parse_args()
     ensure_open3d()
@@ -77,7 +79,7 @@ def main():
     for count, repeat in plan:
         n_open3d = None
         for rep in range(repeat):
-            for tool in ("cpu", "open3d", "gpu"):
+            for tool in args.backends[:1] + ["open3d"] + args.backends[1:]:  # Open3D takes the first run's count
                 if tool == "open3d":
                     r = run_open3d(mesh, n_open3d)
                     radius = rows[-1]["radius"]
@@ -110,7 +112,7 @@ def main():
     for count, _ in plan:
         mine = [r for r in rows if r["count"] == count]
         o3d_median = statistics.median(r["seconds"] for r in mine if r["tool"] == "Open3D")
-        for tool in ("tetrasand --backend cpu", "tetrasand --backend gpu", "Open3D"):
+        for tool in [f"tetrasand --backend {b}" for b in args.backends] + ["Open3D"]:
             rs = [r for r in mine if r["tool"] == tool]
             med = lambda k: statistics.median(r[k] for r in rs)  # noqa: E731
             cert = "" if tool == "Open3D" else ", ".join(
@@ -119,12 +121,12 @@ def main():
                   f"{med('cpu_seconds'):.2f} | {min(r['load'] for r in rs):.1f}-{max(r['load'] for r in rs):.1f} | "
                   f"{med('rho'):.3f} | {med('cv'):.3f} | {med('c_over_r'):.3f} | {cert} |")
     print()
-    print("| stage (median, s) | " + " | ".join(f"{c} {b}" for c, _ in plan for b in ("cpu", "gpu")) + " |")
-    print("|---|" + "---|" * (2 * len(plan)))
+    print("| stage (median, s) | " + " | ".join(f"{c} {b}" for c, _ in plan for b in args.backends) + " |")
+    print("|---|" + "---|" * (len(args.backends) * len(plan)))
     for k in STAGES:
         cells = []
         for count, _ in plan:
-            for b in ("cpu", "gpu"):
+            for b in args.backends:
                 rs = [r for r in rows if r["count"] == count and r["tool"] == f"tetrasand --backend {b}"]
                 cells.append(f"{statistics.median(r['stages'][k] for r in rs):.3f}")
         print(f"| {k} | " + " | ".join(cells) + " |")
