@@ -147,6 +147,8 @@ void check_ply_layout(const std::filesystem::path& path, const ply::Header& head
       throw InputError(path, fmt::format("element '{}' has no list property vertex_indices", element.name));
     }
   }
+  if (std::find(seen.begin(), seen.end(), "vertex") == seen.end())
+    throw InputError(path, "the PLY header declares no vertex element (a mesh needs one, with x, y and z)");
 }
 
 // One corner of row `row` of a face or tristrips element: a vertex index (a strip may also hold -1,

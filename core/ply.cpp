@@ -36,6 +36,13 @@ constexpr std::array<ScalarInfo, 8> kScalars = {{
 
 const ScalarInfo& info(Scalar type) { return kScalars[static_cast<std::size_t>(type)]; }
 
+// `line` without the spaces and tabs around it.
+std::string_view trimmed_blanks(std::string_view line) {
+  const std::size_t first = line.find_first_not_of(" \t");
+  if (first == std::string_view::npos) return {};
+  return line.substr(first, line.find_last_not_of(" \t") - first + 1);
+}
+
 // The header, line by line: each line is split into words and handled by its keyword.
 class HeaderParser {
  public:
@@ -50,6 +57,10 @@ class HeaderParser {
       words = next_line();
       if (words.empty()) continue;
       ended = words[0] == "end_header";
+      // assimp reads binary data from the byte after the end_header line; any byte on that line but
+      // blanks (a vertical tab, binary data) sent its reader into a SIGSEGV (fuzz_mesh, 2026-12-06).
+      if (ended && trimmed_blanks(line_) != "end_header")
+        fail("the end_header line holds more than 'end_header' (the data must start on the next line)");
       if (!ended) keyword_line(words);
     }
     if (!ended) throw InputError(file_, "the PLY header has no end_header line");

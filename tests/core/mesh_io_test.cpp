@@ -243,6 +243,8 @@ TEST(MeshIo, InputsThatCrashedOrWereMisreadAreClearErrors) {
       {"glb-accessor-past-its-buffer-view.glb",
        "glTF: accessor 2 reads 24 elements of 12 bytes, 12 apart, from byte 5 of bufferView 2: up to byte 293, "
        "past its 288 bytes"},
+      {"ply-data-on-the-end-header-line-binary.ply",
+       "line 5: the end_header line holds more than 'end_header' (the data must start on the next line)"},
       {"glb-line-loop-without-positions.glb",
        "glTF: mesh 0 primitive 0 has no POSITION attribute: its faces would have no vertices"},
   };
@@ -345,6 +347,15 @@ TEST(MeshIo, PlyFacesNeedThreeCornersAndAsciiRowsALineEach) {
     const std::string error = load_error(dir / file);
     EXPECT_NE(error.find(std::string(file) + ": " + expected), std::string::npos) << error;
   }
+}
+
+TEST(MeshIo, PlyWithoutAVertexElementIsAnError) {
+  const auto dir = test::temp_dir();
+  write_text(dir / "no_vertex.ply", "ply\nformat binary_little_endian 1.0\ncomment nothing else\nend_header\n");
+  EXPECT_NE(load_error(dir / "no_vertex.ply")
+                .find("no_vertex.ply: the PLY header declares no vertex element (a mesh needs one, with x, y and z)"),
+            std::string::npos)
+      << load_error(dir / "no_vertex.ply");
 }
 
 TEST(MeshIo, PlyWithoutACoordinateIsAnErrorNotZero) {

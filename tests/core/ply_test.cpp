@@ -259,6 +259,20 @@ TEST(Ply, LinesBetweenAnElementsPropertiesAreErrorsUnlessAllowed) {
   EXPECT_EQ(parse_header(kFile, fine).elements.size(), 2u);
 }
 
+TEST(Ply, TheEndHeaderLineHoldsOnlyEndHeaderAndBlanks) {
+  // assimp reads blanks around end_header and a CRLF ending as a plain end_header line, but a
+  // vertical tab or data on that line crashed it (tests/core/bad_meshes/ply-data-on-the-end-header-line-binary.ply).
+  const std::string top = "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\n";
+  for (const char* line : {"end_header\n", "end_header \n", "\tend_header\t\n", "end_header\r\n", "end_header"})
+    EXPECT_EQ(parse_header(kFile, top + line).elements.size(), 1u) << line;
+  using namespace std::string_literals;
+  for (const std::string& line : {"end_header\v\n"s, "end_header\v"s, "end_header junk\n"s, "end_header \0\0\n"s})
+    EXPECT_EQ(input_error([&] { parse_header(kFile, top + line); }),
+              "test.ply: line 5: the end_header line holds more than 'end_header' (the data must start on the next "
+              "line)")
+        << line;
+}
+
 TEST(Ply, HeaderErrorsNameTheFileAndTheLine) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"", "test.ply: line 1: not a PLY file: it must start with the line 'ply'"},
