@@ -278,14 +278,8 @@ class GltfChecker {
     return doc_[key];
   }
 
-  std::uint64_t number(const Json& object, const char* key, const std::string& what,
-                       std::optional<std::uint64_t> fallback = std::nullopt) const {
-    if (!object.is_object()) fail(what + " is not an object");
-    if (!object.contains(key)) {
-      if (fallback) return *fallback;
-      fail(fmt::format("{} has no '{}'", what, key));
-    }
-    const Json& value = object[key];
+  // `value`, found under `key` of `what`, as a whole number.
+  std::uint64_t whole_number(const Json& value, std::string_view key, const std::string& what) const {
     constexpr double kLargest = 9007199254740992.0;  // 2^53
     if (!value.is_number() || value.get<double>() < 0 || value.get<double>() > kLargest ||
         std::floor(value.get<double>()) != value.get<double>())
@@ -293,12 +287,28 @@ class GltfChecker {
     return static_cast<std::uint64_t>(value.get<double>());
   }
 
-  // An index into doc_[key], checked.
-  std::uint64_t index(const Json& object, const char* key, const char* into, const std::string& what) const {
-    const std::uint64_t i = number(object, key, what);
+  std::uint64_t number(const Json& object, const char* key, const std::string& what,
+                       std::optional<std::uint64_t> fallback = std::nullopt) const {
+    if (!object.is_object()) fail(what + " is not an object");
+    if (!object.contains(key)) {
+      if (fallback) return *fallback;
+      fail(fmt::format("{} has no '{}'", what, key));
+    }
+    return whole_number(object[key], key, what);
+  }
+
+  // `value` (under `key` of `what`) as an index into doc_[into], checked.
+  std::uint64_t index_of(const Json& value, std::string_view key, const char* into, const std::string& what) const {
+    const std::uint64_t i = whole_number(value, key, what);
     if (i >= array(into).size())
       fail(fmt::format("{} refers to {}[{}]; there are {}", what, into, i, array(into).size()));
     return i;
+  }
+
+  std::uint64_t index(const Json& object, const char* key, const char* into, const std::string& what) const {
+    if (!object.is_object()) fail(what + " is not an object");
+    if (!object.contains(key)) fail(fmt::format("{} has no '{}'", what, key));
+    return index_of(object[key], key, into, what);
   }
 
  private:
@@ -398,9 +408,9 @@ void check_gltf_json(const std::filesystem::path& path, std::string_view json,
     if (static_cast<long double>(offset) + length > buffer_lengths[buffer])
       gltf.fail(fmt::format("{} spans bytes {} to {} of buffer {}, which has {}", what, offset,
                             static_cast<long double>(offset) + length, buffer, buffer_lengths[buffer]));
-    std::optional<std::uint64_t> stride;
-    if (view.contains("byteStride")) stride = gltf.number(view, "byteStride", what);
-    views.push_back({length, stride});
+    // No stride, or 0, is tightly packed: assimp then steps by the element's size.
+    const std::uint64_t stride = gltf.number(view, "byteStride", what, 0);
+    views.push_back({length, stride == 0 ? std::nullopt : std::optional<std::uint64_t>(stride)});
   }
 
   // Where assimp copies an accessor's elements from: `count` elements of `element` bytes, `stride`
@@ -435,10 +445,11 @@ void check_gltf_json(const std::filesystem::path& path, std::string_view json,
       const std::uint64_t index_bytes = accessor_component_bytes(
           gltf, gltf.number(indices, "componentType", sparse_what + " indices"), sparse_what + " indices");
       const std::uint64_t index_view = gltf.index(indices, "bufferView", "bufferViews", sparse_what + " indices");
-      check_span(sparse_what + " indices", index_view, gltf.number(indices, "byteOffset", sparse_what, 0),
+      check_span(sparse_what + " indices", index_view, gltf.number(indices, "byteOffset", sparse_what + " indices", 0),
                  sparse_count, index_bytes, index_bytes);
       const std::uint64_t value_view = gltf.index(values, "bufferView", "bufferViews", sparse_what + " values");
-      check_span(sparse_what + " values", value_view, gltf.number(values, "byteOffset", sparse_what, 0), sparse_count,
+      check_span(sparse_what + " values", value_view, gltf.number(values, "byteOffset", sparse_what + " values", 0),
+                 sparse_count,
                  element, element);
     }
   }
@@ -463,10 +474,8 @@ void check_gltf_json(const std::filesystem::path& path, std::string_view json,
         for (const Json& target : primitive["targets"]) attribute_sets.push_back(&target);
       for (const Json* attributes : attribute_sets) {
         if (!attributes->is_object()) gltf.fail(what + ": attributes are not an object");
-        for (const auto& [name, value] : attributes->items()) {
-          const Json holder = {{"accessor", value}};
-          gltf.index(holder, "accessor", "accessors", what + " attribute " + name);
-        }
+        for (const auto& [name, value] : attributes->items())
+          gltf.index_of(value, name, "accessors", what + " attribute " + name);
       }
     }
   }

@@ -31,11 +31,12 @@ void check_readable_file(const fs::path& path) {
   if (!probe) throw InputError(path, "cannot be opened for reading (permission?)");
 }
 
-std::string lowercase_extension(const fs::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
+std::string lowercase(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
 }
+
+std::string lowercase_extension(const fs::path& path) { return lowercase(path.extension().string()); }
 
 // The first bytes of a file (at most `count`), to tell its format by content.
 std::string file_start(const fs::path& path, std::size_t count) {
@@ -49,12 +50,7 @@ std::string file_start(const fs::path& path, std::size_t count) {
 bool starts_as_ply(std::string_view bytes) { return bytes.starts_with("ply\n") || bytes.starts_with("ply\r\n"); }
 
 // assimp's OFF reader claims a file by its first 3 bytes, "off" in any case.
-bool starts_as_off(std::string_view bytes) {
-  if (bytes.size() < 3) return false;
-  std::string head(bytes.substr(0, 3));
-  std::transform(head.begin(), head.end(), head.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return head == "off";
-}
+bool starts_as_off(std::string_view bytes) { return lowercase(std::string(bytes.substr(0, 3))) == "off"; }
 
 // OFF, PLY and glTF get a strict pass first (core/mesh_file_checks.h): assimp's readers trust declared
 // counts for allocations, offsets for copies, and clamp out-of-range indices without an error. A PLY,
