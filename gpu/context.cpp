@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "gpu/gl.h"
 #include "gpu/host_sync.h"
 
 namespace ts::gpu {
@@ -84,6 +85,7 @@ struct RawContext {
 
 void destroy(RawContext& raw) {
   if (raw.display == EGL_NO_DISPLAY) return;
+  if (raw.context != EGL_NO_CONTEXT && eglGetCurrentContext() == raw.context) release_readback_staging();
   eglMakeCurrent(raw.display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   if (raw.context != EGL_NO_CONTEXT) eglDestroyContext(raw.display, raw.context);
   eglTerminate(raw.display);

@@ -1,5 +1,6 @@
 #include "gpu/gl.h"
 
+#include <EGL/egl.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -65,7 +66,43 @@ GLuint link(const std::vector<GLuint>& shaders, const std::string& name) {
   return program;
 }
 
+// The staging buffer of the context current on this thread (GL contexts are current per thread):
+// host memory by hint (client storage, map-read), the only buffer the host reads directly.
+struct ReadbackStaging {
+  EGLContext context = EGL_NO_CONTEXT;  // whose buffer name `id` is
+  GLuint id = 0;
+  std::size_t bytes = 0;
+};
+thread_local ReadbackStaging staging;
+
+// The staging buffer, holding at least `bytes` (at most kReadbackChunkBytes are asked for).
+GLuint readback_staging(std::size_t bytes) {
+  const EGLContext current = eglGetCurrentContext();
+  // A buffer name of another (possibly destroyed) context means nothing here: forget it, never delete it.
+  if (staging.context != current) staging = {current, 0, 0};
+  if (staging.id != 0 && staging.bytes >= bytes) return staging.id;
+  if (staging.id != 0) glDeleteBuffers(1, &staging.id);
+  // Doubling keeps the number of reallocations logarithmic in the largest read.
+  const std::size_t size = std::min(kReadbackChunkBytes, std::max({bytes, 2 * staging.bytes, std::size_t{4096}}));
+  staging = {current, 0, 0};
+  glCreateBuffers(1, &staging.id);
+  glNamedBufferStorage(staging.id, static_cast<GLsizeiptr>(size), nullptr, GL_MAP_READ_BIT | GL_CLIENT_STORAGE_BIT);
+  if (glGetError() == GL_OUT_OF_MEMORY) {
+    glDeleteBuffers(1, &staging.id);
+    staging.id = 0;
+    throw GpuError(fmt::format("out of memory allocating a {:.1f} MiB read-back buffer", size / 1048576.0));
+  }
+  staging.bytes = size;
+  return staging.id;
+}
+
 }  // namespace
+
+void release_readback_staging() {
+  if (staging.context != eglGetCurrentContext()) return;  // another context's: not ours to free
+  if (staging.id != 0) glDeleteBuffers(1, &staging.id);
+  staging = {};
+}
 
 void check_gl(const std::string& what) {
   const GLenum code = glGetError();
@@ -114,9 +151,17 @@ void Buffer::upload(const void* data, std::size_t bytes, std::size_t offset) {
 void Buffer::download(void* data, std::size_t bytes, std::size_t offset) const {
   if (offset + bytes > bytes_) throw GpuError(fmt::format("buffer read of {} bytes at {} overruns {} bytes", bytes, offset, bytes_));
   if (bytes == 0) return;
+  // Kernel writes become visible to the copy (a buffer update) through this barrier.
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  count_read();
-  glGetNamedBufferSubData(id_, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+  auto* out = static_cast<std::byte*>(data);
+  for (std::size_t done = 0; done < bytes;) {
+    const std::size_t chunk = std::min(bytes - done, kReadbackChunkBytes);
+    const GLuint stage = readback_staging(chunk);
+    glCopyNamedBufferSubData(id_, stage, static_cast<GLintptr>(offset + done), 0, static_cast<GLsizeiptr>(chunk));
+    count_read();
+    glGetNamedBufferSubData(stage, 0, static_cast<GLsizeiptr>(chunk), out + done);
+    done += chunk;
+  }
 }
 
 void Buffer::fill_zero() {

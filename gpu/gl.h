@@ -16,6 +16,14 @@
 
 namespace ts::gpu {
 
+// The most one read back moves through the staging buffer at a time; larger reads go in chunks,
+// so the staging buffer (one per context, grown on demand) never holds more than this.
+inline constexpr std::size_t kReadbackChunkBytes = std::size_t{64} << 20;
+
+// Frees the current context's staging buffer; called by Context while its GL context is still
+// current, before it is destroyed. A no-op when none was made.
+void release_readback_staging();
+
 // A shader storage / general-purpose GL buffer. Move-only.
 class Buffer {
  public:
@@ -38,6 +46,10 @@ class Buffer {
   void upload(std::span<const T> items, std::size_t first = 0) {
     upload(items.data(), items.size_bytes(), first * sizeof(T));
   }
+  // Reads [offset, offset + bytes) back: the GPU copies it into the context's host-side staging
+  // buffer, the host reads that (one round trip per kReadbackChunkBytes). A buffer read directly is
+  // one the driver may move to host memory for good, after which every kernel that writes it does so
+  // over the bus: NVIDIA's driver did so to the scan conversion's band buffers on the first device run.
   void download(void* data, std::size_t bytes, std::size_t offset = 0) const;
   template <typename T>
   std::vector<T> read(std::size_t count, std::size_t first = 0) const {

@@ -24,6 +24,18 @@ TEST(GpuContext, CreatesGl45CoreContextOnSomeEglDevice) {
   EXPECT_GE(context.limits().max_geometry_output_vertices, 256);
 }
 
+// Each context makes its own read-back staging buffer and frees it when it ends: reads work in a
+// context made after another one read and was destroyed.
+TEST(GpuContext, BufferReadsWorkInEachContextOneAfterAnother) {
+  const std::vector<float> values = {1.5f, -2.0f, 3.25f, 4.0f};
+  for (int round = 0; round < 3; ++round) {
+    Context context;
+    const Buffer buffer = Buffer::from<float>(values);
+    EXPECT_EQ(buffer.read<float>(4), values) << "round " << round;
+    EXPECT_EQ(buffer.read<float>(2, 1), std::vector<float>(values.begin() + 1, values.begin() + 3)) << "round " << round;
+  }
+}
+
 TEST(GpuContext, EnumerationListsTheChosenDevice) {
   const auto devices = enumerate_devices(true);
   ASSERT_FALSE(devices.empty());

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "gpu/context.h"
@@ -31,6 +33,26 @@ TEST_F(HostSync, EachBufferReadIsOneRoundTripAndUploadsNone) {
   const HostSyncCounts made = host_sync_counts() - before;
   EXPECT_EQ(made.reads, 2);
   EXPECT_EQ(made.total(), 2);
+}
+
+// Reads go through a staging buffer of at most kReadbackChunkBytes: a larger read comes back whole,
+// in one round trip per chunk, also from an offset that puts the chunk boundary mid-array.
+TEST_F(HostSync, ReadsLargerThanOneStagingChunkComeBackWholeInOneRoundTripPerChunk) {
+  const std::size_t words = kReadbackChunkBytes / sizeof(std::uint32_t) + 1027;
+  std::vector<std::uint32_t> pattern(words);
+  for (std::size_t i = 0; i < words; ++i) pattern[i] = static_cast<std::uint32_t>(i * 2654435761u) ^ 0x5a5a5a5au;
+  const Buffer buffer = Buffer::from<std::uint32_t>(pattern);
+  HostSyncCounts before = host_sync_counts();
+  EXPECT_EQ(buffer.read<std::uint32_t>(words), pattern);
+  EXPECT_EQ((host_sync_counts() - before).reads, 2);
+  const std::size_t first = 3, count = words - 5;  // both ends cut, the boundary mid-array
+  before = host_sync_counts();
+  const auto middle = buffer.read<std::uint32_t>(count, first);
+  EXPECT_EQ((host_sync_counts() - before).reads, 2);
+  ASSERT_EQ(middle.size(), count);
+  EXPECT_TRUE(std::equal(middle.begin(), middle.end(), pattern.begin() + first));
+  // A small read after the large ones reuses the staging buffer and reads only what it asks for.
+  EXPECT_EQ(buffer.read<std::uint32_t>(2, words - 2), std::vector<std::uint32_t>(pattern.end() - 2, pattern.end()));
 }
 
 TEST_F(HostSync, FinishIsCountedOnTheQueueAndTheContext) {
