@@ -261,18 +261,32 @@ void Queue::dispatch(const Program& program, std::uint32_t gx, std::uint32_t gy,
   if (check_errors_) check("kernel " + program.name());
 }
 
+std::pair<std::uint32_t, std::uint32_t> Queue::group_grid(std::size_t groups, std::size_t max_x) {
+  if (groups <= max_x) return {static_cast<std::uint32_t>(groups), 1u};
+  // Rows as even as the limit allows: fewer padding groups in the last row than full rows of max_x.
+  const std::size_t rows = (groups + max_x - 1) / max_x;
+  return {static_cast<std::uint32_t>((groups + rows - 1) / rows), static_cast<std::uint32_t>(rows)};
+}
+
+void Queue::dispatch_groups(const Program& program, std::size_t groups, GLbitfield barrier) {
+  if (groups == 0) return;
+  // Queried once: a state query per dispatch is a driver call in the innermost loop.
+  if (max_groups_[0] == 0) {
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &max_groups_[0]);
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 1, &max_groups_[1]);
+  }
+  const auto [gx, gy] = group_grid(groups, static_cast<std::size_t>(max_groups_[0]));
+  // Past both limits a dispatch is a GL error that leaves the buffers as they were: stop instead.
+  if (gy > static_cast<std::uint32_t>(max_groups_[1])) {
+    throw GpuError(fmt::format("dispatch of {} needs {} work groups, above this GPU's limit of {} x {}", program.name(),
+                               groups, max_groups_[0], max_groups_[1]));
+  }
+  dispatch(program, gx, gy, 1, barrier);
+}
+
 void Queue::dispatch_items(const Program& program, std::size_t items, GLbitfield barrier) {
   const std::size_t local = static_cast<std::size_t>(program.local_size()[0]);
-  const std::size_t groups = (items + local - 1) / local;
-  // Queried once: a state query per dispatch is a driver call in the innermost loop.
-  if (max_groups_x_ == 0) glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &max_groups_x_);
-  // Past the limit a dispatch is a GL error that leaves the buffers as they were: stop instead.
-  if (groups > static_cast<std::size_t>(max_groups_x_)) {
-    throw GpuError("dispatch of " + program.name() + " over " + std::to_string(items) + " items needs " +
-                   std::to_string(groups) + " work groups, above this GPU's limit of " +
-                   std::to_string(max_groups_x_));
-  }
-  dispatch(program, static_cast<std::uint32_t>(groups), 1, 1, barrier);
+  dispatch_groups(program, (items + local - 1) / local, barrier);
 }
 
 void Queue::check(const std::string& what) const { check_gl(what); }

@@ -10,6 +10,7 @@
 #include <map>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gpu/shader_library.h"
@@ -124,8 +125,14 @@ class Queue {
   // kernel sees this one's writes. barrier = 0 for none (the caller batches barriers itself).
   void dispatch(const Program& program, std::uint32_t groups_x, std::uint32_t groups_y = 1,
                 std::uint32_t groups_z = 1, GLbitfield barrier = GL_SHADER_STORAGE_BARRIER_BIT);
-  // Enough groups of the program's local size to cover `items` threads along x.
+  // `groups` work groups numbered 0..groups-1 by dispatch_group() (shaders/common/dispatch.glsl):
+  // one row along x, or rows of the GPU's largest x count (GL_MAX_COMPUTE_WORK_GROUP_COUNT[0], 65535
+  // on llvmpipe) stacked along y when there are more, the last row padded with groups past the end.
+  void dispatch_groups(const Program& program, std::size_t groups, GLbitfield barrier = GL_SHADER_STORAGE_BARRIER_BIT);
+  // Enough groups of the program's local size to cover `items` threads, numbered by dispatch_item().
   void dispatch_items(const Program& program, std::size_t items, GLbitfield barrier = GL_SHADER_STORAGE_BARRIER_BIT);
+  // The (x, y) grid dispatch_groups uses for `groups` when at most `max_x` fit along x.
+  static std::pair<std::uint32_t, std::uint32_t> group_grid(std::size_t groups, std::size_t max_x);
   // Times arbitrary GL work (draw calls, copies) under `name`.
   template <typename F>
   void timed(const std::string& name, F&& work) {
@@ -162,7 +169,7 @@ class Queue {
   std::vector<Pending> pending_;
   std::vector<GLuint> spare_queries_;
   std::vector<KernelTiming> totals_;
-  GLint max_groups_x_ = 0;  // GL_MAX_COMPUTE_WORK_GROUP_COUNT along x, 0 until first needed
+  GLint max_groups_[2] = {0, 0};  // GL_MAX_COMPUTE_WORK_GROUP_COUNT along x and y, 0 until first needed
 };
 
 // Throws GpuError with `what` when glGetError reports an error.

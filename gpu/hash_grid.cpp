@@ -25,7 +25,7 @@ void PrefixScan::run(Queue& queue, Buffer& values, std::uint32_t count) {
     level_buffer(l).bind(TS_SCAN_VALUES);
     level_buffer(l + 1).bind(TS_SCAN_BLOCK_SUMS);
     blocks_.set("count", sizes[l]);
-    queue.dispatch(blocks_, (sizes[l] + 511u) / 512u);
+    queue.dispatch_groups(blocks_, (sizes[l] + 511u) / 512u);
   }
   // Up: add each level's scanned block offsets back into the level below.
   for (std::size_t l = sizes.size() - 1; l-- > 0;) {

@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Counting sort, pass 1: each particle finds its hashed cell and takes a slot in it. Slot order within
 // a cell depends on atomics; grid_sort_cells.comp restores index order so results stay deterministic.
+#include "common/dispatch.glsl"
 #include "common/hash_grid.glsl"
 #include "common/bindings.h"
 layout(local_size_x = 256) in;
@@ -13,7 +14,7 @@ uniform uint count;
 uniform float cell_size;
 uniform uint table_size;
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = dispatch_item();
   if (i >= count) return;
   uint h = hash_cell(cell_of_position(positions[i].xyz, cell_size), table_size);
   cell_of[i] = h;

@@ -1,6 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Counting sort, pass 3: particle ids into their cell's range of the sorted array.
+#include "common/dispatch.glsl"
 #include "common/bindings.h"
 layout(local_size_x = 256) in;
 layout(std430, binding = TS_SORT_KEY) readonly buffer CellOf { uint cell_of[]; };
@@ -9,6 +10,6 @@ layout(std430, binding = TS_SORT_BUCKET_START) readonly buffer CellStart { uint 
 layout(std430, binding = TS_SORT_SORTED) writeonly buffer Sorted { uint sorted_ids[]; };
 uniform uint count;
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = dispatch_item();
   if (i < count) sorted_ids[cell_start[cell_of[i]] + slot[i]] = i;
 }

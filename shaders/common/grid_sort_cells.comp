@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Counting sort, pass 4: insertion sort of each cell's ids, so neighbours are always visited in index
 // order and float sums over them are bitwise reproducible. Cells hold a handful of ids.
+#include "common/dispatch.glsl"
 #include "common/bindings.h"
 layout(local_size_x = 256) in;
 layout(std430, binding = TS_SORT_BUCKET_COUNT) readonly buffer CellCount { uint cell_count[]; };
@@ -9,7 +10,7 @@ layout(std430, binding = TS_SORT_BUCKET_START) readonly buffer CellStart { uint 
 layout(std430, binding = TS_SORT_SORTED) buffer Sorted { uint sorted_ids[]; };
 uniform uint table_size;
 void main() {
-  uint c = gl_GlobalInvocationID.x;
+  uint c = dispatch_item();
   if (c >= table_size) return;
   uint begin = cell_start[c], n = cell_count[c];
   for (uint a = 1u; a < n; ++a) {

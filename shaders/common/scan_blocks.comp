@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Exclusive prefix sum, pass 1: each work group scans 512 values in shared memory (Blelloch 1990) and
 // writes its total to block_sums, which the host scans recursively before scan_add.comp adds it back.
+#include "common/dispatch.glsl"
 #include "common/bindings.h"
 layout(local_size_x = 256) in;
 layout(std430, binding = TS_SCAN_VALUES) buffer Values { uint values[]; };
@@ -10,7 +11,8 @@ uniform uint count;
 shared uint temp[512];
 void main() {
   uint t = gl_LocalInvocationID.x;
-  uint base = gl_WorkGroupID.x * 512u;
+  uint base = dispatch_group() * 512u;
+  if (base >= count) return;  // a group past the end (2D layout): no block, no block sum
   temp[2u * t] = base + 2u * t < count ? values[base + 2u * t] : 0u;
   temp[2u * t + 1u] = base + 2u * t + 1u < count ? values[base + 2u * t + 1u] : 0u;
   uint offset = 1u;
@@ -23,7 +25,7 @@ void main() {
     offset <<= 1u;
   }
   if (t == 0u) {
-    block_sums[gl_WorkGroupID.x] = temp[511];
+    block_sums[dispatch_group()] = temp[511];
     temp[511] = 0u;
   }
   for (uint d = 1u; d < 512u; d <<= 1u) {

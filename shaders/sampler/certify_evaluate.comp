@@ -10,6 +10,7 @@
 // then T's fate: covered (U <= radius: one ball holds its corners, so all of it), split in four,
 // or final and uncovered. Centres come from the hashed grid (cell = radius) in cubic shells of cells
 // around the centroid until no unvisited centre can lower U (see the search below).
+#include "common/dispatch.glsl"
 #include "common/hash_grid.glsl"
 #include "common/bindings.h"
 #include "common/layouts.h"
@@ -87,7 +88,7 @@ void visit_shell(ivec3 c, int R, vec3 v0, vec3 v1, vec3 v2, vec3 g, inout Search
 }
 
 void main() {
-  uint e = base + gl_GlobalInvocationID.x;
+  uint e = base + dispatch_item();
   if (e == count) {  // the extra zero that makes the scanned value at `count` the total
     splits[e] = 0u;
     uncovered[e] = 0u;

@@ -5,6 +5,7 @@
 // each split sub-triangle writes its four children to the next level's queue at its scanned offset,
 // each final uncovered one itself and its bounds to the holes. Offsets come from the scan, not from
 // atomics, so the next queue and the holes are in the same order on every run.
+#include "common/dispatch.glsl"
 #include "common/bindings.h"
 #include "common/layouts.h"
 #include "sampler/bindings.h"
@@ -25,7 +26,7 @@ uvec4 child(uint triangle, uint level, bool down, uint i, uint j) {
 }
 
 void main() {
-  uint e = base + gl_GlobalInvocationID.x;
+  uint e = base + dispatch_item();
   if (e >= count) return;
   uvec4 id = queue[e];
   uint first = split_offset[e];

@@ -3,6 +3,7 @@
 // Convergence reduction: per work group, the sum of the gradient steps of the mobile particles, the
 // largest |phi|, the count of particles outside the band and the count of mobile particles. The host
 // adds the partials in order (deterministic, no float atomics).
+#include "common/dispatch.glsl"
 #include "sampler/bindings.h"
 layout(local_size_x = 256) in;
 layout(std430, binding = TS_SAMPLER_STEP_INFO) readonly buffer StepInfo { vec4 step_info[]; };
@@ -10,7 +11,8 @@ layout(std430, binding = TS_SAMPLER_PARTIALS) writeonly buffer Partials { vec4 p
 uniform uint count;
 shared vec4 scratch[256];
 void main() {
-  uint i = gl_GlobalInvocationID.x, t = gl_LocalInvocationID.x;
+  uint i = dispatch_item(), t = gl_LocalInvocationID.x;
+  if (dispatch_group() * gl_WorkGroupSize.x >= count) return;  // past the end: no partial
   scratch[t] = i < count ? step_info[i] : vec4(0.0);
   for (uint stride = 128u; stride > 0u; stride >>= 1u) {
     barrier();
@@ -19,5 +21,5 @@ void main() {
       scratch[t] = vec4(a.x + b.x, max(a.y, b.y), a.z + b.z, a.w + b.w);
     }
   }
-  if (t == 0u) partials[gl_WorkGroupID.x] = scratch[0];
+  if (t == 0u) partials[dispatch_group()] = scratch[0];
 }

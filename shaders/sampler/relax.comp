@@ -13,6 +13,7 @@
 //
 // positions.w = 1 marks a mobile particle; 0 a frozen one, which still repels but does not move (the
 // local re-relaxation after an injection moves only the particles near the new ones).
+#include "common/dispatch.glsl"
 #include "common/hash_grid.glsl"
 #include "common/bindings.h"
 #include "sampler/bindings.h"
@@ -70,7 +71,7 @@ vec3 repulsion_at(uint i, vec3 p) {
 }
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = dispatch_item();
   if (i >= count) return;
   vec4 pw = p_in[i];
   vec3 p = pw.xyz;

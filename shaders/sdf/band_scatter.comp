@@ -3,6 +3,7 @@
 // Band compaction, pass 2: each band voxel writes its slab index and value at the place the scan of
 // the flags gave it, in slab order (x fastest, then y, then layer), so the compacted band is in the
 // same order as a scan of the whole slab on the host would find it.
+#include "common/dispatch.glsl"
 #include "sdf/bindings.h"
 layout(local_size_x = 256) in;
 layout(binding = TS_SDF_UNIT_SLAB) uniform sampler2DArray slab;
@@ -13,7 +14,7 @@ uniform ivec2 layer_size;
 uniform uint voxels;
 uniform float band;
 void main() {
-  uint v = gl_GlobalInvocationID.x;
+  uint v = dispatch_item();
   if (v >= voxels) return;
   uint per_layer = uint(layer_size.x * layer_size.y);
   ivec3 texel = ivec3(int(v % uint(layer_size.x)), int((v % per_layer) / uint(layer_size.x)), int(v / per_layer));

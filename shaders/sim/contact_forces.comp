@@ -6,6 +6,7 @@
 // With the spring tangential model each dynamic particle keeps its contacts' springs in its own
 // history slots (read at the start, rewritten in gather order), matched by partner id, as
 // CpuStepper::visit_contacts does. At most 16 storage blocks (the per-stage minimum of GL 4.3).
+#include "common/dispatch.glsl"
 #include "common/bindings.h"
 #include "sim/bindings.h"
 #include "common/hash_grid.glsl"
@@ -86,7 +87,7 @@ void note_penetration(uint i, uint slot) {
 }
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = dispatch_item();
   if (i >= particle_count) return;
   uint body_i = particle_info[i].x;
   real4 xi4 = POSITION(i);

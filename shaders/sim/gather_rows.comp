@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Re-sort, pass 4: dst row r = src row index[r], rows of `width` uvec4 words, copied bit for bit (so
 // any per-body or per-particle array, float or double, moves with one kernel).
+#include "common/dispatch.glsl"
 #include "sim/bindings.h"
 layout(local_size_x = 128) in;
 layout(std430, binding = TS_SIM_GATHER_SOURCE) readonly buffer Src { uvec4 src[]; };
@@ -10,7 +11,7 @@ layout(std430, binding = TS_SIM_GATHER_INDEX) readonly buffer Index { uint index
 uniform uint rows;
 uniform uint width;
 void main() {
-  uint r = gl_GlobalInvocationID.x;
+  uint r = dispatch_item();
   if (r >= rows) return;
   uint from = index[r] * width, to = r * width;
   for (uint k = 0u; k < width; ++k) dst[to + k] = src[from + k];

@@ -6,6 +6,7 @@
 // velocities, semi-implicit Euler with the new ones. Static bodies are skipped; kinematic bodies
 // follow their prescribed velocities or
 // their keyframes (sim/keyframes.glsl). Velocity clamps (thesis 3.3.1) are counted, never silent.
+#include "common/dispatch.glsl"
 #include "sim/bindings.h"
 #include "common/layouts.h"
 #include "sim/rigid.glsl"
@@ -32,7 +33,7 @@ uniform float angular_damping_speed;   // [m/s]: damp when |v| + |w| reach is be
 uniform real time_after;               // [s]: the time this step ends at (keyframed bodies)
 
 void main() {
-  uint b = gl_GlobalInvocationID.x;
+  uint b = dispatch_item();
   if (b >= body_count) return;
   uint motion = uint(body_velocity[b].w);
   if (motion == TS_MOTION_STATIC) return;

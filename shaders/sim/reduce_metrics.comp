@@ -3,6 +3,7 @@
 // Metrics for the CSV and the blow-up check, per work group (the host adds partials in order):
 // x: translational kinetic energy [J], y: rotational kinetic energy [J], z: potential energy [J]
 // relative to z = 0, w: NaN/inf count. Only dynamic bodies count.
+#include "common/dispatch.glsl"
 #include "sim/bindings.h"
 #include "common/layouts.h"
 #include "sim/rigid.glsl"
@@ -16,7 +17,8 @@ uniform uint body_count;
 uniform vec3 gravity;
 shared dvec4 scratch[256];
 void main() {
-  uint b = gl_GlobalInvocationID.x, t = gl_LocalInvocationID.x;
+  uint b = dispatch_item(), t = gl_LocalInvocationID.x;
+  if (dispatch_group() * gl_WorkGroupSize.x >= body_count) return;  // past the end: no partial
   dvec4 e = dvec4(0.0);
   if (b < body_count && uint(body_velocity[b].w) == TS_MOTION_DYNAMIC) {
     double m = 1.0 / double(body_position[b].w);
@@ -33,5 +35,5 @@ void main() {
     barrier();
     if (t < stride) scratch[t] += scratch[t + stride];
   }
-  if (t == 0u) partials[gl_WorkGroupID.x] = scratch[0];
+  if (t == 0u) partials[dispatch_group()] = scratch[0];
 }

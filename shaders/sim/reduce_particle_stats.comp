@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Contact statistics per work group (the host adds partials in order): x pair contacts, y wall
 // contacts, z largest overlap ratio (max), w overlap clamps.
+#include "common/dispatch.glsl"
 #include "sim/bindings.h"
 #include "common/layouts.h"
 layout(local_size_x = 256) in;
@@ -10,7 +11,8 @@ layout(std430, binding = TS_SIM_STAT_PARTIALS) writeonly buffer Partials { vec4 
 uniform uint particle_count;
 shared vec4 scratch[256];
 void main() {
-  uint i = gl_GlobalInvocationID.x, t = gl_LocalInvocationID.x;
+  uint i = dispatch_item(), t = gl_LocalInvocationID.x;
+  if (dispatch_group() * gl_WorkGroupSize.x >= particle_count) return;  // past the end: no partial
   scratch[t] = i < particle_count ? particle_stats[i] : vec4(0.0);
   for (uint stride = 128u; stride > 0u; stride >>= 1u) {
     barrier();
@@ -19,5 +21,5 @@ void main() {
       scratch[t] = vec4(a.x + b.x, a.y + b.y, max(a.z, b.z), a.w + b.w);
     }
   }
-  if (t == 0u) partials[gl_WorkGroupID.x] = scratch[0];
+  if (t == 0u) partials[dispatch_group()] = scratch[0];
 }

@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Re-sort, pass 5, per new particle: its owner is the body's new index, and its springs name their
 // partner particles by their new ids (walls and free slots unchanged).
+#include "common/dispatch.glsl"
 #include "sim/bindings.h"
 #include "common/layouts.h"
 #include "sim/precision.glsl"
@@ -17,7 +18,7 @@ layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots springs
 uniform uint particle_count;
 uniform int spring_model;
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = dispatch_item();
   if (i >= particle_count) return;
   particle_info[i].x = owner[i];
   if (spring_model == 0) return;

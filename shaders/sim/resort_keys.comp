@@ -4,6 +4,7 @@
 // of each cell coordinate, interleaved) masked to the table size, so bodies in neighbouring cells get
 // nearby keys and end up near each other in memory; and a slot in its key's bucket (order fixed later
 // by common/grid_sort_cells.comp, so the result does not depend on the atomics).
+#include "common/dispatch.glsl"
 #include "common/bindings.h"
 #include "sim/bindings.h"
 #include "common/hash_grid.glsl"
@@ -29,7 +30,7 @@ uint spread_bits(uint v) {
 }
 
 void main() {
-  uint b = gl_GlobalInvocationID.x;
+  uint b = dispatch_item();
   if (b >= body_count) return;
   uvec3 c = uvec3(cell_of_position(vec3(body_position[b].xyz), cell_size));
   uint k = (spread_bits(c.x) | (spread_bits(c.y) << 1u) | (spread_bits(c.z) << 2u)) & (table_size - 1u);

@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Re-sort, pass 3, per new body: its new range (keyframe references kept), and for each of its
 // particles where it comes from, where it goes, and which body now owns it.
+#include "common/dispatch.glsl"
 #include "common/bindings.h"
 #include "sim/bindings.h"
 #include "common/layouts.h"
@@ -15,7 +16,7 @@ layout(std430, binding = TS_SIM_RESORT_DESTINATION) writeonly buffer Destination
 layout(std430, binding = TS_SIM_RESORT_OWNER) writeonly buffer Owner { uint owner[]; };             // new particle -> new body
 uniform uint body_count;
 void main() {
-  uint b = gl_GlobalInvocationID.x;
+  uint b = dispatch_item();
   if (b >= body_count) return;
   uvec4 old_range = body_range[order[b]];
   uint first = new_first[b];

@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Re-sort, pass 2: the particle count of each body in its new place, to be scanned into the bodies'
 // new first particles (a body's particles stay contiguous and in their order).
+#include "common/dispatch.glsl"
 #include "common/bindings.h"
 #include "sim/bindings.h"
 #include "common/layouts.h"
@@ -11,6 +12,6 @@ layout(std430, binding = TS_SIM_BODY_RANGE) readonly buffer BR { uvec4 body_rang
 layout(std430, binding = TS_SIM_RESORT_NEW_FIRST) writeonly buffer NewFirst { uint new_first[]; };
 uniform uint body_count;
 void main() {
-  uint b = gl_GlobalInvocationID.x;
+  uint b = dispatch_item();
   if (b < body_count) new_first[b] = body_range[order[b]].y;
 }

@@ -1,6 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Step 1: body poses -> particle world positions and velocities (thesis eq. 3.43: v_p = v + w x (R o_p)).
+#include "common/dispatch.glsl"
 #include "sim/bindings.h"
 #include "common/layouts.h"
 #include "sim/rigid.glsl"
@@ -18,7 +19,7 @@ layout(std430, binding = TS_SIM_PARTICLE_POSITION_EXACT) writeonly buffer PX { d
 #endif
 uniform uint particle_count;
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = dispatch_item();
   if (i >= particle_count) return;
   uint b = particle_info[i].x;
   real3 arm = rotate(body_orientation[b], particle_local[i].xyz);

@@ -1,6 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // y <- a x + y: the smallest kernel, used by tests of the GPU layer (dispatch, barriers, readback, timers).
+#include "common/dispatch.glsl"
 #include "test/bindings.h"
 layout(local_size_x = 64) in;
 layout(std430, binding = TS_TEST_SAXPY_X) readonly buffer X { float x[]; };
@@ -8,6 +9,6 @@ layout(std430, binding = TS_TEST_SAXPY_Y) buffer Y { float y[]; };
 uniform float a;
 uniform uint count;
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = dispatch_item();
   if (i < count) y[i] = a * x[i] + y[i];
 }

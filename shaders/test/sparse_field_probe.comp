@@ -9,6 +9,7 @@
 // mode 5: as mode 0 with the accessor's root moved onto the grid header (whose word at the root's tile
 // count offset is the grid index, 0): a read that walked the root would find no tile and give the
 // background, so this shows that reads in the first root tile never walk it (the NVIDIA work-around).
+#include "common/dispatch.glsl"
 #include "test/bindings.h"
 layout(local_size_x = 64) in;
 layout(std430, binding = TS_TEST_FIELD_GRID) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
@@ -33,7 +34,7 @@ const int mode = TS_PROBE_MODE;
 uniform int mode;
 #endif
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = dispatch_item();
   if (i >= count) return;
   FieldReader reader = field_reader();
   vec3 x = points[i].xyz;

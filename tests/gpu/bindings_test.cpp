@@ -187,6 +187,25 @@ TEST(HostSources, OnlyTheGpuLayerMakesTheGlCallsThatWait) {
                             << ::testing::PrintToString(hits);
 }
 
+// Past GL_MAX_COMPUTE_WORK_GROUP_COUNT[0] groups the queue lays a dispatch out as a 2D grid, where
+// gl_GlobalInvocationID.x and gl_WorkGroupID.x no longer number items and groups: kernels go through
+// shaders/common/dispatch.glsl (tests/gpu/context_test.cpp runs a dispatch past the limit).
+TEST(Dispatch, KernelsNumberItemsAndGroupsOnlyThroughDispatchGlsl) {
+  const std::regex raw(R"(gl_(GlobalInvocationID|WorkGroupID))");
+  const std::regex through(R"(dispatch_(item|group)\(\))");
+  std::vector<std::string> hits;
+  std::size_t users = 0;
+  for (const fs::path& file : files_below(kSource / "shaders", {".comp", ".glsl"})) {
+    if (file.generic_string() == "common/dispatch.glsl") continue;
+    const std::string text = read_text(kSource / "shaders" / file);
+    for (auto& hit : matching_lines(text, raw, file.generic_string())) hits.push_back(hit);
+    if (std::regex_search(text, through)) ++users;
+  }
+  EXPECT_GE(users, 20u);  // the check must see the kernels it guards
+  EXPECT_TRUE(hits.empty()) << "number items with dispatch_item() and groups with dispatch_group():\n"
+                            << ::testing::PrintToString(hits);
+}
+
 TEST(Bindings, NoTwoBlocksOfOnePassShareASlot) {
   const auto all = passes();
   ASSERT_GT(all.size(), 20u);  // the check must see the kernels it guards

@@ -81,6 +81,45 @@ TEST(GpuQueue, DispatchComputesSaxpyAndReadsBack) {
   EXPECT_NE(queue.timing_report().find("test/saxpy.comp"), std::string::npos);
 }
 
+TEST(GpuQueue, GroupGridCoversEveryGroupInRowsNoWiderThanTheLimit) {
+  for (const std::size_t max_x : {std::size_t{1}, std::size_t{7}, std::size_t{65535}}) {
+    for (const std::size_t groups : {std::size_t{1}, max_x, max_x + 1, 2 * max_x, 3 * max_x - 1, 70 * max_x + 3}) {
+      const auto [gx, gy] = Queue::group_grid(groups, max_x);
+      EXPECT_LE(gx, max_x) << groups << " groups, limit " << max_x;
+      EXPECT_GE(std::size_t{gx} * gy, groups) << groups << " groups, limit " << max_x;
+      EXPECT_LT(std::size_t{gx} * (gy - 1), groups) << "a whole row of padding: " << groups << ", " << max_x;
+      if (groups <= max_x) {
+        EXPECT_EQ(gy, 1u);
+      }
+    }
+  }
+}
+
+// Past GL_MAX_COMPUTE_WORK_GROUP_COUNT[0] groups (65535 on llvmpipe) the items go out in rows of a 2D
+// grid (shaders/common/dispatch.glsl); each is computed once and the padding past the end touches nothing.
+TEST(GpuQueue, ItemsPastTheGroupLimitAlongXAreEachComputedOnce) {
+  Context context;
+  const std::size_t max_x = static_cast<std::size_t>(context.limits().max_compute_work_group_count[0]);
+  const std::size_t local = 64;  // test/saxpy.comp
+  if (max_x * local > (std::size_t{1} << 26)) GTEST_SKIP() << "this GPU's x limit (" << max_x << " groups) is too large to pass here";
+  ShaderLibrary library;
+  Program saxpy = Program::compute(library, "test/saxpy.comp");
+  const std::size_t n = max_x * local + 1000;
+  std::vector<float> x(n), y(n + 64, -7.0f);  // y's tail past `count`: must stay as it is
+  for (std::size_t i = 0; i < n; ++i) x[i] = static_cast<float>(i % 4093);
+  std::fill(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(n), 1.0f);
+  Buffer bx = Buffer::from<float>(x), by = Buffer::from<float>(y);
+  bx.bind(TS_TEST_SAXPY_X);
+  by.bind(TS_TEST_SAXPY_Y);
+  saxpy.set("a", 2.0f);
+  saxpy.set("count", static_cast<unsigned>(n));
+  Queue queue(/*timings=*/false, /*check_errors=*/true);
+  queue.dispatch_items(saxpy, n);
+  const auto result = by.read<float>(n + 64);
+  for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(result[i], 1.0f + 2.0f * static_cast<float>(i % 4093)) << i;
+  for (std::size_t i = n; i < n + 64; ++i) ASSERT_EQ(result[i], -7.0f) << i;
+}
+
 TEST(ShaderLibrary, CompileErrorNamesFileAndLine) {
   Context context;
   const auto dir = std::filesystem::temp_directory_path() / "tetrasand-shader-error-test";

@@ -34,6 +34,26 @@ TEST_F(GpuGrid, PrefixScanMatchesCpuAtBlockBoundariesAndAcrossLevels) {
   }
 }
 
+// A scan with more 512-value blocks than the GPU's work groups along x (65535 on llvmpipe): its first
+// level goes out as a 2D grid of groups, whose padding groups must write no block sum.
+TEST_F(GpuGrid, PrefixScanPastTheGroupLimitAlongXMatchesCpu) {
+  const std::size_t max_x = static_cast<std::size_t>(context.limits().max_compute_work_group_count[0]);
+  if (max_x * 512 > (std::size_t{1} << 26)) GTEST_SKIP() << "this GPU's x limit (" << max_x << " groups) is too large to pass here";
+  const auto n = static_cast<std::uint32_t>(max_x * 512 + 1000);
+  std::vector<std::uint32_t> values(n);
+  std::mt19937 rng(11);
+  for (auto& v : values) v = rng() % 3;
+  Buffer buffer = Buffer::from<std::uint32_t>(values);
+  PrefixScan scan(library);
+  scan.run(queue, buffer, n);
+  const auto gpu = buffer.read<std::uint32_t>(n);
+  std::uint32_t sum = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    ASSERT_EQ(gpu[i], sum) << "i=" << i;
+    sum += values[i];
+  }
+}
+
 std::uint32_t cpu_hash(int x, int y, int z, std::uint32_t table) {
   return ((static_cast<std::uint32_t>(x) * 73856093u) ^ (static_cast<std::uint32_t>(y) * 19349663u) ^
           (static_cast<std::uint32_t>(z) * 83492791u)) & (table - 1u);
