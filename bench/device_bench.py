@@ -42,14 +42,16 @@ SIZES = {
         "selftest": "full",
         "sdf": {"meshes": ["knot1", "armadillo", "icosphere:8"], "resolutions": [256, 512, 1024, 2048]},
         "sampler": {"mesh": "bunny", "counts": [10_000, 100_000, 1_000_000]},
-        "sim": {"grains": [64_000, 1_000_000, 4_000_000], "precisions": ["float", "double"], "seconds": 1.0},
+        "sim": {"grains": [64_000, 1_000_000, 4_000_000], "precisions": ["float", "double"], "seconds": 1.0,
+                "kernel_grains": [1_000_000, 4_000_000], "kernel_seconds": 0.5},
         "preview": {"mesh": "bunny", "size": 1024, "resolution": 1024, "particles": 1_000_000, "repeat": 3},
     },
     "quick": {
         "selftest": "quick",
         "sdf": {"meshes": ["knot1", "icosphere:2"], "resolutions": [16, 24]},
         "sampler": {"mesh": "bunny", "counts": [400, 600]},
-        "sim": {"grains": [1000], "precisions": ["float", "double"], "seconds": 0.1},
+        "sim": {"grains": [1000], "precisions": ["float", "double"], "seconds": 0.1,
+                "kernel_grains": [1000], "kernel_seconds": 0.05},
         "preview": {"mesh": "bunny", "size": 96, "resolution": 32, "particles": 2000, "repeat": 1},
     },
 }
@@ -106,6 +108,22 @@ def outcome(rc, stderr):
     if rc is None:
         return "timeout", "stopped at its time cap"
     return ("ok", "") if rc == 0 else ("error", f"exit status {rc}: {tail(stderr)}")
+
+
+def kernel_tables(text):
+    """The per-kernel tables `tetrasand_bench_sim --timings` prints to stderr, one per size:
+    {grains: [{kernel, calls, ms, share}]} (the `total` row left out)."""
+    tables, grains = {}, None
+    for line in text.splitlines():
+        head = re.match(r"^(\d+) grains:$", line)
+        row = re.match(r"^(\S+)\s+(\d+)\s+([\d.]+)\s+([\d.]+)%$", line)
+        if head:
+            grains = head.group(1)
+            tables[grains] = []
+        elif row and grains is not None:
+            tables[grains].append({"kernel": row.group(1), "calls": int(row.group(2)), "ms": float(row.group(3)),
+                                   "share": float(row.group(4))})
+    return tables
 
 
 def csv_rows(path):
@@ -213,7 +231,19 @@ class Run:
         cmd = [self.exe("sim"), "--grains", ",".join(map(str, s["grains"])), "--precision", ",".join(s["precisions"]),
                "--seconds", str(s["seconds"]), "--csv", table]
         rc, secs, _, err = run_capped(cmd, cap, os.path.join(self.work, "sim"))
-        return rc, secs, err, {"command": cmd, "planned_grains": s["grains"], "rows": csv_rows(table)}
+        result = {"command": cmd, "planned_grains": s["grains"], "rows": csv_rows(table)}
+        # Then, with what the cap leaves, where a float step's GPU time goes (timer queries, read at the
+        # end) at the large sizes: a separate run, so the queries do not touch the rates above. On the
+        # first device run 4M grains stepped 130x slower than 1M; this names the kernel.
+        left = cap - secs
+        if rc == 0 and left > 5:
+            kcmd = [self.exe("sim"), "--grains", ",".join(map(str, s["kernel_grains"])), "--precision", "float",
+                    "--seconds", str(s["kernel_seconds"]), "--timings"]
+            krc, ksecs, _, kerr = run_capped(kcmd, left, os.path.join(self.work, "sim-kernels"))
+            status, error = outcome(krc, kerr)
+            result["kernels"] = {"command": kcmd, "status": status, "error": error, "tables": kernel_tables(kerr)}
+            secs += ksecs
+        return rc, secs, err, result
 
     def preview(self, cap):
         s = self.sizes["preview"]
@@ -407,6 +437,17 @@ def sim_section(res):
     gone = [g for g in p.get("planned_grains", []) if g // 1000 not in done]
     if gone:
         lines += ["", "Not run (planned, no row above): " + ", ".join(map(str, gone)) + " grains."]
+    k = p.get("kernels")
+    if k:
+        lines += ["", f"Where a float step's GPU time goes: `{' '.join(os.path.basename(c) for c in k['command'])}` "
+                  f"(a separate run with timer queries, read at the end; status {k['status']}"
+                  + (f": {k['error']}" if k["error"] else "") + ")."]
+        for grains, table in k["tables"].items():
+            steps = max((t["calls"] for t in table if t["kernel"] == "sim/contact_forces.comp"), default=0)
+            lines += ["", f"{grains} grains, {steps} steps:", "", "| kernel | calls | ms | share | ms per step |",
+                      "|---|---|---|---|---|"]
+            lines += [f"| {t['kernel']} | {t['calls']} | {t['ms']:.2f} | {t['share']:.1f} % "
+                      f"| {t['ms'] / steps if steps else float('nan'):.3f} |" for t in table]
     return "\n".join(lines)
 
 

@@ -57,6 +57,10 @@ def quick(build):
     check(len(sdf) == 4 and all(int(r["gpu_wrong_signs"]) == 0 for r in sdf), "sdf: 2 meshes x 2 grids, no wrong sign")
     sim = res["parts"]["sim"]["rows"]
     check(sorted(r["precision"] for r in sim) == ["double", "float"], "sim: a float and a double row")
+    kernels = res["parts"]["sim"].get("kernels", {})
+    table = kernels.get("tables", {}).get("1000", [])
+    check(kernels.get("status") == "ok" and any(t["kernel"] == "sim/contact_forces.comp" and t["calls"] > 0 for t in table)
+          and abs(sum(t["share"] for t in table) - 100) < 1, f"sim: the per-kernel table of the 1000-grain float run ({kernels})")
     sampler = res["parts"]["sampler"]["rows"]
     # --backend auto: the GPU kernels on a hardware GPU, the CPU relaxation on llvmpipe; either names itself.
     check(all(r["status"] == "ok" and ("sampler/relax.comp" in r["timings"] or "CPU relaxation" in r["timings"])
@@ -87,6 +91,7 @@ def report(build):
               f"nvidia-{part}: names the GL renderer and the date")
         check("Not an NVIDIA GPU" in body, f"nvidia-{part}: an llvmpipe run is labelled as not NVIDIA")
     check("| knot1 | 6400 |" in doc and "| 1000 | double |" in doc, "the SDF and sim rows are in their sections")
+    check("| sim/contact_forces.comp |" in doc, "the sim section has the per-kernel table")
     outside = lambda text: text.split("<!-- section: nvidia-selftest -->")[0]
     check(outside(doc) == outside(original), "the text before the NVIDIA sections is unchanged")
     device_bench("report", results, "--markdown", copy, "--allow-test", "--baseline", results)
