@@ -39,9 +39,13 @@ void emit(vec3 p, int layer) {
   EmitVertex();
 }
 
-vec3 edge_point(vec3 a, vec3 b, float sa, float sb) {
-  // sa and sb lie on opposite sides (one > 0, the other <= 0), so sa - sb never vanishes.
-  return mix(a, b, sa / (sa - sb));
+// Where the edge from a vertex above the slice plane (signed height sa > 0) to one below (sb <= 0)
+// crosses it; sa - sb never vanishes. Always called above-to-below and `precise` (no contraction that
+// could differ between call sites), so an edge shared by two tetrahedra gives the bitwise same point
+// in both, and their slices meet without a crack a voxel centre could fall into.
+vec3 edge_point(vec3 above, vec3 below, float sa, float sb) {
+  precise vec3 p = mix(above, below, sa / (sa - sb));
+  return p;
 }
 
 void slice_tetrahedron(vec3 v0, vec3 v1, vec3 v2, vec3 v3, float z, int layer) {
@@ -63,10 +67,13 @@ void slice_tetrahedron(vec3 v0, vec3 v1, vec3 v2, vec3 v3, float z, int layer) {
     emit(edge_point(v[b], v[d], s[b], s[d]), layer);
   } else {
     int lone = na == 1 ? above[0] : below[0];
-    for (int i = 0, k = 0; i < 4; ++i) {
+    for (int i = 0; i < 4; ++i) {
       if (i == lone) continue;
-      emit(edge_point(v[lone], v[i], s[lone], s[i]), layer);
-      ++k;
+      if (na == 1) {
+        emit(edge_point(v[lone], v[i], s[lone], s[i]), layer);
+      } else {
+        emit(edge_point(v[i], v[lone], s[i], s[lone]), layer);
+      }
     }
   }
   EndPrimitive();
