@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <span>
 
@@ -239,14 +240,15 @@ void fill_dense_off_band(DenseSdf& dense, const std::vector<std::uint8_t>& state
     if (state[idx] != kInBand) dense.values[idx] = {0.0f, 0.0f, 0.0f, state[idx] == kOutside ? band_world : -band_world};
 }
 
-// `max_items`: the most voxels one compute dispatch of the band compaction (and its scan) covers,
-// 256 per work group times the device's work-group count limit along x.
+// `max_items`: the most voxels one slab's band compaction (and its scan) takes: slab voxels are
+// numbered in 32 bits, and one dispatch covers 256 per work group times the device's work-group
+// count limits along x and y (gpu::Queue::dispatch_groups lays the groups out in rows).
 int choose_slab_layers(const GridSpec& spec, std::size_t budget, std::size_t max_items, int max_layers) {
   const std::size_t per_layer = bytes_per_layer(spec);
   const std::size_t layer_voxels = static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y());
   if (layer_voxels > max_items) {
-    throw GpuError(fmt::format("one z-layer of the SDF grid ({} x {} voxels) exceeds the {} voxels one compute dispatch "
-                               "of this GPU covers; use a larger voxel size",
+    throw GpuError(fmt::format("one z-layer of the SDF grid ({} x {} voxels) exceeds the {} voxels one slab's band "
+                               "compaction covers on this GPU; use a larger voxel size",
                                spec.dims.x(), spec.dims.y(), max_items));
   }
   const int fit = static_cast<int>(std::min<std::size_t>(
@@ -562,6 +564,13 @@ void check_request(const gpu::Context& context, const GridSpec& spec, const Scan
 }
 
 // Layers one slab target may have: 2D array layers and layered-framebuffer layers.
+std::size_t max_slab_items(const gpu::Context& context) {
+  const gpu::DeviceLimits& l = context.limits();
+  const std::size_t groups = static_cast<std::size_t>(l.max_compute_work_group_count[0]) *
+                             static_cast<std::size_t>(std::max(l.max_compute_work_group_count[1], 1));
+  return std::min<std::size_t>(std::numeric_limits<std::uint32_t>::max(), 256u * groups);
+}
+
 int max_slab_layers(const gpu::Context& context) {
   const gpu::DeviceLimits& l = context.limits();
   return std::min(l.max_texture_layers, l.max_framebuffer_layers > 0 ? l.max_framebuffer_layers : l.max_texture_layers);
@@ -577,8 +586,7 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
                                const GridSpec& spec, const ScanConvertOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   check_request(context, spec, options);
-  const std::size_t max_items = 256u * static_cast<std::size_t>(context.limits().max_compute_work_group_count[0]);
-  const ScanPlan plan = plan_scan(max_items, max_slab_layers(context), mesh, normals, spec, options);
+  const ScanPlan plan = plan_scan(max_slab_items(context), max_slab_layers(context), mesh, normals, spec, options);
   gpu::ShaderLibrary library;
   gpu::Queue queue(options.timings, context.debug());
   SlabScanner scanner(library, queue, spec, plan);
