@@ -34,19 +34,10 @@ void ensure(gpu::Buffer& buffer, std::size_t bytes) {
 
 float bits_to_float(std::uint32_t bits) { return std::bit_cast<float>(bits); }
 
-// gpu::PrefixScan adds its block sums back in one dispatch of 256-wide groups: a level's flags
-// (sub-triangles + 1) must fit in 65535 of them.
-constexpr std::size_t kMaxScanItems = 65535 * 256 - 1;
-
-// GL guarantees only 65535 work groups along x: larger levels go in chunks, each told its first item.
-constexpr std::size_t kMaxGroups = 65535;
-void dispatch_chunked(gpu::Queue& queue, const gpu::Program& program, std::size_t items) {
-  const std::size_t chunk = kMaxGroups * static_cast<std::size_t>(program.local_size()[0]);
-  for (std::size_t base = 0; base < items; base += chunk) {
-    program.set("base", static_cast<std::uint32_t>(base));
-    queue.dispatch_items(program, std::min(chunk, items - base));
-  }
-}
+// A level of n sub-triangles has at most 4n children, totalled by a 32-bit scan over n + 1 flags:
+// 4n + 1 must fit in a uint, the only bound on a level's size (dispatches of any size go out as a 2D
+// grid of work groups, gpu::Queue::dispatch_items).
+constexpr std::size_t kMaxLevelItems = (std::size_t{std::numeric_limits<std::uint32_t>::max()} - 1) / 4;
 
 }  // namespace
 
@@ -189,7 +180,7 @@ CoverageCertifier::LevelCounts CoverageCertifier::evaluate(std::uint32_t count, 
                 static_cast<float>(std::max(frame.radius, double{witness_so_far}) / settings.floor_divisor));
   evaluate_.set("witness_so_far", witness_so_far);
   evaluate_.set("no_split", no_split ? 1u : 0u);
-  dispatch_chunked(queue_, evaluate_, std::size_t{count} + 1);
+  queue_.dispatch_items(evaluate_, std::size_t{count} + 1);
   scan_.run(queue_, splits_, count + 1);
   scan_.run(queue_, uncovered_, count + 1);
   LevelCounts counts;
@@ -208,7 +199,7 @@ void CoverageCertifier::scatter(std::uint32_t count, const LevelCounts& counts) 
   queue_buffers_[1].bind(TS_CERT_NEXT_QUEUE);
   holes_.bind(TS_CERT_HOLES);
   scatter_.set("count", count);
-  dispatch_chunked(queue_, scatter_, count);
+  queue_.dispatch_items(scatter_, count);
   std::swap(queue_buffers_[0], queue_buffers_[1]);
 }
 
@@ -332,12 +323,12 @@ CoverageCertificate CoverageCertifier::certify(std::span<const Eigen::Vector3f> 
                                                const CertificateSettings& settings) {
   if (centres.empty()) throw Error(ExitCode::Internal, "coverage certificate: no centres");
   if (!(radius > 0.0) || !(settings.floor_divisor >= 1.0) || !(settings.hole_divisor >= 1.0) ||
-      settings.max_shells < 1 || settings.max_subtriangles >= kMaxScanItems) {
+      settings.max_shells < 1 || settings.max_subtriangles > kMaxLevelItems) {
     throw Error(ExitCode::Internal, "coverage certificate: radius, divisors, shells or budget out of range");
   }
-  if (mesh_.triangle_count() >= kMaxScanItems) {
+  if (mesh_.triangle_count() > kMaxLevelItems) {
     throw InputError(fmt::format("coverage certificate: {} triangles, more than the {} it can take",
-                                 mesh_.triangle_count(), kMaxScanItems - 1));
+                                 mesh_.triangle_count(), kMaxLevelItems));
   }
   CoverageCertificate result;
   result.radius = radius;

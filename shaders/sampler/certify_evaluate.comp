@@ -31,7 +31,6 @@ layout(std430, binding = TS_CERT_BOUNDS) writeonly buffer Bounds { vec4 bounds[]
 layout(std430, binding = TS_CERT_TOTALS) buffer Totals { uint totals[]; };
 
 uniform uint count;             // sub-triangles in the queue
-uniform uint base;              // this dispatch's first sub-triangle (dispatches are chunked)
 uniform float cell_size;        // of the hashed grid [m]
 uniform uint table_size;
 uniform int max_shells;         // the search stops after this many shells around the centroid's cell
@@ -88,7 +87,7 @@ void visit_shell(ivec3 c, int R, vec3 v0, vec3 v1, vec3 v2, vec3 g, inout Search
 }
 
 void main() {
-  uint e = base + dispatch_item();
+  uint e = dispatch_item();
   if (e == count) {  // the extra zero that makes the scanned value at `count` the total
     splits[e] = 0u;
     uncovered[e] = 0u;

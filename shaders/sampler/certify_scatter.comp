@@ -19,14 +19,13 @@ layout(std430, binding = TS_CERT_NEXT_QUEUE) writeonly buffer NextQueue { uvec4 
 layout(std430, binding = TS_CERT_HOLES) writeonly buffer Holes { CertLeaf holes[]; };
 
 uniform uint count;
-uniform uint base;  // this dispatch's first sub-triangle (dispatches are chunked)
 
 uvec4 child(uint triangle, uint level, bool down, uint i, uint j) {
   return uvec4(triangle, level | (down ? 1u << 8 : 0u), i, j);
 }
 
 void main() {
-  uint e = base + dispatch_item();
+  uint e = dispatch_item();
   if (e >= count) return;
   uvec4 id = queue[e];
   uint first = split_offset[e];

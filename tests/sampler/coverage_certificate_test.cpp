@@ -17,6 +17,7 @@
 #include <ostream>
 #include <random>
 
+#include "core/error.h"
 #include "sampler/cpu_coverage_certificate.h"
 #include "sampler/point_grid.h"
 #include "sampler/sampling_quality.h"
@@ -400,6 +401,25 @@ TEST(CoverageCertificate, SameInputGivesTheSameBitsAndABudgetCostsTilesNotRefine
     EXPECT_LE(budget.covering_lower, exact);
     EXPECT_EQ(budget.covered, budget.covering_bound <= r);
   }
+}
+
+TEST(CoverageCertificate, LevelBudgetIsBoundedOnlyByItsThirtyTwoBitCounts) {
+  // Levels of any size go out as a 2D grid of work groups, so a budget past the old one-row limit
+  // (16M) is taken and changes nothing where the work is small; one whose children (four per
+  // sub-triangle) could not count in 32 bits is refused.
+  const TriangleMesh sphere = test::icosphere(1.0, 2);
+  const std::vector<Eigen::Vector3f> stored =
+      to_float(std::vector<Eigen::Vector3d>(sphere.vertices.begin(), sphere.vertices.begin() + 42));
+  CoverageCertifier certifier(shared_context(), sphere);
+  CertificateSettings large;
+  large.max_subtriangles = std::size_t{1} << 28;
+  const CoverageCertificate by_default = certifier.certify(stored, 0.3);
+  const CoverageCertificate with_large = certifier.certify(stored, 0.3, large);
+  EXPECT_EQ(with_large.covering_bound, by_default.covering_bound);
+  EXPECT_EQ(with_large.evaluated, by_default.evaluated);
+  CertificateSettings too_large;
+  too_large.max_subtriangles = std::size_t{1} << 30;
+  EXPECT_THROW(certifier.certify(stored, 0.3, too_large), Error);
 }
 
 TEST_P(KnownCoverage, FarFromTheOriginAndTinyTheBoundStaysAboveTheExactValue) {
