@@ -32,10 +32,10 @@ struct CertificateSettings {
   // sub-triangle; one that finds no centre there is bounded on the CPU (exact nearest centre).
   int max_shells = 8;
   // Sub-triangles one level may hand to the next, which bounds the certificate's GPU memory (8M take
-  // about 330 MB; at most about 1.07e9, so that a level's children, four each, count in 32 bits). Triangles are certified in
-  // tiles (ranges of triangles): a tile whose next level would pass this is split and redone, so the
-  // budget costs time, not refinement. Only a single triangle past it has that level made final
-  // (still conservative: what is not proven covered is reported uncovered).
+  // about 330 MB; at most about 1.07e9, so that a level's children, four each, count in 32 bits).
+  // Triangles are certified in tiles (ranges of triangles): a tile whose next level would pass this
+  // is split and redone, so the budget costs time, not refinement. Only a single triangle past it
+  // has that level made final (still conservative: what is not proven covered is reported uncovered).
   std::size_t max_subtriangles = std::size_t{1} << 23;
 };
 
