@@ -1,11 +1,11 @@
-// `tetrasand export lammps SCENE.toml -o DIR`: the scene as a LAMMPS input deck (sim/export_lammps.h),
+// `tetrasand export lammps SCENE.toml -o DIR`: the scene as a LAMMPS input deck (export/lammps_deck.h),
 // for scenes that outgrow one GPU and run on a cluster under LAMMPS with MPI.
 #include <fmt/format.h>
 
 #include "app/commands.h"
 #include "core/log.h"
-#include "sim/export_lammps.h"
-#include "sim/scene.h"
+#include "export/lammps_deck.h"
+#include "scene/scene.h"
 
 namespace ts::app {
 
@@ -21,8 +21,8 @@ Runner add_export_command(CLI::App& app, const GlobalOptions&) {
   lammps->add_option("SCENE", o->scene, "Scene file (TOML; see assets/scenes/README.md)")->required()->check(CLI::ExistingFile);
   lammps->add_option("-o,--output", o->output, "Output directory")->capture_default_str();
   return [o] {
-    const sim::Scene scene = sim::load_scene(o->scene);
-    const sim::LammpsDeck deck = sim::export_lammps(scene, o->output);
+    const scene::Scene scene = scene::load_scene(o->scene);
+    const exporter::LammpsDeck deck = exporter::export_lammps(scene, o->output);
     fmt::print("{}: LAMMPS deck in {} ({} rigid bodies, {} frozen particles, dt = {:.4g} s, {} steps)\n", o->scene,
                o->output, deck.dynamic_bodies, deck.frozen_particles, deck.dt, deck.steps);
     for (const std::string& a : deck.approximations) fmt::print("  not exactly the same: {}\n", a);

@@ -15,8 +15,8 @@
 #include "gpu/context.h"
 #include "preview/sim_frames.h"
 #include "sim/gpu_stepper.h"
-#include "sim/scene.h"
-#include "sim/scene_runner.h"
+#include "scene/scene.h"
+#include "scene/scene_runner.h"
 
 namespace ts::app {
 namespace {
@@ -84,7 +84,7 @@ void report_progress(double duration, const sim::World& world, const sim::StepSt
 
 // "360 grains; props: 1 dynamic; static bodies: 2 rough walls; smooth walls: 5 planes" (kinds with
 // none left out, so a grain-only scene reads "360 grains").
-std::string describe_bodies(const sim::BodyCounts& c) {
+std::string describe_bodies(const scene::BodyCounts& c) {
   const auto plural = [](std::size_t n, std::string_view what) {
     return fmt::format("{} {}{}", n, what, n == 1 ? "" : "s");
   };
@@ -145,7 +145,7 @@ Backend choose_backend(const Options& o, const GlobalOptions& global, bool frame
 
 const std::string& output_dir(const Options& o) { return o.resume.empty() ? o.output : o.resume; }
 
-void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResult& result, double seconds,
+void print_summary(const Options& o, const scene::Scene& scene, const scene::RunResult& result, double seconds,
                    Backend backend, const gpu::Context* context) {
   // Steps this process ran (a resumed run started at resumed_from).
   const auto stepped = static_cast<double>(result.steps - std::max<std::int64_t>(result.resumed_from, 0));
@@ -164,7 +164,7 @@ void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResu
   if (result.checkpoints > 0)
     fmt::print("checkpoints: {} written in {}\n", result.checkpoints, output_dir(o));
   std::vector<std::string> files;
-  for (const sim::OutputRecord& f : result.files)
+  for (const scene::OutputRecord& f : result.files)
     files.push_back(fmt::format("{} ({} {})", (std::filesystem::path(output_dir(o)) / f.pattern).string(),
                                 f.count, f.unit));
   fmt::print("outputs: {}\n", files.empty() ? std::string("none ([output] writes nothing)")
@@ -173,10 +173,10 @@ void print_summary(const Options& o, const sim::Scene& scene, const sim::RunResu
 
 int run_sim(const Options& o, const GlobalOptions& global) {
   requested_backend(o);  // a usage error before any work
-  const sim::Scene scene = sim::load_scene(o.scene);
+  const scene::Scene scene = scene::load_scene(o.scene);
   std::unique_ptr<gpu::Context> context;
   const Backend backend = choose_backend(o, global, scene.output.frames, context);
-  sim::StepperFactory make_stepper;  // empty: the CPU reference
+  scene::StepperFactory make_stepper;  // empty: the CPU reference
   if (backend == Backend::Gpu) {
     const auto precision = o.precision == "double" ? sim::Precision::Double : sim::Precision::Float;
     make_stepper = [&, precision](const sim::StepSettings& settings) -> std::unique_ptr<sim::Stepper> {
@@ -185,7 +185,7 @@ int run_sim(const Options& o, const GlobalOptions& global) {
   }
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
   const auto start = Clock::now();
-  sim::RunHooks hooks;
+  scene::RunHooks hooks;
   std::unique_ptr<preview::SimFrameWriter> frames;  // [output] frames = true: PNGs through the preview renderer
   if (scene.output.frames) {
     frames = std::make_unique<preview::SimFrameWriter>(*context, scene);
@@ -203,10 +203,10 @@ int run_sim(const Options& o, const GlobalOptions& global) {
   };
   std::string timing_report;
   if (o.timings) hooks.on_finish = [&](sim::Stepper& stepper) { timing_report = stepper.timing_report(); };
-  sim::RunControl control;
+  scene::RunControl control;
   control.resume = !o.resume.empty();
   control.duration = o.duration;
-  const sim::RunResult result = sim::run_scene(scene, output_dir(o), hooks, make_stepper, control);
+  const scene::RunResult result = scene::run_scene(scene, output_dir(o), hooks, make_stepper, control);
   if (terminal) std::fprintf(stderr, "\n");
   if (!result.time_step_warning.empty()) log::warn("{}", result.time_step_warning);
   print_summary(o, scene, result, std::chrono::duration<double>(Clock::now() - start).count(), backend,

@@ -9,8 +9,8 @@
 #include <utility>
 
 #include "sim/grain.h"
-#include "sim/scene_runner.h"
-#include "sim/scene_world.h"
+#include "scene/scene_runner.h"
+#include "scene/scene_world.h"
 
 namespace ts::bench {
 
@@ -56,9 +56,9 @@ std::string grain_centres_csv(const sim::World& world) {
   return csv;
 }
 
-BenchWorld settle(const sim::Scene& scene) {
-  BenchWorld out{sim::make_world(scene), scene.simulation.step};
-  out.settings.dt = sim::resolve_time_step(scene, out.world, nullptr);
+BenchWorld settle(const scene::Scene& scene) {
+  BenchWorld out{scene::make_world(scene), scene.simulation.step};
+  out.settings.dt = scene::resolve_time_step(scene, out.world, nullptr);
   sim::CpuStepper stepper(out.world, out.settings);
   const auto steps = static_cast<std::int64_t>(std::ceil(scene.simulation.duration / out.settings.dt));
   for (std::int64_t s = 0; s < steps; ++s) stepper.step(out.world);
@@ -101,15 +101,15 @@ std::pair<std::size_t, std::size_t> tile_grid(std::size_t tiles) {
 
 BenchWorld settled_bed(std::uint32_t grains) {
   struct Tile {
-    sim::Scene scene;
+    scene::Scene scene;
     BenchWorld settled;
   };
   static const Tile tile = [] {
-    Tile t{sim::load_scene(reference_scene("bed_tile.toml")), {}};
+    Tile t{scene::load_scene(reference_scene("bed_tile.toml")), {}};
     t.settled = settle(t.scene);
     return t;
   }();
-  const sim::Boundary& box = tile.scene.boundaries.at(0);
+  const scene::Boundary& box = tile.scene.boundaries.at(0);
   const Eigen::Vector3d extent = box.max - box.min;
   const sim::World& source = tile.settled.world;
   const std::size_t tiles = std::max<std::size_t>(1, grains / source.bodies.size());

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "sim/cpu_reference.h"
-#include "sim/scene.h"
+#include "scene/scene.h"
 #include "sim/world.h"
 
 namespace ts::bench {
@@ -30,7 +30,7 @@ struct BenchWorld {
 };
 
 // `scene` built and run on the CPU reference for its [simulation] duration.
-BenchWorld settle(const sim::Scene& scene);
+BenchWorld settle(const scene::Scene& scene);
 
 // A resting bed of `grains` grains (rounded down to whole tiles, at least one): the tile
 // reference/bed_tile.toml (1000 grains settled in a 5 cm box; settled once per process, about

@@ -27,14 +27,15 @@
 #include "gpu/context.h"
 #include "sim/cpu_reference.h"
 #include "sim/gpu_stepper.h"
-#include "sim/scene.h"
-#include "sim/scene_runner.h"
-#include "sim/scene_world.h"
+#include "scene/scene.h"
+#include "scene/scene_runner.h"
+#include "scene/scene_world.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace ts::sim;
+using namespace ts::scene;
 using Clock = std::chrono::steady_clock;
 
 struct Backend {

@@ -128,16 +128,16 @@ std::vector<Eigen::Vector3d> clip_plane(const Eigen::Vector3d& point, const Eige
   return out;
 }
 
-FrameWalls::FrameWalls(const sim::Scene& scene) {
-  for (const sim::Boundary& b : scene.boundaries) {
+FrameWalls::FrameWalls(const scene::Scene& scene) {
+  for (const scene::Boundary& b : scene.boundaries) {
     switch (b.type) {
-      case sim::BoundaryType::Box:
+      case scene::BoundaryType::Box:
         boxes_.push_back(b);
         break;
-      case sim::BoundaryType::Cylinder:
+      case scene::BoundaryType::Cylinder:
         cylinders_.push_back(b);
         break;
-      case sim::BoundaryType::Plane:
+      case scene::BoundaryType::Plane:
         if (!is_floor(b.normal)) {
           planes_.push_back(b);
         } else {
@@ -146,21 +146,21 @@ FrameWalls::FrameWalls(const sim::Scene& scene) {
         break;
     }
   }
-  for (const sim::Boundary& b : boxes_) floor_level_ = std::min(floor_level_.value_or(b.min.z()), b.min.z());
+  for (const scene::Boundary& b : boxes_) floor_level_ = std::min(floor_level_.value_or(b.min.z()), b.min.z());
 }
 
 Aabb FrameWalls::framing_box(const Aabb& content) const {
   Aabb box;
-  for (const sim::Boundary& b : boxes_) {
+  for (const scene::Boundary& b : boxes_) {
     box.extend(b.min);
     box.extend(Eigen::Vector3d(b.max.x(), b.max.y(), framed_top(b.min.z(), b.max.z(), content)));
   }
-  for (const sim::Boundary& b : cylinders_) {
+  for (const scene::Boundary& b : cylinders_) {
     box.extend(Eigen::Vector3d(b.axis.x() - b.radius, b.axis.y() - b.radius, b.z_min));
     box.extend(
         Eigen::Vector3d(b.axis.x() + b.radius, b.axis.y() + b.radius, framed_top(b.z_min, b.z_max, content)));
   }
-  for (const sim::Boundary& b : planes_) {
+  for (const scene::Boundary& b : planes_) {
     for (const Eigen::Vector3d& p : clip_plane(b.point, b.normal, widened(content))) box.extend(p);
   }
   if (floor_level_ && content.valid()) {
@@ -172,14 +172,14 @@ Aabb FrameWalls::framing_box(const Aabb& content) const {
 
 std::vector<Segment> FrameWalls::outlines(const Aabb& content) const {
   std::vector<Segment> out;
-  for (const sim::Boundary& b : boxes_) {
+  for (const scene::Boundary& b : boxes_) {
     const auto c = corners(b.min, b.max);
     for (int i = 0; i < 8; ++i)
       for (int bit = 1; bit < 8; bit <<= 1)
         if (!(i & bit)) out.push_back({c[i], c[i | bit]});
   }
   constexpr int kRimSegments = 64;
-  for (const sim::Boundary& b : cylinders_) {
+  for (const scene::Boundary& b : cylinders_) {
     for (const double z : {b.z_min, b.z_max}) {
       for (int k = 0; k < kRimSegments; ++k) {
         const auto at = [&](int j) {
@@ -190,7 +190,7 @@ std::vector<Segment> FrameWalls::outlines(const Aabb& content) const {
       }
     }
   }
-  for (const sim::Boundary& b : planes_) {
+  for (const scene::Boundary& b : planes_) {
     const auto polygon = clip_plane(b.point, b.normal, widened(content));
     for (std::size_t k = 0; k < polygon.size(); ++k)
       out.push_back({polygon[k], polygon[(k + 1) % polygon.size()]});
@@ -203,7 +203,7 @@ std::optional<double> FrameWalls::far_wall(const Eigen::Vector3d& o, const Eigen
   const auto keep = [&](double t) {
     if (t > 0 && (!nearest || t < *nearest)) nearest = t;
   };
-  for (const sim::Boundary& b : boxes_) {
+  for (const scene::Boundary& b : boxes_) {
     // Slabs: where the ray leaves the box, and along which axis.
     double t_in = -1e300, t_out = 1e300;
     int exit_axis = -1;
@@ -220,7 +220,7 @@ std::optional<double> FrameWalls::far_wall(const Eigen::Vector3d& o, const Eigen
     if (t_out > t_in && exit_axis >= 0 && exit_axis < 2)
       keep(t_out);  // a side wall, not the floor or the open top
   }
-  for (const sim::Boundary& b : cylinders_) {
+  for (const scene::Boundary& b : cylinders_) {
     const Eigen::Vector2d p = o.head<2>() - b.axis, v = d.head<2>();
     const double a = v.squaredNorm(), h = p.dot(v), c = p.squaredNorm() - b.radius * b.radius;
     const double disc = h * h - a * c;

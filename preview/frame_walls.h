@@ -12,7 +12,7 @@
 #include "preview/camera.h"
 #include "preview/image.h"
 #include "preview/renderer.h"
-#include "sim/scene.h"
+#include "scene/scene.h"
 
 namespace ts::preview {
 
@@ -22,7 +22,7 @@ struct Segment {
 
 class FrameWalls {
  public:
-  explicit FrameWalls(const sim::Scene& scene);
+  explicit FrameWalls(const scene::Scene& scene);
 
   // What the default camera frames of the walls around `content` (m): each box's and cylinder's
   // footprint, from its floor up to its top or the content's top, whichever is lower (a tall box
@@ -44,7 +44,7 @@ class FrameWalls {
   bool empty() const { return boxes_.empty() && cylinders_.empty() && planes_.empty(); }
 
  private:
-  std::vector<sim::Boundary> boxes_, cylinders_, planes_;  // planes: the non-floor ones
+  std::vector<scene::Boundary> boxes_, cylinders_, planes_;  // planes: the non-floor ones
   std::optional<double> floor_level_;
 };
 

@@ -41,7 +41,7 @@ Aabb widen_at_once_narrow_slowly(const Aabb& from, const Aabb& to, double rate) 
 
 }  // namespace
 
-FrameSettings frame_settings(const sim::OutputSettings& output) {
+FrameSettings frame_settings(const scene::OutputSettings& output) {
   FrameSettings s;
   s.camera = output.camera;
   s.color_by = output.color_by;
@@ -49,10 +49,10 @@ FrameSettings frame_settings(const sim::OutputSettings& output) {
   return s;
 }
 
-SimFrameWriter::SimFrameWriter(gpu::Context& context, const sim::Scene& scene)
+SimFrameWriter::SimFrameWriter(gpu::Context& context, const scene::Scene& scene)
     : SimFrameWriter(context, scene, frame_settings(scene.output)) {}
 
-SimFrameWriter::SimFrameWriter(gpu::Context& context, const sim::Scene& scene, const FrameSettings& settings)
+SimFrameWriter::SimFrameWriter(gpu::Context& context, const scene::Scene& scene, const FrameSettings& settings)
     : renderer_(context),
       settings_(settings),
       walls_(scene),
@@ -61,11 +61,11 @@ SimFrameWriter::SimFrameWriter(gpu::Context& context, const sim::Scene& scene, c
   try {
     renderer_.check_image_size(settings_.camera.width, settings_.camera.height);
   } catch (const InputError& e) {
-    throw InputError(fmt::format("{}: {}", sim::scene_location(scene, "output.camera.size"), e.what()));
+    throw InputError(fmt::format("{}: {}", scene::scene_location(scene, "output.camera.size"), e.what()));
   }
   for (const auto& p : scene.props) dynamic_props_ += p.motion == sim::MotionType::Dynamic ? 1 : 0;
   for (const auto& e : scene.emitters) {
-    if (e.type != sim::EmitterType::Pour) continue;  // fill and column grains are there from the start
+    if (e.type != scene::EmitterType::Pour) continue;  // fill and column grains are there from the start
     emitter_box_.extend(e.min);
     emitter_box_.extend(e.max);
   }
@@ -105,16 +105,16 @@ Particles SimFrameWriter::particles_of(const sim::World& world) {
       c = wall;
     } else {
       switch (settings_.color_by) {
-        case sim::FrameColoring::Sand:
+        case scene::FrameColoring::Sand:
           c = b >= ranges.first_grain ? vary(sand, b, 0.12f) : prop;
           break;
-        case sim::FrameColoring::Height:
+        case scene::FrameColoring::Height:
           c = viridis((out.centers[i].z() - z_min) / std::max(z_max - z_min, 1e-12));
           break;
-        case sim::FrameColoring::Speed:
+        case scene::FrameColoring::Speed:
           c = viridis(speed[i] / speed_scale_);
           break;
-        case sim::FrameColoring::Body:
+        case scene::FrameColoring::Body:
           c = categorical(b);
           break;
       }

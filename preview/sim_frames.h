@@ -2,7 +2,7 @@
 // PNG frames of `tetrasand sim` ([output] frames = true): every particle of the world as a sphere
 // impostor, lit by one directional light with shadow mapping (thesis 5.2), over a ground plane at
 // the lowest floor, with the scene's walls drawn faintly over them (preview/frame_walls.h).
-// The camera ([output.camera], sim/scene.h) is one of:
+// The camera ([output.camera], scene/scene.h) is one of:
 //   fixed       eye and target given: the camera never moves;
 //   follow prop the prop's centre of mass stays at the image centre (eye, if given, keeps its offset
 //               from it; else the prop and 2.5 times its bounding radius around it are framed);
@@ -21,13 +21,13 @@
 #include "preview/camera.h"
 #include "preview/frame_walls.h"
 #include "preview/renderer.h"
-#include "sim/scene.h"
+#include "scene/scene.h"
 #include "sim/world.h"
 
 namespace ts::preview {
 
 struct FrameSettings {
-  sim::FrameCamera camera;  // [output.camera]: size, eye/target, up, fov, the followed prop
+  scene::FrameCamera camera;  // [output.camera]: size, eye/target, up, fov, the followed prop
   // The default camera's direction relative to camera.up (camera.h's view_direction): degrees from the
   // front axis towards the side axis, and above the horizon. A three-quarter view rather than the iso
   // view (45, 35.26): a box's footprint fills more of a 4:3 image seen closer to its front, and a
@@ -35,7 +35,7 @@ struct FrameSettings {
   // 24-26 % of the pixels here, 21-25 % from the iso view, docs/first-use.md).
   double azimuth = 30.0, elevation = 30.0;
   double margin = 1.08;  // the framed box spans 1 / margin of the image in its tighter direction
-  sim::FrameColoring color_by = sim::FrameColoring::Sand;
+  scene::FrameColoring color_by = scene::FrameColoring::Sand;
   bool walls = true;  // draw the boundaries (preview/frame_walls.h)
   // Share of the gap the default framing closes per frame when content shrinks: a quarter, so a bed
   // that settles out of a tall fill is framed closely within about ten frames (0.75^10 = 6 %).
@@ -43,13 +43,13 @@ struct FrameSettings {
 };
 
 // The frame settings a scene's [output] and [output.camera] ask for.
-FrameSettings frame_settings(const sim::OutputSettings& output);
+FrameSettings frame_settings(const scene::OutputSettings& output);
 
 class SimFrameWriter {
  public:
   // With the scene's own settings (frame_settings(scene.output)), or with `settings`.
-  SimFrameWriter(gpu::Context& context, const sim::Scene& scene);
-  SimFrameWriter(gpu::Context& context, const sim::Scene& scene, const FrameSettings& settings);
+  SimFrameWriter(gpu::Context& context, const scene::Scene& scene);
+  SimFrameWriter(gpu::Context& context, const scene::Scene& scene, const FrameSettings& settings);
 
   // Writes dir/frame_NNNNNN.png (NNNNNN = frame) atomically; nothing while the world has no particle.
   void write(const sim::World& world, std::int64_t frame, const std::filesystem::path& dir);

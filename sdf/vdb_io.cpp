@@ -41,11 +41,6 @@ std::string openvdb_problem(const std::string& message) {
 
 }  // namespace
 
-void ensure_openvdb_initialized() {
-  static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
-}
-
 void write_vdb(const std::filesystem::path& path, const openvdb::FloatGrid::Ptr& grid,
                const std::map<std::string, std::string>& metadata,
                const std::vector<std::filesystem::path>& inputs) {

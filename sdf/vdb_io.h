@@ -7,10 +7,9 @@
 #include <string>
 #include <vector>
 
-namespace ts::sdf {
+#include "sdf/openvdb_init.h"
 
-// openvdb::initialize(), once per process.
-void ensure_openvdb_initialized();
+namespace ts::sdf {
 
 // Writes `grid` (a float level set named "surface") with string metadata, atomically; refuses to
 // overwrite any of `inputs`.

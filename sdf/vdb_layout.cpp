@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "sdf/vdb_io.h"
+#include "sdf/openvdb_init.h"
 
 namespace ts::sdf {
 namespace {

@@ -105,4 +105,18 @@ class ByteReader {
   std::size_t offset_ = 0;
 };
 
+// Arrays of structs: a count, then each element through `put_one`; read back likewise, the count
+// checked against the bytes left (each element takes at least `min_bytes`).
+template <typename T, typename Put>
+void put_each(ByteWriter& w, const std::vector<T>& values, Put put_one) {
+  w.put<std::uint64_t>(values.size());
+  for (const T& v : values) put_one(v);
+}
+template <typename T, typename Get>
+std::vector<T> get_each(ByteReader& r, std::size_t min_bytes, Get get_one) {
+  std::vector<T> values(r.get_count(min_bytes));
+  for (T& v : values) get_one(v);
+  return values;
+}
+
 }  // namespace ts::sim

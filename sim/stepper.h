@@ -2,7 +2,7 @@
 // The one interface of the two DEM engines, and the data every engine takes and gives: the settings
 // of a step, the statistics of a step and one contact of a state. sim::CpuStepper
 // (sim/cpu_reference.h, double precision) and sim::GpuStepper (sim/gpu_stepper.h, GL compute) both
-// implement Stepper; sim::run_scene (sim/scene_runner.h) drives either through it.
+// implement Stepper; sim::run_scene (scene/scene_runner.h) drives either through it.
 #include <Eigen/Core>
 
 #include <cstddef>
@@ -119,7 +119,7 @@ class Stepper {
   virtual std::string timing_report() { return {}; }
   virtual const StepSettings& settings() const = 0;
 
-  // For checkpoints (sim/checkpoint.h): which engine this is ("cpu reference", "gpu float", ...; a
+  // For checkpoints (scene/checkpoint.h): which engine this is ("cpu reference", "gpu float", ...; a
   // checkpoint resumes only on the engine that wrote it), and its own state beyond the world it last
   // brought up to date (the GPU's memory order, its re-sort counter, the energy check's reference), so
   // that after load(world) and restore_state(world, save_state()) it steps on bit for bit. Throws

@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-# The scenes, shared with tests/sim/export_lammps_test.cpp and bench/validation.
+# The scenes, shared with tests/export/lammps_deck_test.cpp and bench/validation.
 REFERENCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "assets", "scenes", "reference")
 
 

@@ -127,7 +127,7 @@ ring, fitted from the edge of the flat top, above 80 % of the height, out to 20 
 
 
 def round_rim_sites(D, plate_radius=COARSE_RADIUS):
-    """(x, y) of the rim spheres sim/scene_world.cpp round_hole_rim puts around a hole of diameter D."""
+    """(x, y) of the rim spheres scene/scene_world.cpp round_hole_rim puts around a hole of diameter D."""
     circle = D / 2 + plate_radius
     count = max(3, int(np.ceil(2 * np.pi * circle / plate_radius)))
     angle = 2 * np.pi * np.arange(count) / count
@@ -660,7 +660,7 @@ FORCES_GENTLE_START, FORCES_GENTLE_END = "<!-- section: forces-gentle -->\n", "<
 SILO_SPHERES_START, SILO_SPHERES_END = "<!-- section: silo-spheres -->\n", "<!-- end: silo-spheres -->\n"
 SILO_LAMMPS_START, SILO_LAMMPS_END = "<!-- section: silo-lammps -->\n", "<!-- end: silo-lammps -->\n"  # silo_lammps.py
 OEDOMETER_STIFF_START, OEDOMETER_STIFF_END = "<!-- section: oedometer-stiff -->\n", "<!-- end: oedometer-stiff -->\n"
-# The bidisperse bed against LAMMPS: written by hand from its test (tests/sim/export_lammps_test.cpp).
+# The bidisperse bed against LAMMPS: written by hand from its test (tests/export/lammps_deck_test.cpp).
 BIDISPERSE_START, BIDISPERSE_END = "<!-- section: bidisperse -->\n", "<!-- end: bidisperse -->\n"
 # Repose magnitude (issue 18): written by hand from `scripts/bench.sh repose` (bench/validation/repose_sweep.py).
 REPOSE_SWEEP_START, REPOSE_SWEEP_END = "<!-- section: repose-sweep -->\n", "<!-- end: repose-sweep -->\n"

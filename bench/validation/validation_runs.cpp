@@ -27,17 +27,19 @@
 #include "core/atomic_file.h"
 #include "gpu/context.h"
 #include "sim/cpu_reference.h"
-#include "sim/export_lammps.h"
+#include "export/lammps_deck.h"
 #include "sim/gpu_stepper.h"
-#include "sim/scene.h"
-#include "sim/scene_runner.h"
-#include "sim/scene_world.h"
+#include "scene/scene.h"
+#include "scene/scene_runner.h"
+#include "scene/scene_world.h"
 #include "sim/time_step.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace ts::sim;
+using namespace ts::scene;
+using namespace ts::exporter;
 
 // One solid sphere (r = 1 mm, quartz, E = 10 MPa) hitting a smooth wall of the same material head on
 // at `speed`, no gravity: the rebound speed over the impact speed.

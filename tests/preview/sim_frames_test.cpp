@@ -13,8 +13,8 @@
 #include "core/atomic_file.h"
 #include "preview/image.h"
 #include "preview/sim_frames.h"
-#include "sim/scene.h"
-#include "sim/scene_world.h"
+#include "scene/scene.h"
+#include "scene/scene_world.h"
 #include "tests/input_error.h"
 #include "tests/scene_texts.h"
 #include "tests/test_support.h"
@@ -37,10 +37,10 @@ std::string scene_with_output(const std::string& output) {
       test::kCoarseSand, test::asset("bodies/cube.body.json").string(), output);
 }
 
-sim::Scene parse(const std::string& text) { return sim::parse_scene(text, "frames.toml"); }
+scene::Scene parse(const std::string& text) { return scene::parse_scene(text, "frames.toml"); }
 
 TEST(FrameSettings, CameraAndColorKeysAreRead) {
-  const sim::Scene scene = parse(scene_with_output(R"([output]
+  const scene::Scene scene = parse(scene_with_output(R"([output]
 frames = true
 color_by = "speed"
 [output.camera]
@@ -51,7 +51,7 @@ fov = 40.0
 size = [320, 200]
 )"));
   const preview::FrameSettings s = preview::frame_settings(scene.output);
-  EXPECT_EQ(s.color_by, sim::FrameColoring::Speed);
+  EXPECT_EQ(s.color_by, scene::FrameColoring::Speed);
   ASSERT_TRUE(s.camera.eye && s.camera.target);
   EXPECT_EQ(*s.camera.eye, Eigen::Vector3d(1.0, -2.0, 0.5));
   EXPECT_EQ(*s.camera.target, Eigen::Vector3d(0.0, 0.0, 0.1));
@@ -61,11 +61,11 @@ size = [320, 200]
   EXPECT_EQ(s.camera.height, 200);
   EXPECT_EQ(s.camera.follow_prop, -1);
   for (const std::string follow : {"prop cube", "prop 0"}) {
-    const sim::Scene f = parse(scene_with_output("[output.camera]\nfollow = \"" + follow + "\"\n"));
+    const scene::Scene f = parse(scene_with_output("[output.camera]\nfollow = \"" + follow + "\"\n"));
     EXPECT_EQ(f.output.camera.follow_prop, 0) << follow;
   }
-  const sim::Scene plain = parse(test::kCoarseSand);
-  EXPECT_EQ(plain.output.color_by, sim::FrameColoring::Sand);
+  const scene::Scene plain = parse(test::kCoarseSand);
+  EXPECT_EQ(plain.output.color_by, scene::FrameColoring::Sand);
   EXPECT_EQ(plain.output.camera.width, 960);
   EXPECT_EQ(plain.output.camera.height, 720);
   EXPECT_FALSE(plain.output.camera.eye);
@@ -183,10 +183,10 @@ TEST(SimFrames, PropDropFramesAreMostlyGrainsAndShowTheWallsFirstAndSettled) {
 // back in slowly (a film does not jump) once they gather again.
 TEST(SimFrames, DefaultCameraFramesTheGrainsAgainWhenTheySpread) {
   const auto dir = test::temp_dir();
-  const sim::Scene scene =
+  const scene::Scene scene =
       parse(std::string(test::kCoarseSand) +
             test::box_emitter("fill", "[-0.06, -0.06, 0.0]", "[0.06, 0.06, 0.06]", 20, "seed = 3\n"));
-  sim::World world = sim::make_world(scene);
+  sim::World world = scene::make_world(scene);
   preview::FrameSettings settings;
   settings.camera.width = 64;
   settings.camera.height = 48;
@@ -215,10 +215,10 @@ TEST(SimFrames, DefaultCameraFramesTheGrainsAgainWhenTheySpread) {
 // distance.
 TEST(SimFrames, FollowedPropStaysAtTheImageCentre) {
   const auto dir = test::temp_dir();
-  const sim::Scene scene = parse(scene_with_output(
+  const scene::Scene scene = parse(scene_with_output(
       test::box_emitter("fill", "[-0.06, -0.06, 0.0]", "[0.06, 0.06, 0.06]", 20, "seed = 3\n") +
       "[output]\nframes = true\n[output.camera]\nfollow = \"prop cube\"\nsize = [64, 48]\n"));
-  sim::World world = sim::make_world(scene);
+  sim::World world = scene::make_world(scene);
   preview::SimFrameWriter writer(context(), scene);
   writer.write(world, 0, dir);
   EXPECT_TRUE(writer.camera().target.isApprox(world.bodies.position[0]));  // the prop is the first body
@@ -232,17 +232,17 @@ TEST(SimFrames, FollowedPropStaysAtTheImageCentre) {
 // Every colouring draws the grains; a fixed camera stays where the scene puts it.
 TEST(SimFrames, ColoringsAndAFixedCameraRender) {
   const auto dir = test::temp_dir();
-  sim::Scene scene =
+  scene::Scene scene =
       parse(std::string(test::kCoarseSand) +
             test::box_emitter("fill", "[-0.06, -0.06, 0.0]", "[0.06, 0.06, 0.06]", 20, "seed = 3\n") +
             "[[boundary]]\ntype = \"box\"\nmin = [-0.07, -0.07, 0.0]\nmax = [0.07, 0.07, 0.1]\n"
             "material = \"sand\"\n");
-  sim::World world = sim::make_world(scene);
+  sim::World world = scene::make_world(scene);
   for (std::size_t b = 0; b < world.bodies.size(); ++b)
     world.bodies.linear_velocity[b] = {0.0, 0.0, -0.05 * b};
   std::vector<std::uint32_t> first_colors;
-  for (const auto color_by : {sim::FrameColoring::Sand, sim::FrameColoring::Height, sim::FrameColoring::Speed,
-                              sim::FrameColoring::Body}) {
+  for (const auto color_by : {scene::FrameColoring::Sand, scene::FrameColoring::Height, scene::FrameColoring::Speed,
+                              scene::FrameColoring::Body}) {
     scene.output.color_by = color_by;
     scene.output.camera.width = 64;
     scene.output.camera.height = 48;

@@ -12,13 +12,14 @@
 #include <numbers>
 
 #include "core/atomic_file.h"
-#include "sim/scene.h"
-#include "sim/scene_runner.h"
+#include "scene/scene.h"
+#include "scene/scene_runner.h"
 #include "sim/cpu_reference.h"
-#include "sim/scene_world.h"
+#include "scene/scene_world.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {
+using namespace ts::scene;  // these tests run whole scenes through the engine
 namespace {
 
 constexpr double kRadius = 5e-3;  // m, grain sphere radius used by these scenes

@@ -10,12 +10,13 @@
 #include "core/error.h"
 #include "sim/cpu_reference.h"
 #include "sim/gpu_stepper.h"
-#include "sim/scene.h"
-#include "sim/scene_world.h"
+#include "scene/scene.h"
+#include "scene/scene_world.h"
 #include "sim/world.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {
+using namespace ts::scene;  // these tests run whole scenes through the engine
 namespace {
 
 constexpr double kPi = std::numbers::pi;

@@ -7,12 +7,13 @@
 #include <cmath>
 #include <vector>
 
-#include "sim/scene.h"
-#include "sim/scene_runner.h"
-#include "tests/sim/servo_csv.h"
+#include "scene/scene.h"
+#include "scene/scene_runner.h"
+#include "tests/scene/servo_csv.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {
+using namespace ts::scene;  // these tests run whole scenes through the engine
 namespace {
 
 // The bundled oedometer with 300 grains and a schedule about six times faster: seated at 250 Pa from 0.6 s,

@@ -11,17 +11,18 @@
 
 #include "core/error.h"
 #include "gpu/context.h"
-#include "sim/checkpoint.h"
+#include "scene/checkpoint.h"
 #include "sim/cpu_reference.h"
 #include "sim/gpu_stepper.h"
-#include "sim/grain_mix.h"
-#include "sim/scene.h"
-#include "sim/scene_runner.h"
-#include "sim/scene_world.h"
+#include "scene/grain_mix.h"
+#include "scene/scene.h"
+#include "scene/scene_runner.h"
+#include "scene/scene_world.h"
 #include "tests/input_error.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {
+using namespace ts::scene;  // these tests run whole scenes through the engine
 namespace {
 
 namespace fs = std::filesystem;

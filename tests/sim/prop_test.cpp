@@ -10,11 +10,12 @@
 #include <fstream>
 #include <vector>
 
-#include "sim/scene.h"
-#include "sim/scene_runner.h"
+#include "scene/scene.h"
+#include "scene/scene_runner.h"
 #include "tests/test_support.h"
 
 namespace ts::sim {
+using namespace ts::scene;  // these tests run whole scenes through the engine
 namespace {
 
 std::vector<std::size_t> grains_of(const World& w) {

@@ -1,0 +1,29 @@
+#pragma once
+// The largest sizes a scene may ask for, and the checks that compare the sizes its keys imply with
+// them before anything is allocated (docs/reliability.md, "Sizes checked before allocation"). Every
+// size is computed in double from the keys, so no count overflows on the way.
+#include "scene/lattice.h"
+#include "scene/scene.h"
+#include "sim/world.h"
+#include "scene/uses_engine.h"
+
+namespace ts::scene {
+
+// Particles of a world: both engines' hashed grids have a table of the next power of two >= 2 N
+// entries, indexed with 32 bits.
+inline constexpr double kMaxParticles = 1073741824.0;  // 2^30
+// |coordinate| / cell of any place particles start at: grid cells have 32-bit integer coordinates
+// (the CPU grid clamps them at +-1e9, the GPU converts float to int).
+inline constexpr double kMaxCellCoordinate = 1e9;
+
+// The sizes the scene's keys alone imply: each emitter's lattice and grain count, each rough
+// boundary's particles, and their sum. Throws ts::InputError "file:line: key: ..." with the size asked
+// for and the largest that fits.
+void check_scene_sizes(const Scene& scene);
+
+// Once the boundaries and props are in `world` (and no grain yet): the whole world's particles with
+// every emitter's grains, and the grid cell coordinates of every place particles start at (the cell
+// is the largest particle diameter). Throws as check_scene_sizes.
+void check_world_sizes(const Scene& scene, const World& world);
+
+}  // namespace ts::scene
