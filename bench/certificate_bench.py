@@ -6,14 +6,14 @@ For each count, `tetrasand sample MESH --count N` makes the body (its rounds ste
 certificate; the run's own certificate and probe times come from its report), then
 tetrasand_bench_certificate runs, in one process on that body: the certificate (GPU) and the 1M-probe
 pass (CPU, all cores) side by side, and an independent 10M-probe check with another seed. Criteria
-(written before the runs: bench/certificate_criteria.md, quoted in docs/benchmarks.md): every probe lies
+(written before the runs: bench/certificate_criteria.md, quoted in docs/benchmarks/certificate.md): every probe lies
 within the certified bound, and no probe lies beyond r on a certified body; each body of a count given
 to --must-certify (default 200000) is certified; the CPU certifier (same process, all cores) gives the GPU's
 verdict and a bound within the floor of its bound (criterion 6). Exit status 1 when one fails.
 
 Usage: bench/certificate_bench.py --tetrasand build-release/bin/tetrasand [--mesh assets/bunny.obj]
        [--counts 1000 10000 100000 200000] [--must-certify 200000] [--independent 10000000] [--csv OUT.csv]
-       [--markdown docs/benchmarks.md --command "scripts/bench.sh certificate"]
+       [--markdown docs/benchmarks/certificate.md --command "scripts/bench.sh certificate"]
 --markdown rewrites the section certificate (between `<!-- section: certificate -->` and
 `<!-- end: certificate -->`) with this run's table and the reading in bench/certificate_notes.md;
 with --cpu-table-only it rewrites only the CPU-against-GPU table inside it (between

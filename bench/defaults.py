@@ -1,9 +1,10 @@
 #!/usr/bin/python3
 """Every default against the trade tables (issue 17): applies the rules of bench/defaults_criteria.md
-to the tables already in docs/benchmarks.md and docs/validation.md, runs the trades no table held
+to the tables already in the benchmark pages (docs/benchmarks/*.md) and docs/validation.md, runs the trades no
+table held
 (the sampler's SDF voxel, `sdf --band`, `sample`'s default count, and what a radius map would buy on
 the dino), plots each trade with its default marked, and writes the section between
-`<!-- section: defaults -->` and `<!-- end: defaults -->` of docs/benchmarks.md.
+`<!-- section: defaults -->` and `<!-- end: defaults -->` of docs/benchmarks/defaults.md.
 
 Usage: /usr/bin/python3 bench/defaults.py TETRASAND DOCS_DIR [--work DIR] [--repeats N] [--quick]
        [--only voxel,band,count,radius-map]
@@ -28,6 +29,9 @@ from docs_section import replace_between  # noqa: E402
 
 DEFAULT_STYLE = dict(marker="*", s=260, color="gold", edgecolor="black", zorder=5, label="default")
 TRADES = ("voxel", "band", "count", "radius-map")
+# The benchmark pages whose tables the rules read, in the order the one docs/benchmarks.md had them (a table's
+# first match is the current one; docs/benchmarks/history.md, with the older tables, is left out).
+PAGES = ("sdf", "sampler", "certificate", "preview", "sim", "defaults", "device", "round-trips")
 # `sample`'s default count and the sweep around it (bench/defaults_criteria.md, addendum).
 DEFAULT_COUNT = 8000  # sampler/sample_mesh.cpp's kDefaultCount (4000 until the sweep of 2026-12-03 picked 8000)
 COUNTS = (1000, 2000, 4000, 8000, 16000)
@@ -356,7 +360,7 @@ def verdicts(energy, restitution, trade, tsuji, voxels, bands, counts=None, radi
               f"restitution within {spread} of {e0} from {vmin} to {vmax} m/s (docs/validation.md); rule: change "
               f"<= 2 % ({0.02 * e0:.3f}) between 0.1 and 10 m/s", spread <= 0.02 * e0 and vmin <= 0.1 and vmax >= 10))
     v.append(("tangential model viscous",
-              "docs/benchmarks.md (Bulk behaviour) and assets/scenes/README.md state the creep and name "
+              "docs/benchmarks/sim.md (Bulk behaviour) and assets/scenes/README.md state the creep and name "
               "`tangential = \"spring\"`; checked by this script's text search", None))
     default_rows = [r for r in trade if r[0] == 12]
     reach = [r for r in trade if r[4] <= 1.0]
@@ -407,9 +411,14 @@ def verdicts(energy, restitution, trade, tsuji, voxels, bands, counts=None, radi
     return v
 
 
+def benchmark_pages(docs):
+    """The text of the benchmark pages under DOCS/benchmarks/, one after the other (see PAGES)."""
+    return "\n".join(open(os.path.join(docs, "benchmarks", f"{page}.md")).read() for page in PAGES)
+
+
 def tangential_documented(root):
     scenes = open(os.path.join(root, "assets", "scenes", "README.md")).read()
-    bench = open(os.path.join(root, "docs", "benchmarks.md")).read()
+    bench = benchmark_pages(os.path.join(root, "docs"))
     return ("creep" in scenes.lower() or "creep" in bench.lower()) and 'tangential = "spring"' in (scenes + bench)
 
 
@@ -481,7 +490,7 @@ def plot(energy, restitution, trade, voxels, bands, counts, radius_map, png):
         plot_radius_map(axes[2][2], radius_map)
     handles = [h for h in axes[0][0].collections[:1]]
     fig.legend(handles, ["default"], loc="upper right")
-    fig.suptitle("Defaults (gold stars) on the trade curves; top row and rounds from the tables of docs/benchmarks.md")
+    fig.suptitle("Defaults (gold stars) on the trade curves; top row and rounds from the tables of docs/benchmarks/*.md")
     fig.tight_layout()
     fig.savefig(png, dpi=90)
     plt.close(fig)
@@ -547,7 +556,7 @@ def section(v, trades, runs):
     lines += ["", "| default | evidence | rule |", "|---|---|---|"]
     for name, evidence, met in v:
         lines.append(f"| {name} | {evidence} | {yes(met)} |")
-    lines += ["", "![defaults on the trade curves](benchmarks/defaults.png)", ""]
+    lines += ["", "![defaults on the trade curves](defaults.png)", ""]
     if voxels:
         lines += ["Sampler voxel (default particle count, radius unset; median of "
                   f"{runs['voxel']['repeats']} runs each):", "",
@@ -659,9 +668,9 @@ def main():
     if any(t not in TRADES for t in only):
         raise SystemExit(f"--only: each of {args.only!r} must be one of {', '.join(TRADES)}")
     root = os.path.dirname(os.path.abspath(args.docs.rstrip("/")))
-    bench_md = os.path.join(args.docs, "benchmarks.md")
+    bench_md = os.path.join(args.docs, "benchmarks", "defaults.md")
     record = os.path.join(args.docs, "benchmarks", "defaults.json")
-    doc = open(bench_md).read()
+    doc = benchmark_pages(args.docs)
     validation = open(os.path.join(args.docs, "validation.md")).read()
     trades, runs = carried_over(doc, record)
     renderer = subprocess.run([args.exe, "devices"], capture_output=True, text=True).stdout.strip().splitlines()

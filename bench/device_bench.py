@@ -1,11 +1,11 @@
 #!/usr/bin/python3
 """The device run of issue 16: SDF, sampler, sim and preview benchmarks in one call of at most 8 minutes,
 each part under its own time cap, into one results file; and the report that turns that file into the
-NVIDIA sections of docs/benchmarks.md. scripts/device-bench.sh is the entry point (it unpacks the carried
+NVIDIA sections of docs/benchmarks/device.md. scripts/device-bench.sh is the entry point (it unpacks the carried
 bundle on the device machine first); by hand:
   bench/device_bench.py run --bin BUILD/bin --out DIR [--quick] [--meshes DIR] [--only sdf,sim]
                             [--budget S] [--caps sim=60,preview=20]
-  bench/device_bench.py report DIR/device-bench.json --markdown docs/benchmarks.md [--baseline HERE.json]
+  bench/device_bench.py report DIR/device-bench.json --markdown docs/benchmarks/device.md [--baseline HERE.json]
 `run` writes DIR/device-bench.json (rewritten after every part, so a call stopped at its limit keeps the
 parts it finished) and DIR/device-bench.md (the sections `report` would write). Standard library only:
 the device machine's python3 is not Debian's."""
@@ -373,7 +373,7 @@ def selftest_section(res):
 def sdf_section(res):
     p = res["parts"]["sdf"]
     lines = ["### SDF on an NVIDIA GPU", "", provenance(res, "sdf"), "",
-             "Same program and columns as section SDF above (`tetrasand_bench_sdf`): GPU scan conversion against the "
+             "Same program and columns as [section SDF](sdf.md#sdf) (`tetrasand_bench_sdf`): GPU scan conversion against the "
              "CPU exact SDF and OpenVDB `meshToLevelSet`, both on the device machine's cores, errors against exact.",
              ""]
     rows = p.get("rows", [])
@@ -422,8 +422,8 @@ def sim_section(res):
     p = res["parts"]["sim"]
     rows = p.get("rows", [])
     lines = ["### Simulation on an NVIDIA GPU", "", provenance(res, "sim"), "",
-             "Cundall number (grain time steps per second) of `tetrasand_bench_sim` on the settled bed of section "
-             "Simulation above, GPU pipeline in float and in double against the CPU reference (double, TBB on the "
+             "Cundall number (grain time steps per second) of `tetrasand_bench_sim` on the settled bed of "
+             "[section Simulation](sim.md#simulation), GPU pipeline in float and in double against the CPU reference (double, TBB on the "
              "device machine's cores; measured once per size).", ""]
     if rows:
         lines += ["| grains | GPU precision | contacts / grain | GPU grain-steps/s | CPU grain-steps/s | GPU / CPU "
@@ -457,7 +457,7 @@ def preview_section(res):
     lines = ["### Preview on an NVIDIA GPU", "", provenance(res, "preview"), ""]
     if s:
         lines += [f"`tetrasand_bench_preview {s['mesh']} --size {s['size']} --resolution {s['resolution']} --particles "
-                  f"{s['particles']} --repeat {s['repeat']}` (section Preview above). {p.get('scene', '')}", ""]
+                  f"{s['particles']} --repeat {s['repeat']}` ([section Preview](preview.md#preview)). {p.get('scene', '')}", ""]
     if p.get("rows"):
         lines += [f"| image {s['size']}^2 | first render s | median of {s['repeat']} s |", "|---|---:|---:|"]
         lines += [f"| {r['image']} | {r['first_s']:.3f} | {r['median_s']:.3f} |" for r in p["rows"]]
@@ -504,9 +504,9 @@ def main():
     r.add_argument("--only", help="comma-separated parts to run (others are recorded as skipped)")
     r.add_argument("--caps", help="part=seconds,... overriding the time caps")
     r.add_argument("--budget", type=float, help="seconds for all parts together (default 470; --quick 450)")
-    p = sub.add_parser("report", help="write the NVIDIA sections of docs/benchmarks.md from a results file")
+    p = sub.add_parser("report", help="write the NVIDIA sections of docs/benchmarks/device.md from a results file")
     p.add_argument("results")
-    p.add_argument("--markdown", default=os.path.join(ROOT, "docs", "benchmarks.md"))
+    p.add_argument("--markdown", default=os.path.join(ROOT, "docs", "benchmarks", "device.md"))
     p.add_argument("--baseline", help="a results file of the same sizes run here (llvmpipe), for speed-ups")
     p.add_argument("--allow-test", action="store_true", help="also write a --quick or non-NVIDIA run (tests)")
     args = ap.parse_args()

@@ -62,7 +62,7 @@ def plot_trade(rows, png):
     axes[1].set_title("relative radius rho")
     axes[0].axhline(1.0, color="grey", lw=0.8, ls="--")
     for ax in axes:
-        ax.set_xlabel("relaxation steps, all rounds (times: docs/benchmarks.md)")
+        ax.set_xlabel("relaxation steps, all rounds (times: docs/benchmarks/sampler.md)")
         ax.grid(True, alpha=0.3)
     axes[0].legend(fontsize=7)
     fig.tight_layout()

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The Cundall-number sweep of tetrasand_bench_sim --csv: a log-log plot of grain-steps/s against grains
 (GPU pipeline and CPU reference) and the table between `<!-- cundall -->` and `<!-- end cundall -->`
-inside the sim section of docs/benchmarks.md (the rest of the section is left as it is).
+inside the sim section of docs/benchmarks/sim.md (the rest of the section is left as it is).
 Usage: /usr/bin/python3 bench/plot_sim.py sweep.csv DOCS_DIR  (Debian's python3-matplotlib)"""
 import csv
 import os
@@ -52,7 +52,7 @@ def table(rows, command):
                      f"{float(r['gpu_grain_steps_per_s']):.3g} | {float(r['cpu_grain_steps_per_s']):.3g} | "
                      f"{float(r['gpu_over_cpu']):.2f} | {r['gpu_steps']} / {r['cpu_steps']} | "
                      f"{float(r['gpu_bytes_per_grain']):.0f} | {float(r['cpu_bytes_per_grain']):.0f} |")
-    lines += ["", "![Cundall number against grains](benchmarks/sim_cundall.png)", ""]
+    lines += ["", "![Cundall number against grains](sim_cundall.png)", ""]
     return "\n".join(lines)
 
 
@@ -64,7 +64,7 @@ def main():
     command = sys.argv[3] if len(sys.argv) > 3 else "scripts/bench.sh sim"
     os.makedirs(os.path.join(docs, "benchmarks"), exist_ok=True)
     plot(rows, os.path.join(docs, "benchmarks", "sim_cundall.png"))
-    replace_between(os.path.join(docs, "benchmarks.md"), "<!-- cundall -->\n", "<!-- end cundall -->",
+    replace_between(os.path.join(docs, "benchmarks", "sim.md"), "<!-- cundall -->\n", "<!-- end cundall -->",
                     table(rows, command))
 
 

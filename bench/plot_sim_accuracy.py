@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The E / dt / precision trade of tetrasand_bench_sim_accuracy: plots and the table between
-`<!-- accuracy -->` and `<!-- end accuracy -->` inside the sim section of docs/benchmarks.md.
+`<!-- accuracy -->` and `<!-- end accuracy -->` inside the sim section of docs/benchmarks/sim.md.
 Usage: /usr/bin/python3 bench/plot_sim_accuracy.py RUN_DIR DOCS_DIR  (Debian's python3-matplotlib)"""
 import csv
 import os
@@ -88,7 +88,7 @@ def section(run, energy, pile, renderer):
             ovl = " / ".join(f"{float(by[b]['max_overlap_ratio']):.4f}" if b in by else "-" for b in STYLE)
             dt = float(next(iter(by.values()))["dt_s"]) * 1e6
             lines.append(f"| {e:.0e} | {f:g} | {dt:.2f} | {err} | {ovl} |")
-        lines += ["", "![energy error and overlap against dt](benchmarks/sim_accuracy_energy.png)", ""]
+        lines += ["", "![energy error and overlap against dt](sim_accuracy_energy.png)", ""]
     if pile:
         lines += ["Heap (`assets/scenes/reference/heap.toml` with 150 grains on a 6 cm rough floor, 0.5 s; mu = 0.5, "
                   "e = 0.5, viscous friction, forward Euler as the scene sets it): angle of repose fitted on the flank as in the peers and validation reports; overlap "
@@ -99,7 +99,7 @@ def section(run, energy, pile, renderer):
         for r in pile:
             lines.append(f"| {float(r['E_Pa']):.0e} | {r['dt_factor']} | {r['backend']} | {r['steps']} | "
                          f"{r['angle']:.1f} | {float(r['max_overlap_ratio_at_outputs']):.4f} | {r['seconds']} |")
-        lines += ["", "![angle of repose per run](benchmarks/sim_accuracy_pile.png)", ""]
+        lines += ["", "![angle of repose per run](sim_accuracy_pile.png)", ""]
     return "\n".join(lines)
 
 
@@ -119,7 +119,7 @@ def main():
             r["angle"] = repose_angle(xyz)
         pile_plot(pile, os.path.join(docs, "benchmarks", "sim_accuracy_pile.png"))
     renderer = open(os.path.join(run, "renderer.txt")).read().strip()
-    replace_between(os.path.join(docs, "benchmarks.md"), "<!-- accuracy -->\n", "<!-- end accuracy -->",
+    replace_between(os.path.join(docs, "benchmarks", "sim.md"), "<!-- accuracy -->\n", "<!-- end accuracy -->",
                     section(run, energy, pile, renderer))
 
 

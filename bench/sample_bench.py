@@ -12,7 +12,7 @@ Usage: bench/sample_bench.py --tetrasand build-test/bin/tetrasand [--counts 1000
        [--csv OUT.csv] [--no-trade | --no-compare] [--trade trefoil cube --trade-count 1000
        --trade-rounds 0 1 3 12 --trade-iterations 100 2000]
 --csv writes every row (kind = compare or trade) for bench/plot_sample.py.
---markdown docs/benchmarks.md rewrites its section sampler (between `<!-- section: sampler -->` and
+--markdown docs/benchmarks/sampler.md rewrites its section sampler (between `<!-- section: sampler -->` and
 `<!-- end: sampler -->`) with this run's tables, its plots (docs/benchmarks/sample_*.png) and the
 reading in bench/sample_notes.md; scripts/bench.sh sample does that.
 Installs Debian's python3-open3d when it is missing (root only), as the peers note says.
@@ -141,7 +141,7 @@ def main():
     ap.add_argument("--criteria", action="store_true",
                     help="exit 1 unless every tetrasand body meets issue 15's targets: c / r <= 1, rho >= 0.75, CV <= 0.05")
     ap.add_argument("--csv", help="also write every row to this CSV")
-    ap.add_argument("--markdown", help="rewrite the sampler section of this markdown file (docs/benchmarks.md)")
+    ap.add_argument("--markdown", help="rewrite the sampler section of this markdown file (docs/benchmarks/sampler.md)")
     ap.add_argument("--command", default="", help="the command line to quote in the markdown section")
     args = ap.parse_args()
     if args.markdown and not args.csv:
@@ -227,18 +227,18 @@ def main():
 
 
 def write_markdown(args, report, started, load_start, gl, open3d_version):
-    """The sampler section of docs/benchmarks.md from this run: how it ran, its tables, plots, notes."""
+    """The sampler section of docs/benchmarks/sampler.md from this run: how it ran, its tables, plots, notes."""
     here = os.path.dirname(os.path.abspath(__file__))
     sys.path.insert(0, here)
     from docs_section import replace_between
-    figures = os.path.join(os.path.dirname(os.path.abspath(args.markdown)), "benchmarks")
+    figures = os.path.dirname(os.path.abspath(args.markdown))  # the plots lie beside the page
     os.makedirs(figures, exist_ok=True)
     subprocess.run(["/usr/bin/python3", os.path.join(here, "plot_sample.py"), figures, args.csv], check=True)
     plots = []
     if not args.no_compare:
-        plots.append("![tetrasand and Open3D against the particle count](benchmarks/sample_vs_open3d.png)")
+        plots.append("![tetrasand and Open3D against the particle count](sample_vs_open3d.png)")
     if not args.no_trade and args.trade:
-        plots.append("![sampler trade: covering radius and rho against relaxation steps](benchmarks/sample_trade.png)")
+        plots.append("![sampler trade: covering radius and rho against relaxation steps](sample_trade.png)")
     load_end = open("/proc/loadavg").read().split()[:3]
     notes = os.path.join(here, "sample_notes.md")
     gpu_note = ("**No NVIDIA GPU was used**: tetrasand's GPU work ran on Mesa's llvmpipe, on the same CPU cores as "

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
-"""Writes section `sdf` of docs/benchmarks.md from tetrasand_bench_sdf --csv output (one or more CSV
+"""Writes section `sdf` of docs/benchmarks/sdf.md from tetrasand_bench_sdf --csv output (one or more CSV
 files, e.g. runs split over time), so every figure in it comes from the rows given. Called by
 `scripts/bench.sh sdf`; also usable by hand:
-  /usr/bin/python3 bench/sdf_report.py --markdown docs/benchmarks.md --renderer "..." \
+  /usr/bin/python3 bench/sdf_report.py --markdown docs/benchmarks/sdf.md --renderer "..." \
       --command "scripts/bench.sh sdf ..." [--planned CASE ...] [--load "..."] [--png-name NAME] a.csv [b.csv ...]
 CASE is MESH@R1,R2 as given to the bench; planned cases missing from the CSV are listed as not run."""
 import argparse
@@ -97,7 +97,7 @@ def findings(rows):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("csv", nargs="+")
-    ap.add_argument("--markdown", help="docs/benchmarks.md to rewrite (section sdf)")
+    ap.add_argument("--markdown", help="docs/benchmarks/sdf.md to rewrite (section sdf)")
     ap.add_argument("--renderer", default="unknown")
     ap.add_argument("--command", default="scripts/bench.sh sdf")
     ap.add_argument("--planned", nargs="*", default=[])
@@ -128,7 +128,7 @@ def main():
     gone = missing_cases(a.planned, rows)
     if gone:
         lines += ["Not run (planned, no row above): " + "; ".join(gone) + ".", ""]
-    lines += [f"![SDF error against exact distance versus time](benchmarks/{a.png_name})", "", "What the numbers say:"]
+    lines += [f"![SDF error against exact distance versus time]({a.png_name})", "", "What the numbers say:"]
     lines += findings(rows)
     if a.notes:
         lines += [""] + open(a.notes).read().rstrip("\n").split("\n")

@@ -1,7 +1,7 @@
 """GPU and host memory of the SDF against resolution: the sparse NanoVDB field the sampler and the
 preview read now, against the dense 3D textures they held before (RGBA32F for the sampler, R32F for
 the preview). Runs `tetrasand sdf MESH --resolution N -o OUT.nvdb --json` per mesh and resolution,
-writes section sparse of docs/benchmarks.md and docs/benchmarks/sparse_memory.png.
+writes section sparse of docs/benchmarks/sdf.md and docs/benchmarks/sparse_memory.png.
 
 usage: sparse_memory.py TETRASAND MESH[,...] RESOLUTION[,...] --markdown DOCS.md --plot PNG
        [--rows ROWS.json [--keep]]
@@ -211,11 +211,11 @@ def main():
             "Growth per doubling of N (from each resolution to the next):", "",
             "| mesh | from N | to N | sparse NanoVDB x | dense box x |", "|---|---:|---:|---:|---:|"]
     text += [f"| {m} | {x} | {y} | {s:.2f} | {d:.2f} |" for m, x, y, s, d in g]
-    text += ["", "![GPU memory of the SDF against resolution](benchmarks/sparse_memory.png)", ""]
+    text += ["", "![GPU memory of the SDF against resolution](sparse_memory.png)", ""]
     replace_between(a.markdown, "<!-- sparse results -->\n", "<!-- end sparse results -->", "\n".join(text))
     for r in rows:
         print(f"{r['name']} {r['resolution']}: {r['band_voxels']} band voxels, {r['nanovdb_bytes'] / MIB:.2f} MiB sparse")
-    # The criteria stated in docs/benchmarks.md before the run.
+    # The criteria stated in docs/benchmarks/sdf.md before the run.
     ok = all(s <= 4.5 for m, x, y, s, d in g if x >= 256)
     ok = ok and all(r["readback_bytes"] <= 21 * r["band_voxels"] + 64 * (r.get("slabs") or 0)
                     for r in rows if r.get("backend") != "cpu")

@@ -1,30 +1,31 @@
 #!/usr/bin/env bash
-# One entry point for the comparisons and reports (docs/benchmarks.md, docs/validation.md).
+# One entry point for the comparisons and reports (docs/benchmarks.md and its pages in docs/benchmarks/,
+# docs/validation.md).
 # Usage: scripts/bench.sh [peers|sdf|sparse|sample|sample-large|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all]
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #                        [--only TRADES]
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
-#               its section of docs/benchmarks.md (--quick: knot1 and armadillo at 64^3 and 128^3, 1,000
+#               its section of docs/benchmarks/*.md (--quick: knot1 and armadillo at 64^3 and 128^3, 1,000
 #               particles on three meshes, no sampler trade: under 2 min on 2 idle cores; default: 15 min on 2 idle
 #               cores, over an hour on 2 loaded ones; llvmpipe either way)
 #   sim         Cundall number (grain-steps/s) of the GPU pipeline and the CPU reference on the same
 #               settled beds, 1k to 1M grains (--grains 1000,8000 for fewer), memory per grain
-#               -> the Cundall table and plot in section sim of docs/benchmarks.md      (~8 min, 2 cores)
+#               -> the Cundall table and plot in section sim of docs/benchmarks/sim.md  (~8 min, 2 cores)
 #   sim-accuracy  E, dt and precision (CPU reference, GPU float, GPU double) against largest overlap,
 #               energy drift (no-dissipation box) and angle of repose (150-grain heap)
-#               -> the accuracy table and plots in section sim of docs/benchmarks.md   (~15 min, 2 cores)
+#               -> the accuracy table and plots in section sim of docs/benchmarks/sim.md (~15 min, 2 cores)
 #   peers-sim   tetrasand (CPU reference, GPU pipeline) against LAMMPS on the same scenes, one run:
 #               grain-steps/s as ratios, settled bed height, rebound, angle of repose
-#               -> section peers-sim of docs/benchmarks.md                              (~5 min, 2 cores)
+#               -> section peers-sim of docs/benchmarks/sim.md                          (~5 min, 2 cores)
 #   sample      tetrasand sample against Open3D's sample_points_poisson_disk at equal counts, plus the
-#               sampler's rounds x iterations trade -> section sampler of docs/benchmarks.md (~10 min)
+#               sampler's rounds x iterations trade -> section sampler of docs/benchmarks/sampler.md (~10 min)
 #   sample-large  the bunny at 100,000 and 1,000,000 particles against Open3D, with tetrasand's --timings;
 #               exit 1 unless tetrasand's bodies meet c / r <= 1, rho >= 0.75, CV <= 0.05 (issue 15); prints
 #               the table, which bench/sample_notes.md quotes by hand (--quick: 100,000 only)
 #               (~20 min on 2 idle cores, llvmpipe)
 #   certificate the coverage certificate against the sampler's 1M-probe pass on bunny bodies of 1k, 10k,
 #               100k and 200k particles, an independent 10M-probe check of each, and the criteria of
-#               bench/certificate_criteria.md -> section certificate of docs/benchmarks.md
+#               bench/certificate_criteria.md -> section certificate of docs/benchmarks/certificate.md
 #               (--quick: 1k and 10k only)                                    (~25 min on llvmpipe, 2 cores)
 #               The CPU certifier runs beside the GPU one on each body (criterion 6: the same verdict,
 #               bounds within the floor), its table in the same section.
@@ -35,7 +36,7 @@
 #               with the sampler-voxel and sdf-band trades run anew (knot1, bunny), sample's default count
 #               (1,000-16,000 on five meshes) and what a radius map would buy on the dino
 #               (--only voxel,band,count,radius-map: run those, carry the others' last rows)
-#               -> section defaults of docs/benchmarks.md, docs/benchmarks/defaults.png  (~40 min, 2 cores)
+#               -> section defaults of docs/benchmarks/defaults.md, docs/benchmarks/defaults.png (~40 min, 2 cores)
 #   validation  restitution, angle of repose, column collapse (8 x 20,000 grains), Mankoc-sized silo
 #               discharge (80,000 grains) with a Beverloo fit, contact-force distribution (the silo's fill
 #               and 3 more 30,000-grain piles), on the CPU reference
@@ -56,16 +57,16 @@
 #               (CGAL, all cores), OpenVDB meshToLevelSet (all cores), errors against exact; default
 #               knot1, armadillo (libcgal-demo) and a 1.3M-triangle icosphere:8 at 64^3..1024^3
 #               (--cases 'knot1@64,128 icosphere:8@64' for fewer; NAME = libcgal-demo mesh, or a path)
-#               -> section sdf of docs/benchmarks.md, docs/benchmarks/sdf_error_vs_time.png
+#               -> section sdf of docs/benchmarks/sdf.md, docs/benchmarks/sdf_error_vs_time.png
 #               (12 min on llvmpipe, 2 idle cores; over an hour on 2 loaded ones)
 #   sparse      GPU memory of the SDF against resolution: the sparse NanoVDB field (what the sampler and the
 #               preview hold) against the dense textures they held before, band voxels, bytes per band
 #               voxel, bytes read back, peak resident memory; bunny, knot1, armadillo at 64^3..2032^3
-#               (--quick: 64, 128) -> section sparse of docs/benchmarks.md, docs/benchmarks/sparse_memory.png,
+#               (--quick: 64, 128) -> section sparse of docs/benchmarks/sdf.md, docs/benchmarks/sparse_memory.png,
 #               the raw rows in docs/benchmarks/sparse_memory_rows.json (2032: ~30 min a mesh at load 15)
 #   all         every one of the above, in one run
 # Exit status: 0 when every physical comparison is within its stated tolerance, 1 otherwise.
-# The preview bench (tetrasand_bench_preview) has no peer; see docs/benchmarks.md.
+# The preview bench (tetrasand_bench_preview) has no peer; see docs/benchmarks/preview.md.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 what=${1:-all}
@@ -121,15 +122,15 @@ py=/usr/bin/python3
 if runs sim; then
   "$bin/tetrasand_bench_sim" --grains "$grains" --csv "$work/sim.csv"
   "$py" "$root/bench/plot_sim.py" "$work/sim.csv" "$root/docs" "scripts/bench.sh sim --grains $grains"
-  echo "bench: wrote the Cundall table of docs/benchmarks.md and docs/benchmarks/sim_cundall.png"
+  echo "bench: wrote the Cundall table of docs/benchmarks/sim.md and docs/benchmarks/sim_cundall.png"
 fi
 if runs sim-accuracy; then
   "$bin/tetrasand_bench_sim_accuracy" "$work/sim-accuracy" all
   "$py" "$root/bench/plot_sim_accuracy.py" "$work/sim-accuracy" "$root/docs"
-  echo "bench: wrote the accuracy table of docs/benchmarks.md and docs/benchmarks/sim_accuracy_*.png"
+  echo "bench: wrote the accuracy table of docs/benchmarks/sim.md and docs/benchmarks/sim_accuracy_*.png"
 fi
 if runs peers-sim; then
-  "$py" "$root/bench/peers/sim_peers.py" "$bin" "$work/peers-sim" --markdown "$root/docs/benchmarks.md" || status=1
+  "$py" "$root/bench/peers/sim_peers.py" "$bin" "$work/peers-sim" --markdown "$root/docs/benchmarks/sim.md" || status=1
 fi
 if runs sample-large; then
   large_counts=(100000 1000000)
@@ -142,20 +143,20 @@ if runs sample; then
   sample_args=()
   [ "$quick" -eq 1 ] && sample_args=(--large --no-trade)
   (cd "$root" && "$py" bench/sample_bench.py --tetrasand "$bin/tetrasand" "${sample_args[@]}" --csv "$work/sample.csv" \
-    --markdown docs/benchmarks.md --command "scripts/bench.sh sample${sample_args:+ (--quick: ${sample_args[*]})}") || status=1
+    --markdown docs/benchmarks/sampler.md --command "scripts/bench.sh sample${sample_args:+ (--quick: ${sample_args[*]})}") || status=1
 fi
 if runs certificate; then
   counts=(1000 10000 100000 200000)
   [ "$quick" -eq 1 ] && counts=(1000 10000)
   (cd "$root" && "$py" bench/certificate_bench.py --tetrasand "$bin/tetrasand" --counts "${counts[@]}" \
-    --csv "$work/certificate.csv" --markdown docs/benchmarks.md \
+    --csv "$work/certificate.csv" --markdown docs/benchmarks/certificate.md \
     --command "scripts/bench.sh certificate$([ "$quick" -eq 1 ] && echo ' --quick')") || status=1
 fi
 if [ "$what" = certificate-cpu ]; then  # not in `all`: the certificate run above makes the same table
   counts=(1000 10000 100000)
   [ "$quick" -eq 1 ] && counts=(1000 10000)
   (cd "$root" && "$py" bench/certificate_bench.py --tetrasand "$bin/tetrasand" --counts "${counts[@]}" \
-    --must-certify --csv "$work/certificate-cpu.csv" --markdown docs/benchmarks.md --cpu-table-only \
+    --must-certify --csv "$work/certificate-cpu.csv" --markdown docs/benchmarks/certificate.md --cpu-table-only \
     --command "scripts/bench.sh certificate-cpu$([ "$quick" -eq 1 ] && echo ' --quick')") || status=1
 fi
 if runs defaults; then
@@ -209,9 +210,9 @@ if runs sparse; then
   # --quick writes its rows to the work folder, leaving the full run's rows in docs/ alone.
   [ "$quick" -eq 1 ] && sparse_res=64,128 && sparse_rows=(--rows "$work/sparse_memory_rows.json")
   "$py" "$root/bench/sparse_memory.py" "$bin/tetrasand" "$root/assets/bunny.obj,$meshes/knot1.off,$meshes/armadillo.off" \
-    "$sparse_res" --markdown "$root/docs/benchmarks.md" --plot "$root/docs/benchmarks/sparse_memory.png" \
+    "$sparse_res" --markdown "$root/docs/benchmarks/sdf.md" --plot "$root/docs/benchmarks/sparse_memory.png" \
     "${sparse_rows[@]}" --command "scripts/bench.sh sparse$([ "$quick" -eq 1 ] && echo ' --quick')" || status=1
-  echo "bench: wrote section sparse of docs/benchmarks.md and docs/benchmarks/sparse_memory.png"
+  echo "bench: wrote section sparse of docs/benchmarks/sdf.md and docs/benchmarks/sparse_memory.png"
 fi
 if runs sdf; then
   meshes=$(cgal_meshes)
@@ -227,9 +228,9 @@ if runs sdf; then
   load_end=$(cut -d' ' -f1-3 /proc/loadavg)
   renderer=$(sed -n 's/^renderer: //p' "$work/sdf.err" | head -n 1)
   "$py" "$root/bench/plot_sdf.py" "$work/sdf.csv" "$root/docs/benchmarks/sdf_error_vs_time.png"
-  "$py" "$root/bench/sdf_report.py" "$work/sdf.csv" --markdown "$root/docs/benchmarks.md" --renderer "$renderer" \
+  "$py" "$root/bench/sdf_report.py" "$work/sdf.csv" --markdown "$root/docs/benchmarks/sdf.md" --renderer "$renderer" \
     --command "scripts/bench.sh sdf --cases '$sdf_cases'" --planned "${resolved[@]}" \
     --load "$load_start (1/5/15 min) at the start, $load_end at the end" --notes "$root/bench/sdf_notes.md" >/dev/null
-  echo "bench: wrote section sdf of docs/benchmarks.md and docs/benchmarks/sdf_error_vs_time.png"
+  echo "bench: wrote section sdf of docs/benchmarks/sdf.md and docs/benchmarks/sdf_error_vs_time.png"
 fi
 exit $status

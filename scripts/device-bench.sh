@@ -15,9 +15,9 @@
 #       into DIR/device-bench.json and DIR/device-bench.md (DIR: --out, else $OUT, else ./device-bench-out).
 #       Without a bundle it runs the build tree's binaries (default build-release).
 #   scripts/device-bench.sh report RESULTS.json [--markdown FILE] [--baseline HERE.json] [--allow-test]
-#       here: rewrites the NVIDIA sections (nvidia-sdf, -sampler, -sim, -preview) of docs/benchmarks.md;
+#       here: rewrites the NVIDIA sections (nvidia-sdf, -sampler, -sim, -preview) of docs/benchmarks/device.md;
 #       a --quick or non-NVIDIA run only with --allow-test (the ctest writes into a copy).
-# One device call (README.md, "Benchmarks"): carry .devbundle, timeout_s 540, command
+# One device call (docs/benchmarks.md, "How the figures are made"): carry .devbundle, timeout_s 540, command
 #   scripts/device-bench.sh run --bundle .devbundle --out $OUT
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Before/after pictures of first use (issue 17), into docs/images/first-use/ (shown in docs/first-use.md):
+# Pictures of first use (issue 17), into docs/images/first-use/ (shown in docs/first-use.md, the guide, and
+# in docs/benchmarks/history.md, the before/after record of issue 17):
 #   dino-before.png   `sample --preview --up 0,1,0`: the old y-up default, CGAL's z-up dino on its side
 #   dino-after.png    `sample --preview`: the default +z up, the dino standing
 #   drop-before.png   prop_drop's last frame as the old frames showed it: 640x480, no walls, the camera

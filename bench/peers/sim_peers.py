@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Simulation against LAMMPS, side by side in one run (docs/benchmarks.md, section peers-sim).
+"""Simulation against LAMMPS, side by side in one run (docs/benchmarks/sim.md, section peers-sim).
 
 The same scenes run on tetrasand's CPU reference (`tetrasand sim --backend cpu`), its GPU pipeline
 (`tetrasand sim --backend gpu`, on whatever EGL device is there: llvmpipe without a GPU) and LAMMPS

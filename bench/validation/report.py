@@ -737,7 +737,7 @@ def main():
     header = f"""# Physical validation
 
 Produced by `scripts/bench.sh validation` ({time.strftime('%Y-%m-%d')}, {os.cpu_count()} CPU cores){made}. All of them ran on the CPU reference (double
-precision; the one NVIDIA GPU lent to this project so far had 15 minutes, spent on docs/benchmarks.md's
+precision; the one NVIDIA GPU lent to this project so far had 15 minutes, spent on docs/benchmarks/device.md's
 device run, and on Mesa's llvmpipe the GPU pipeline is slower than the CPU reference). Tetrahedral grains of four touching spheres, quartz density,
 E = 1 MPa in the scene runs. The restitution run is one r = 1 mm sphere; the angle of repose (4 heaps of
 3,000 grains), the column collapse ({column_count} columns of {column_grains:,} grains), the silo ({silo_grains:,} grains, sized to the
@@ -745,7 +745,7 @@ conditions of Mankoc et al. 2007) and the contact forces (that silo's settled fi
 grains, whose longer time step covers the same number of grain diameters in fewer steps.
 
 The same contact law run by LAMMPS (through `tetrasand export lammps`) settles beds, rebounds grains and
-builds heaps like tetrasand does: see the section "Simulation against LAMMPS" of docs/benchmarks.md,
+builds heaps like tetrasand does: see the section "Simulation against LAMMPS" of docs/benchmarks/sim.md,
 produced by `scripts/bench.sh peers-sim`.
 """
     if os.path.exists(note):

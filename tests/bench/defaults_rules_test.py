@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """The rules of bench/defaults_criteria.md as bench/defaults.py applies them, without its runs: the
-tables it reads are still in docs/benchmarks.md and docs/validation.md in the shape it parses, the
+tables it reads are still in the benchmark pages (docs/benchmarks/*.md) and docs/validation.md in the shape it
+parses, the
 committed figures meet the rules they met, and figures that break a rule make it fail.
 Usage: defaults_rules_test.py ROOT. Exit status 0 when every check holds."""
 import os
@@ -23,7 +24,7 @@ def verdict(rows, name):
     return next(m for n, _, m in rows if n.startswith(name))
 
 
-doc = open(os.path.join(ROOT, "docs", "benchmarks.md")).read()
+doc = defaults.benchmark_pages(os.path.join(ROOT, "docs"))
 validation = open(os.path.join(ROOT, "docs", "validation.md")).read()
 energy, restitution, trade = defaults.energy_rows(doc), defaults.restitution_rows(doc), defaults.sampler_trade_rows(doc)
 tsuji = defaults.tsuji_spread(validation)

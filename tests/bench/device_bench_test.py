@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """CTest checks of scripts/device-bench.sh on llvmpipe, at the --quick sizes (label device-bench):
   device_bench_test.py quick BUILD_DIR    the whole chain: every part recorded, each ok with rows
-  device_bench_test.py report BUILD_DIR   `report` on quick's results, into a copy of docs/benchmarks.md
+  device_bench_test.py report BUILD_DIR   `report` on quick's results, into a copy of docs/benchmarks/device.md
   device_bench_test.py caps BUILD_DIR     a part past its cap is stopped and recorded, the next still runs,
                                           a missing executable is that part's error, not the run's
 Exit status 0 when every check holds; each failed check is printed."""
@@ -15,7 +15,7 @@ import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(ROOT, "scripts", "device-bench.sh")
-DOCS = os.path.join(ROOT, "docs", "benchmarks.md")
+DOCS = os.path.join(ROOT, "docs", "benchmarks", "device.md")
 PARTS = ["selftest", "sdf", "sampler", "sim", "preview"]
 failures = []
 
@@ -76,14 +76,14 @@ def report(build):
     res = json.load(open(results))
     before = hashlib.sha256(open(DOCS, "rb").read()).hexdigest()
     tmp = tempfile.mkdtemp(prefix="device-bench-report.")
-    copy = os.path.join(tmp, "benchmarks.md")
+    copy = os.path.join(tmp, "device.md")
     shutil.copy(DOCS, copy)
     refused = subprocess.run([SCRIPT, "report", results, "--markdown", copy], capture_output=True, text=True)
     check(refused.returncode != 0 and "--allow-test" in refused.stderr and open(copy).read() == open(DOCS).read(),
           "a quick llvmpipe run is refused without --allow-test, the file left as it was")
     device_bench("report", results, "--markdown", copy, "--allow-test")
     doc, original = open(copy).read(), open(DOCS).read()
-    check(hashlib.sha256(open(DOCS, "rb").read()).hexdigest() == before, "docs/benchmarks.md itself is untouched")
+    check(hashlib.sha256(open(DOCS, "rb").read()).hexdigest() == before, "docs/benchmarks/device.md itself is untouched")
     for part in PARTS:
         start, end = f"<!-- section: nvidia-{part} -->\n", f"<!-- end: nvidia-{part} -->"
         body = doc[doc.index(start) + len(start):doc.index(end)]
