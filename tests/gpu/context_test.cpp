@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "gpu/context.h"
 #include "gpu/gl.h"
+#include "gpu/params.h"
 #include "gpu/shader_library.h"
 #include "shaders/test/bindings.h"
 
@@ -66,8 +67,9 @@ TEST(GpuQueue, DispatchComputesSaxpyAndReadsBack) {
   Buffer bx = Buffer::from<float>(x), by = Buffer::from<float>(y);
   bx.bind(TS_TEST_SAXPY_X);
   by.bind(TS_TEST_SAXPY_Y);
-  saxpy.set("a", 2.0f);
-  saxpy.set("count", n);
+  ParamBlock<params::SaxpyParams> params;
+  params.values = {{n, 0u, 0u, 0u}, {2.0f, 0.0f, 0.0f, 0.0f}};
+  params.bind(TS_TEST_PARAMS);
   Queue queue(/*timings=*/true, /*check_errors=*/true);
   queue.dispatch_items(saxpy, n);
   queue.dispatch_items(saxpy, n);
@@ -111,8 +113,9 @@ TEST(GpuQueue, ItemsPastTheGroupLimitAlongXAreEachComputedOnce) {
   Buffer bx = Buffer::from<float>(x), by = Buffer::from<float>(y);
   bx.bind(TS_TEST_SAXPY_X);
   by.bind(TS_TEST_SAXPY_Y);
-  saxpy.set("a", 2.0f);
-  saxpy.set("count", static_cast<unsigned>(n));
+  ParamBlock<params::SaxpyParams> params;
+  params.values = {{static_cast<unsigned>(n), 0u, 0u, 0u}, {2.0f, 0.0f, 0.0f, 0.0f}};
+  params.bind(TS_TEST_PARAMS);
   Queue queue(/*timings=*/false, /*check_errors=*/true);
   queue.dispatch_items(saxpy, n);
   const auto result = by.read<float>(n + 64);
