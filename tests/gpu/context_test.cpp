@@ -83,6 +83,38 @@ TEST(GpuQueue, DispatchComputesSaxpyAndReadsBack) {
   EXPECT_NE(queue.timing_report().find("test/saxpy.comp"), std::string::npos);
 }
 
+// A ParamBlock rewritten between two dispatches: the first reads what it was issued with, the second
+// the new values, and binding unchanged values again uploads nothing new yet still binds the block.
+TEST(GpuParamBlock, EachDispatchReadsTheValuesBoundBeforeIt) {
+  Context context;
+  ShaderLibrary library;
+  Program saxpy = Program::compute(library, "test/saxpy.comp");
+  const unsigned n = 300;
+  std::vector<float> x(n), y(n, 1.0f);
+  std::iota(x.begin(), x.end(), 0.0f);
+  Buffer bx = Buffer::from<float>(x), by = Buffer::from<float>(y);
+  bx.bind(TS_TEST_SAXPY_X);
+  by.bind(TS_TEST_SAXPY_Y);
+  ParamBlock<params::SaxpyParams> params, other;
+  Queue queue(/*timings=*/false, /*check_errors=*/true);
+  params.values = {{n, 0u, 0u, 0u}, {2.0f, 0.0f, 0.0f, 0.0f}};
+  params.bind(TS_TEST_PARAMS);
+  queue.dispatch_items(saxpy, n);
+  params.values.scale.x = 3.0f;
+  params.values.count.x = n / 2;  // the second dispatch covers the first half only
+  params.bind(TS_TEST_PARAMS);
+  queue.dispatch_items(saxpy, n);
+  other.values = {{n, 0u, 0u, 0u}, {100.0f, 0.0f, 0.0f, 0.0f}};
+  other.bind(TS_TEST_PARAMS);  // takes the slot ...
+  params.bind(TS_TEST_PARAMS);  // ... and gives it back, unchanged values: no upload, still bound
+  queue.dispatch_items(saxpy, n);
+  const auto result = by.read<float>(n);
+  for (unsigned i = 0; i < n; ++i) {
+    const float expected = 1.0f + (i < n / 2 ? 8.0f : 2.0f) * static_cast<float>(i);
+    ASSERT_FLOAT_EQ(result[i], expected) << i;
+  }
+}
+
 TEST(GpuQueue, GroupGridCoversEveryGroupInRowsNoWiderThanTheLimit) {
   for (const std::size_t max_x : {std::size_t{1}, std::size_t{7}, std::size_t{65535}}) {
     for (const std::size_t groups : {std::size_t{1}, max_x, max_x + 1, 2 * max_x, 3 * max_x - 1, 70 * max_x + 3}) {
