@@ -197,43 +197,18 @@ Program::~Program() {
 }
 
 Program::Program(Program&& other) noexcept
-    : id_(std::exchange(other.id_, 0)), name_(std::move(other.name_)), uniforms_(std::move(other.uniforms_)) {}
+    : id_(std::exchange(other.id_, 0)), name_(std::move(other.name_)) {}
 
 Program& Program::operator=(Program&& other) noexcept {
   if (this != &other) {
     if (id_) glDeleteProgram(id_);
     id_ = std::exchange(other.id_, 0);
     name_ = std::move(other.name_);
-    uniforms_ = std::move(other.uniforms_);
   }
   return *this;
 }
 
 void Program::use() const { glUseProgram(id_); }
-
-GLint Program::uniform(const char* name) const {
-  auto it = uniforms_.find(name);
-  if (it == uniforms_.end()) it = uniforms_.emplace(name, glGetUniformLocation(id_, name)).first;
-  return it->second;
-}
-
-void Program::set(const char* name, int value) const { glProgramUniform1i(id_, uniform(name), value); }
-void Program::set(const char* name, unsigned value) const { glProgramUniform1ui(id_, uniform(name), value); }
-void Program::set(const char* name, float value) const { glProgramUniform1f(id_, uniform(name), value); }
-void Program::set(const char* name, float x, float y) const { glProgramUniform2f(id_, uniform(name), x, y); }
-void Program::set(const char* name, float x, float y, float z) const { glProgramUniform3f(id_, uniform(name), x, y, z); }
-void Program::set(const char* name, float x, float y, float z, float w) const {
-  glProgramUniform4f(id_, uniform(name), x, y, z, w);
-}
-void Program::set(const char* name, int x, int y) const { glProgramUniform2i(id_, uniform(name), x, y); }
-void Program::set(const char* name, int x, int y, int z) const { glProgramUniform3i(id_, uniform(name), x, y, z); }
-void Program::set_double(const char* name, double value) const { glProgramUniform1d(id_, uniform(name), value); }
-void Program::set_double(const char* name, double x, double y, double z) const {
-  glProgramUniform3d(id_, uniform(name), x, y, z);
-}
-void Program::set_matrix4(const char* name, const float* m) const {
-  glProgramUniformMatrix4fv(id_, uniform(name), 1, GL_FALSE, m);
-}
 
 std::array<int, 3> Program::local_size() const {
   std::array<int, 3> size{1, 1, 1};

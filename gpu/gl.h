@@ -7,7 +7,6 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <map>
 #include <span>
 #include <string>
 #include <utility>
@@ -84,26 +83,14 @@ class Program {
   GLuint id() const { return id_; }
   const std::string& name() const { return name_; }
   void use() const;
-  GLint uniform(const char* name) const;  // -1 when the compiler removed it
-  void set(const char* name, int value) const;
-  void set(const char* name, unsigned value) const;
-  void set(const char* name, float value) const;
-  void set(const char* name, float x, float y) const;
-  void set(const char* name, float x, float y, float z) const;
-  void set(const char* name, float x, float y, float z, float w) const;
-  void set(const char* name, int x, int y) const;
-  void set(const char* name, int x, int y, int z) const;
-  void set_matrix4(const char* name, const float* column_major) const;
-  // Double-precision uniforms (GLSL `double`/`dvec3`, core since GL 4.0).
-  void set_double(const char* name, double value) const;
-  void set_double(const char* name, double x, double y, double z) const;
+  // No by-name uniform setters: a kernel's parameters are a struct of shaders/common/params.h in a
+  // uniform block, uploaded through gpu::ParamBlock (gpu/params.h).
   // Work-group size declared by a compute kernel (layout(local_size_x = ...)).
   std::array<int, 3> local_size() const;
 
  private:
   GLuint id_ = 0;
   std::string name_;
-  mutable std::map<std::string, GLint, std::less<>> uniforms_;
 };
 
 // Per-kernel GPU times, accumulated over a run.

@@ -24,14 +24,16 @@ void PrefixScan::run(Queue& queue, Buffer& values, std::uint32_t count) {
   for (std::size_t l = 0; l < sizes.size(); ++l) {
     level_buffer(l).bind(TS_SCAN_VALUES);
     level_buffer(l + 1).bind(TS_SCAN_BLOCK_SUMS);
-    blocks_.set("count", sizes[l]);
+    params_.values.count.x = sizes[l];
+    params_.bind(TS_SCAN_PARAMS);
     queue.dispatch_groups(blocks_, (sizes[l] + 511u) / 512u);
   }
   // Up: add each level's scanned block offsets back into the level below.
   for (std::size_t l = sizes.size() - 1; l-- > 0;) {
     level_buffer(l).bind(TS_SCAN_VALUES);
     level_buffer(l + 1).bind(TS_SCAN_BLOCK_SUMS);
-    add_.set("count", sizes[l]);
+    params_.values.count.x = sizes[l];
+    params_.bind(TS_SCAN_PARAMS);
     queue.dispatch_items(add_, sizes[l]);
   }
 }
@@ -50,9 +52,9 @@ void BucketSort::finish(Queue& queue, const Buffer& keys, const Buffer& counts, 
   slots.bind(TS_SORT_SLOT);
   starts.bind(TS_SORT_BUCKET_START);
   sorted.bind(TS_SORT_SORTED);
-  scatter_.set("count", count);
+  params_.values.sizes = {count, table_size, 0u, 0u};
+  params_.bind(TS_GRID_PARAMS);
   queue.dispatch_items(scatter_, count);
-  sort_buckets_.set("table_size", table_size);
   queue.dispatch_items(sort_buckets_, table_size);
 }
 
@@ -79,9 +81,9 @@ void HashGrid::build(Queue& queue, const Buffer& positions, std::uint32_t count,
   cell_of_.bind(TS_SORT_KEY);
   cell_count_.bind(TS_SORT_BUCKET_COUNT);
   slot_.bind(TS_SORT_SLOT);
-  count_.set("count", count);
-  count_.set("cell_size", cell_size);
-  count_.set("table_size", table_size_);
+  params_.values.sizes = {count, table_size_, 0u, 0u};
+  params_.values.cell.x = cell_size;
+  params_.bind(TS_GRID_PARAMS);
   queue.dispatch_items(count_, count);
   sort_.finish(queue, cell_of_, cell_count_, slot_, cell_start_, sorted_, count, table_size_);
 }

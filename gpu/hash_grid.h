@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "gpu/gl.h"
+#include "gpu/params.h"
 
 namespace ts::gpu {
 
@@ -20,6 +21,7 @@ class PrefixScan {
 
  private:
   Program blocks_, add_;
+  ParamBlock<params::ItemCount> params_;  // values in the level a kernel runs on
   std::vector<Buffer> levels_;  // levels_[l]: block sums of level l (level 0 = the values), grown on demand
 };
 
@@ -37,6 +39,7 @@ class BucketSort {
 
  private:
   Program scatter_, sort_buckets_;
+  ParamBlock<params::GridParams> params_;  // ids and buckets (scatter and in-bucket sort alike)
   PrefixScan scan_;
 };
 
@@ -54,6 +57,7 @@ class HashGrid {
  private:
   void reserve(std::uint32_t count);
   Program count_;
+  ParamBlock<params::GridParams> params_;
   BucketSort sort_;
   Buffer cell_of_, slot_, cell_count_, cell_start_, sorted_;
   std::uint32_t capacity_ = 0, table_size_ = 0;

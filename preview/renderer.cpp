@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "gpu/gl.h"
 #include "gpu/graphics.h"
+#include "gpu/params.h"
 #include "preview/colors.h"
 #include "shaders/preview/bindings.h"
 
@@ -53,24 +54,33 @@ CameraState camera_state(const Camera& camera, int width, int height, const Eige
   return s;
 }
 
-void set_vec3(const gpu::Program& p, const char* name, const Eigen::Vector3d& v) {
-  p.set(name, static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()));
+using gpu::params::CameraParams;
+using gpu::params::ParticleParams;
+using gpu::params::RaycastParams;
+
+// xyz of a parameter vector (w 0), rounded to float.
+gpu::params::vec4 xyz(const Eigen::Vector3d& v) {
+  return {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()), 0.0f};
 }
-void set_vec3(const gpu::Program& p, const char* name, const Eigen::Vector3f& v) { p.set(name, v.x(), v.y(), v.z()); }
-void set_matrix(const gpu::Program& p, const char* name, const Eigen::Matrix4d& m) {
-  const Eigen::Matrix4f f = m.cast<float>();  // Eigen is column-major, as GL expects
-  p.set_matrix4(name, f.data());
+gpu::params::vec4 xyz(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z(), 0.0f}; }
+gpu::params::mat4 matrix(const Eigen::Matrix4d& m) {
+  const Eigen::Matrix4f f = m.cast<float>();  // Eigen is column-major, as GLSL's mat4
+  gpu::params::mat4 out;
+  for (int c = 0; c < 4; ++c) out.column[c] = {f(0, c), f(1, c), f(2, c), f(3, c)};
+  return out;
 }
 
-void set_camera(const gpu::Program& p, const CameraState& c) {
-  set_matrix(p, "view_projection", c.view_projection);
-  set_matrix(p, "inverse_view_projection", c.inverse);
-  set_vec3(p, "eye", c.eye);
-  set_vec3(p, "view_forward", c.forward);
-  set_vec3(p, "view_right", c.right);
-  set_vec3(p, "view_up", c.up);
-  p.set("orthographic", c.ortho ? 1 : 0);
-  p.set("viewport", static_cast<float>(c.width), static_cast<float>(c.height));
+CameraParams camera_params(const CameraState& c) {
+  CameraParams p;
+  p.view_projection = matrix(c.view_projection);
+  p.inverse_view_projection = matrix(c.inverse);
+  p.eye = xyz(c.eye);
+  p.forward = xyz(c.forward);
+  p.right = xyz(c.right);
+  p.up = xyz(c.up);
+  p.lens = {c.ortho ? 1 : 0, 0, 0, 0};
+  p.viewport = {static_cast<float>(c.width), static_cast<float>(c.height), 0.0f, 0.0f};
+  return p;
 }
 
 // Rows bottom-up (GL) -> top-down (images).
@@ -172,15 +182,16 @@ struct Renderer::Impl {
   void ensure_targets(int w, int h);
   void ensure_shadow_map(int size);
   void upload_particles(const Eigen::Vector3d& new_origin);
-  void bind_volume(const gpu::Program& p) const;
-  void draw_particles(const gpu::Program& p);
-  void draw_volume(const gpu::Program& p);
+  void bind_camera(gpu::ParamBlock<CameraParams>& block, const CameraState& camera);
+  void bind_volume();
+  void draw_particles(gpu::ParamBlock<ParticleParams>& params);
+  void draw_volume(gpu::ParamBlock<RaycastParams>& params);
   void shadow_pass(const Frame& f);
   void particle_pass(const RenderSettings& s, const Frame& f);
   void raycast_pass(const RenderSettings& s, const Frame& f);
   void colour_surface(const RenderSettings& s, const CameraState& camera, RenderResult& result);
   void lighting_pass(const RenderSettings& s, const Frame& f);
-  void set_lighting_uniforms(const RenderSettings& s, const Frame& f) const;
+  void bind_lighting_params(const RenderSettings& s, const Frame& f);
   void read_back(const RenderSettings& s, RenderResult& result) const;
   void check(const char* what) const {
     if (context.debug()) gpu::check_gl(what);
@@ -190,6 +201,13 @@ struct Renderer::Impl {
   gpu::ShaderLibrary library;
   gpu::Queue queue;
   gpu::Program particles_program, raycast_program, shade_program;
+  // The passes' parameters (shaders/common/params.h). The shadow pass has blocks of its own, so no
+  // block is rewritten between the draws of a frame (which would make llvmpipe finish them first).
+  gpu::ParamBlock<CameraParams> camera_block, light_camera_block;
+  gpu::ParamBlock<ParticleParams> particle_block, particle_shadow_block;
+  gpu::ParamBlock<RaycastParams> raycast_block, raycast_shadow_block;
+  gpu::ParamBlock<gpu::params::VolumeParams> volume_block;
+  gpu::ParamBlock<gpu::params::ShadeParams> shade_block;
   std::vector<std::string> volume_defines;  // what raycast_program and shade_program were compiled with
   gpu::VertexArray vao;  // none of the passes reads vertex attributes, but GL draws need one bound
 
@@ -284,36 +302,44 @@ void Renderer::Impl::upload_particles(const Eigen::Vector3d& new_origin) {
   particle_count = n;
 }
 
-void Renderer::Impl::bind_volume(const gpu::Program& p) const {
-  field.bind(p, {TS_PREVIEW_SPARSE_FIELD,
-                 {TS_PREVIEW_FIELD_CHUNK_1, TS_PREVIEW_FIELD_CHUNK_2, TS_PREVIEW_FIELD_CHUNK_3, TS_PREVIEW_FIELD_CHUNK_4,
-                  TS_PREVIEW_FIELD_CHUNK_5, TS_PREVIEW_FIELD_CHUNK_6, TS_PREVIEW_FIELD_CHUNK_7}});
-  set_vec3(p, "volume_origin", Eigen::Vector3d(volume_spec.origin - origin));
-  p.set("voxel_size", static_cast<float>(volume_spec.voxel_size));
-  p.set("volume_dims", static_cast<float>(volume_spec.dims.x()), static_cast<float>(volume_spec.dims.y()),
-        static_cast<float>(volume_spec.dims.z()));
-  p.set("band", static_cast<float>(volume_band));
+void Renderer::Impl::bind_camera(gpu::ParamBlock<CameraParams>& block, const CameraState& camera) {
+  block.values = camera_params(camera);
+  block.bind(TS_PREVIEW_CAMERA);
 }
 
-void Renderer::Impl::draw_particles(const gpu::Program& p) {
+void Renderer::Impl::bind_volume() {
+  field.bind({TS_PREVIEW_SPARSE_FIELD,
+              {TS_PREVIEW_FIELD_CHUNK_1, TS_PREVIEW_FIELD_CHUNK_2, TS_PREVIEW_FIELD_CHUNK_3, TS_PREVIEW_FIELD_CHUNK_4,
+               TS_PREVIEW_FIELD_CHUNK_5, TS_PREVIEW_FIELD_CHUNK_6, TS_PREVIEW_FIELD_CHUNK_7},
+              TS_PREVIEW_FIELD_PARAMS});
+  volume_block.values.origin_voxel = xyz(Eigen::Vector3d(volume_spec.origin - origin));
+  volume_block.values.origin_voxel.w = static_cast<float>(volume_spec.voxel_size);
+  volume_block.values.dims_band = {static_cast<float>(volume_spec.dims.x()), static_cast<float>(volume_spec.dims.y()),
+                                   static_cast<float>(volume_spec.dims.z()), static_cast<float>(volume_band)};
+  volume_block.bind(TS_PREVIEW_VOLUME);
+}
+
+void Renderer::Impl::draw_particles(gpu::ParamBlock<ParticleParams>& params) {
   if (particle_count == 0) return;
+  params.bind(TS_PREVIEW_PARAMS);
   spheres.bind(TS_PREVIEW_SPHERES);
   colors.bind(TS_PREVIEW_COLORS);
   gpu::StateScope state;
   state.no_cull();
-  gpu::draw_arrays(queue, p, GL_TRIANGLES, 0, 6 * particle_count);
+  gpu::draw_arrays(queue, particles_program, GL_TRIANGLES, 0, 6 * particle_count);
 }
 
-void Renderer::Impl::draw_volume(const gpu::Program& p) {
+void Renderer::Impl::draw_volume(gpu::ParamBlock<RaycastParams>& params) {
   if (!has_volume) return;
-  bind_volume(p);
+  bind_volume();
   // Steps of the refinement near each crossing the HDDA finds (a few voxels long), grazing rays included.
-  p.set("max_steps", 512);
-  p.set("min_step", 0.02f);
+  params.values.flags.z = 512;
+  params.values.steps.x = 0.02f;
+  params.bind(TS_PREVIEW_PARAMS);
   // Front faces culled: one fragment per covered pixel, on the far face, also with the eye inside.
   gpu::StateScope state;
   state.cull(GL_FRONT);
-  gpu::draw_arrays(queue, p, GL_TRIANGLES, 0, 36);
+  gpu::draw_arrays(queue, raycast_program, GL_TRIANGLES, 0, 36);
 }
 
 // 1. The key light's shadow map: particles and the SDF, depth only.
@@ -323,13 +349,12 @@ void Renderer::Impl::shadow_pass(const Frame& f) {
     gpu::StateScope pass;
     pass.framebuffer(shadow_target).viewport(f.shadow_size, f.shadow_size);
     shadow_target.clear_depth(1.0f);
-    set_camera(particles_program, f.light_camera);
-    particles_program.set("per_particle_color", 0);
-    draw_particles(particles_program);
-    set_camera(raycast_program, f.light_camera);
-    raycast_program.set("use_particle_depth", 0);
-    raycast_program.set("depth_only", 1);
-    draw_volume(raycast_program);
+    bind_camera(light_camera_block, f.light_camera);
+    particle_shadow_block.values.flags.x = 0;
+    draw_particles(particle_shadow_block);
+    raycast_shadow_block.values.flags.x = 0;  // no particle depth
+    raycast_shadow_block.values.flags.y = 1;  // depth only
+    draw_volume(raycast_shadow_block);
   });
 }
 
@@ -341,10 +366,10 @@ void Renderer::Impl::particle_pass(const RenderSettings& s, const Frame& f) {
     gbuffer.clear_color(0, {0.0f, 0.0f, 0.0f, 0.0f});
     gbuffer.clear_color(1, {0.0f, 0.0f, 0.0f, 0.0f});
     gbuffer.clear_depth(1.0f);
-    set_camera(particles_program, f.camera);
-    particles_program.set("per_particle_color", per_particle_color ? 1 : 0);
-    set_vec3(particles_program, "particle_color", s.particle_color);
-    draw_particles(particles_program);
+    bind_camera(camera_block, f.camera);
+    particle_block.values.flags.x = per_particle_color ? 1 : 0;
+    particle_block.values.color = xyz(s.particle_color);
+    draw_particles(particle_block);
   });
 }
 
@@ -357,11 +382,11 @@ void Renderer::Impl::raycast_pass(const RenderSettings& s, const Frame& f) {
     // The ray cast reads the particle depth while the depth test writes the G-buffer's: a copy.
     if (limit) depth.copy_to(particle_depth);
     particle_depth.bind_unit(TS_PREVIEW_UNIT_PARTICLE_DEPTH);
-    raycast_program.set("use_particle_depth", limit ? 1 : 0);
-    raycast_program.set("depth_only", 0);
-    set_vec3(raycast_program, "surface_color", s.surface_color);
-    set_camera(raycast_program, f.camera);
-    draw_volume(raycast_program);
+    raycast_block.values.flags.x = limit ? 1 : 0;
+    raycast_block.values.flags.y = 0;
+    raycast_block.values.surface_color = xyz(s.surface_color);
+    bind_camera(camera_block, f.camera);
+    draw_volume(raycast_block);
   });
 }
 
@@ -378,36 +403,33 @@ void Renderer::Impl::lighting_pass(const RenderSettings& s, const Frame& f) {
     } else {
       gpu::Texture::unbind_unit(TS_PREVIEW_UNIT_SHADOW);
     }
-    if (has_volume) bind_volume(shade_program);
-    set_lighting_uniforms(s, f);
+    if (has_volume) bind_volume();
+    bind_lighting_params(s, f);
     gpu::draw_arrays(queue, shade_program, GL_TRIANGLES, 0, 3);
   });
 }
 
-void Renderer::Impl::set_lighting_uniforms(const RenderSettings& s, const Frame& f) const {
-  const gpu::Program& p = shade_program;
-  set_camera(p, f.camera);
-  p.set("shadows", s.shadows ? 1 : 0);
+void Renderer::Impl::bind_lighting_params(const RenderSettings& s, const Frame& f) {
+  bind_camera(camera_block, f.camera);
+  gpu::params::ShadeParams& p = shade_block.values;
   if (s.shadows) {
-    set_matrix(p, "light_view_projection", f.light_camera.view_projection);
+    p.light_view_projection = matrix(f.light_camera.view_projection);
     const double texel = 2.02 * f.radius / shadow_size;
-    p.set("shadow_texel", static_cast<float>(texel));
     // Light depth is linear over the near-far range (about 2 radius): one texel of slack.
-    p.set("shadow_bias", static_cast<float>(texel / (2.0 * f.radius)));
-    p.set("shadow_texel_uv", 1.0f / shadow_size, 1.0f / shadow_size);
+    p.shadow = {static_cast<float>(texel), static_cast<float>(texel / (2.0 * f.radius)), 1.0f / shadow_size,
+                1.0f / shadow_size};
   }
-  p.set("has_volume", has_volume ? 1 : 0);
-  set_vec3(p, "light_dir", f.light);
-  set_vec3(p, "world_up", f.up);
-  p.set("ground", s.ground ? 1 : 0);
-  p.set("ground_level", static_cast<float>(f.ground_level));
+  p.flags = {s.shadows ? 1 : 0, has_volume ? 1 : 0, s.ground ? 1 : 0, s.alpha ? 1 : 0};
+  p.light_dir = xyz(f.light);
+  p.world_up = xyz(f.up);
   const Eigen::Vector3d center = f.content.center() - f.origin;
-  set_vec3(p, "ground_center", Eigen::Vector3d(center - (f.up.dot(center) - f.ground_level) * f.up));
-  p.set("ground_radius", static_cast<float>(2.5 * 0.5 * f.content.size().norm()));
-  set_vec3(p, "ground_color", Eigen::Vector3f(0.88f, 0.88f, 0.87f));
-  set_vec3(p, "background_top", Eigen::Vector3f(0.97f, 0.97f, 0.98f));
-  set_vec3(p, "background_bottom", Eigen::Vector3f(0.80f, 0.82f, 0.86f));
-  p.set("transparent", s.alpha ? 1 : 0);
+  p.ground = xyz(Eigen::Vector3d(center - (f.up.dot(center) - f.ground_level) * f.up));
+  p.ground.w = static_cast<float>(f.ground_level);
+  p.ground_color = xyz(Eigen::Vector3f(0.88f, 0.88f, 0.87f));
+  p.ground_color.w = static_cast<float>(2.5 * 0.5 * f.content.size().norm());
+  p.background_top = xyz(Eigen::Vector3f(0.97f, 0.97f, 0.98f));
+  p.background_bottom = xyz(Eigen::Vector3f(0.80f, 0.82f, 0.86f));
+  shade_block.bind(TS_PREVIEW_PARAMS);
 }
 
 // The image, and with keep_buffers each pixel's layer and normal, top row first.

@@ -166,20 +166,17 @@ CoverageCertifier::LevelCounts CoverageCertifier::evaluate(std::uint32_t count, 
   bounds_.bind(TS_CERT_BOUNDS);
   totals_.bind(TS_CERT_TOTALS);
   const double floor = frame.radius / settings.floor_divisor;
-  evaluate_.set("count", count);
-  evaluate_.set("cell_size", grid_.cell_size());
-  evaluate_.set("table_size", grid_.table_size());
-  evaluate_.set("max_shells", settings.max_shells);
-  evaluate_.set("search_slack", static_cast<float>(frame.margin));
-  evaluate_.set("test_radius", static_cast<float>(frame.test_radius));
-  evaluate_.set("floor_length", static_cast<float>(floor));
-  evaluate_.set("hole_resolution", static_cast<float>(std::max(floor, frame.radius / settings.hole_divisor)));
+  gpu::params::CertifyParams& p = evaluate_params_.values;
+  p.sizes = {count, grid_.table_size(), no_split ? 1u : 0u, 0u};
+  p.search = {settings.max_shells, 0, 0, 0};
+  p.lengths = {grid_.cell_size(), static_cast<float>(frame.margin), static_cast<float>(frame.test_radius),
+               static_cast<float>(floor)};
   // The bound is refined to within the floor of the covering radius found so far, or the same
   // fraction of it in a hole deeper than the radius.
-  evaluate_.set("refine_tol",
-                static_cast<float>(std::max(frame.radius, double{witness_so_far}) / settings.floor_divisor));
-  evaluate_.set("witness_so_far", witness_so_far);
-  evaluate_.set("no_split", no_split ? 1u : 0u);
+  p.refine = {static_cast<float>(std::max(floor, frame.radius / settings.hole_divisor)),
+              static_cast<float>(std::max(frame.radius, double{witness_so_far}) / settings.floor_divisor),
+              witness_so_far, 0.0f};
+  evaluate_params_.bind(TS_SAMPLER_PARAMS);
   queue_.dispatch_items(evaluate_, std::size_t{count} + 1);
   scan_.run(queue_, splits_, count + 1);
   scan_.run(queue_, uncovered_, count + 1);
@@ -198,7 +195,8 @@ void CoverageCertifier::scatter(std::uint32_t count, const LevelCounts& counts) 
   bounds_.bind(TS_CERT_BOUNDS);
   queue_buffers_[1].bind(TS_CERT_NEXT_QUEUE);
   holes_.bind(TS_CERT_HOLES);
-  scatter_.set("count", count);
+  scatter_params_.values.count.x = count;
+  scatter_params_.bind(TS_SAMPLER_PARAMS);
   queue_.dispatch_items(scatter_, count);
   std::swap(queue_buffers_[0], queue_buffers_[1]);
 }

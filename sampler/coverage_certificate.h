@@ -127,6 +127,8 @@ class CoverageCertifier {
   gpu::ShaderLibrary library_;
   gpu::Queue queue_;
   gpu::Program evaluate_, scatter_;
+  gpu::ParamBlock<gpu::params::CertifyParams> evaluate_params_;
+  gpu::ParamBlock<gpu::params::ItemCount> scatter_params_;
   gpu::HashGrid grid_;
   gpu::PrefixScan scan_;
   gpu::Buffer triangles_, centres_, queue_buffers_[2], splits_, uncovered_, bounds_, totals_, holes_;

@@ -26,16 +26,18 @@ std::size_t GpuRelaxer::gpu_bytes() const {
   return field_.gpu_bytes() + positions_[0].bytes() * 2 + step_info_.bytes() + partials_.bytes() + grid_.bytes();
 }
 
-void GpuRelaxer::bind_sdf(const gpu::Program& program) const {
-  field_.bind(program, {TS_SAMPLER_SPARSE_FIELD,
-                        {TS_SAMPLER_FIELD_CHUNK_1, TS_SAMPLER_FIELD_CHUNK_2, TS_SAMPLER_FIELD_CHUNK_3, TS_SAMPLER_FIELD_CHUNK_4,
-                         TS_SAMPLER_FIELD_CHUNK_5, TS_SAMPLER_FIELD_CHUNK_6, TS_SAMPLER_FIELD_CHUNK_7}});
+void GpuRelaxer::bind_sdf() const {
+  field_.bind({TS_SAMPLER_SPARSE_FIELD,
+               {TS_SAMPLER_FIELD_CHUNK_1, TS_SAMPLER_FIELD_CHUNK_2, TS_SAMPLER_FIELD_CHUNK_3, TS_SAMPLER_FIELD_CHUNK_4,
+                TS_SAMPLER_FIELD_CHUNK_5, TS_SAMPLER_FIELD_CHUNK_6, TS_SAMPLER_FIELD_CHUNK_7},
+               TS_SAMPLER_FIELD_PARAMS});
 }
 
 void GpuRelaxer::project(std::uint32_t count, int steps) {
   positions_[0].bind(TS_SAMPLER_POSITIONS);
-  bind_sdf(project_);
-  project_.set("count", count);
+  bind_sdf();
+  count_params_.values.count.x = count;
+  count_params_.bind(TS_SAMPLER_PARAMS);
   for (int s = 0; s < steps; ++s) queue_.dispatch_items(project_, count);
 }
 
@@ -48,9 +50,9 @@ void GpuRelaxer::iterate(std::uint32_t count, double cutoff) {
   grid_.bind();
   velocities_.bind(TS_SAMPLER_VELOCITIES);
   step_info_.bind(TS_SAMPLER_STEP_INFO);
-  bind_sdf(relax_);
-  relax_.set("count", count);
-  relax_.set("table_size", grid_.table_size());
+  bind_sdf();
+  relax_params_.values.sizes = {count, grid_.table_size(), 0u, 0u};
+  relax_params_.bind(TS_SAMPLER_PARAMS);
   queue_.dispatch_items(relax_, count);
   std::swap(positions_[0], positions_[1]);
 }
@@ -60,7 +62,8 @@ GpuRelaxer::StepSums GpuRelaxer::check(std::uint32_t count) {
   ++checks_run_;
   step_info_.bind(TS_SAMPLER_STEP_INFO);
   partials_.bind(TS_SAMPLER_PARTIALS);
-  reduce_.set("count", count);
+  count_params_.values.count.x = count;
+  count_params_.bind(TS_SAMPLER_PARAMS);
   queue_.dispatch_items(reduce_, count);
   StepSums sums;
   for (const auto& p : partials_.read<Eigen::Vector4f>((count + 255) / 256)) {
@@ -107,12 +110,10 @@ RelaxStats GpuRelaxer::run(std::vector<Eigen::Vector3f>& positions, const RelaxS
   upload();
   std::uint32_t count = static_cast<std::uint32_t>(positions.size());
 
-  relax_.set("cell_size", static_cast<float>(cutoff));
-  relax_.set("inv_two_sigma2", static_cast<float>(1.0 / (2.0 * sigma * sigma)));
-  relax_.set("repulsion_gain", static_cast<float>(settings.repulsion_gain));
-  relax_.set("momentum", static_cast<float>(settings.momentum));
-  relax_.set("max_move", static_cast<float>(settings.max_move_over_cell * cutoff));
-  relax_.set("band_limit", static_cast<float>(settings.band_limit));
+  relax_params_.values.kernel = {static_cast<float>(cutoff), static_cast<float>(1.0 / (2.0 * sigma * sigma)),
+                                 static_cast<float>(settings.repulsion_gain), static_cast<float>(settings.momentum)};
+  relax_params_.values.limits = {static_cast<float>(settings.max_move_over_cell * cutoff),
+                                 static_cast<float>(settings.band_limit), 0.0f, 0.0f};
   while (stats.iterations < settings.max_iterations && count > 0) {
     iterate(count, cutoff);
     ++stats.iterations;

@@ -33,7 +33,7 @@ class GpuRelaxer final : public ParticleRelaxer {
  private:
   RelaxStats run(std::vector<Eigen::Vector3f>& positions, const RelaxSettings& settings,
                  const RelaxProgress& progress, std::vector<std::uint8_t>* mobile) override;
-  void bind_sdf(const gpu::Program& program) const;
+  void bind_sdf() const;
   void project(std::uint32_t count, int steps);
   // One step: the hashed grid rebuilt, every particle moved (no read-back).
   void iterate(std::uint32_t count, double cutoff);
@@ -48,6 +48,8 @@ class GpuRelaxer final : public ParticleRelaxer {
   gpu::ShaderLibrary library_;
   gpu::Queue queue_;
   gpu::Program relax_, project_, reduce_;
+  gpu::ParamBlock<gpu::params::RelaxParams> relax_params_;  // the step's constants, set once per run
+  gpu::ParamBlock<gpu::params::ItemCount> count_params_;    // project_ and reduce_
   gpu::HashGrid grid_;
   gpu::Buffer positions_[2], velocities_, step_info_, partials_;
   gpu::HostSyncCounts iteration_syncs_, check_syncs_, relax_syncs_;

@@ -318,11 +318,13 @@ class SlabScanner {
   gpu::Queue& queue_;
   std::vector<gpu::Program> programs_;  // one per kVariantInvocations
   std::vector<std::string> timer_names_;
+  gpu::ParamArray<gpu::params::ScanConvertParams> draw_params_;  // one entry per draw of a slab
   gpu::Buffer triangles_, prisms_, indices_;
   gpu::VertexArray vertices_;
   SlabTarget target_;
   // Band compaction: flags (scanned in place into offsets), the compacted band, its host copy.
   gpu::Program flag_band_, scatter_band_;
+  gpu::ParamBlock<gpu::params::BandParams> band_params_;
   gpu::PrefixScan scan_;
   gpu::Buffer flags_, band_indices_, band_values_;
   std::vector<std::uint32_t> index_words_;
@@ -349,13 +351,9 @@ SlabScanner::SlabScanner(const gpu::ShaderLibrary& library, gpu::Queue& queue, c
              static_cast<std::size_t>(plan.slab_layers) * sizeof(std::uint32_t)) {
   target_.color.set_sampling(GL_NEAREST);  // read by texelFetch; a complete texture needs a non-mip filter
   for (int invocations : kVariantInvocations) {
-    gpu::Program& program = programs_.emplace_back(
-        gpu::Program::graphics(library, "sdf/scan_convert.vert", "sdf/scan_convert.geom",
-                               "sdf/scan_convert.frag", {"INVOCATIONS " + std::to_string(invocations)}));
-    program.set("grid_xy", static_cast<float>(spec.dims.x()), static_cast<float>(spec.dims.y()));
-    program.set("slab_layers", plan.slab_layers);
-    program.set("depth_range", static_cast<float>(plan.margin));
-    program.set("draw_layers", plan.block);
+    programs_.push_back(gpu::Program::graphics(library, "sdf/scan_convert.vert", "sdf/scan_convert.geom",
+                                               "sdf/scan_convert.frag",
+                                               {"INVOCATIONS " + std::to_string(invocations)}));
     timer_names_.push_back(fmt::format("sdf/scan_convert ({} GS invocations)", invocations));
   }
   vertices_.set_element_buffer(indices_);
@@ -369,30 +367,37 @@ int SlabScanner::draw(int z0, int layers) {
   prisms_.bind(TS_SDF_PRISMS);
   target_.framebuffer.clear_color(0, {0.0f, 0.0f, 0.0f, kUntouched});
   target_.framebuffer.clear_depth(1.0f);
-  int draws = 0;
+  struct Draw {
+    std::size_t variant, begin, count;
+  };
+  std::vector<Draw> draws;
+  std::vector<gpu::params::ScanConvertParams> params;
   for (int first = 0; first < layers; first += plan_.block) {
     for (std::size_t variant = 0; variant < kVariants; ++variant) {
       const std::size_t list = kVariants * static_cast<std::size_t>((z0 + first) / plan_.block) + variant;
       const std::size_t begin = plan_.lists.begin[list], end = plan_.lists.begin[list + 1];
       if (begin == end) continue;
-      const gpu::Program& program = programs_[variant];
-      program.set("slab_first_z", z0);
-      program.set("draw_first_layer", first);
-      gpu::draw_elements(queue_, program, GL_LINES_ADJACENCY, begin, end - begin, timer_names_[variant]);
-      ++draws;
+      draws.push_back({variant, begin, end - begin});
+      params.push_back({{z0, plan_.slab_layers, first, plan_.block},
+                        {static_cast<float>(spec_.dims.x()), static_cast<float>(spec_.dims.y()),
+                         static_cast<float>(plan_.margin), 0.0f}});
     }
   }
-  return draws;
+  // The slab's parameters go up in one upload, before its first draw (gpu::ParamArray says why).
+  draw_params_.upload(params);
+  for (std::size_t d = 0; d < draws.size(); ++d) {
+    draw_params_.bind(d, TS_SDF_SCAN_PARAMS);
+    gpu::draw_elements(queue_, programs_[draws[d].variant], GL_LINES_ADJACENCY, draws[d].begin, draws[d].count,
+                       timer_names_[draws[d].variant]);
+  }
+  return static_cast<int>(draws.size());
 }
 
 SlabScanner::Band SlabScanner::read_band(int layers, float band) {
   const std::uint32_t voxels = static_cast<std::uint32_t>(spec_.dims.x()) * static_cast<std::uint32_t>(spec_.dims.y()) *
                                static_cast<std::uint32_t>(layers);
-  for (gpu::Program* program : {&flag_band_, &scatter_band_}) {
-    program->set("layer_size", spec_.dims.x(), spec_.dims.y());
-    program->set("voxels", voxels);
-    program->set("band", band);
-  }
+  band_params_.values = {{spec_.dims.x(), spec_.dims.y(), 0, 0}, {voxels, 0u, 0u, 0u}, {band, 0.0f, 0.0f, 0.0f}};
+  band_params_.bind(TS_SDF_BAND_PARAMS);
   target_.color.bind_unit(TS_SDF_UNIT_SLAB);
   flags_.bind(TS_SDF_BAND_FLAGS);
   // Host reads of what a kernel wrote need the buffer-update barrier besides the storage one.
@@ -409,6 +414,7 @@ SlabScanner::Band SlabScanner::read_band(int layers, float band) {
   flags_.bind(TS_SDF_BAND_OFFSETS);
   band_indices_.bind(TS_SDF_BAND_INDICES);
   band_values_.bind(TS_SDF_BAND_VALUES);
+  band_params_.bind(TS_SDF_BAND_PARAMS);  // again: the scan's own parameters took the slot
   queue_.dispatch_items(scatter_band_, voxels, kToHost);
   gpu::Texture::unbind_unit(TS_SDF_UNIT_SLAB);
   index_words_.resize(count);

@@ -129,13 +129,13 @@ std::vector<std::string> SparseField::shader_defines() const {
   return {fmt::format("TS_FIELD_CHUNKS {}", chunks_.size()), fmt::format("TS_FIELD_CHUNK_SHIFT {}", chunk_shift_)};
 }
 
-void SparseField::bind(const gpu::Program& program, const FieldSlots& slots) const {
+void SparseField::bind(const FieldSlots& slots) const {
   for (std::size_t c = 0; c < chunks_.size(); ++c) chunks_[c].bind(c == 0 ? slots.first : slots.more[c - 1]);
   const Eigen::Vector3i offset = gpu_index_offset();
-  program.set("field_index_offset", offset.x(), offset.y(), offset.z());
-  program.set("field_voxel_size", static_cast<float>(spec_.voxel_size));
-  program.set("field_background", background_);
-  if (chunks_.size() > 1) program.set("field_corner_count", 8);
+  // The corner count is read only by a chunked field's programs (TS_FIELD_CHUNKS > 1).
+  params_.values.index_offset = {offset.x(), offset.y(), offset.z(), chunks_.size() > 1 ? 8 : 0};
+  params_.values.scale = {static_cast<float>(spec_.voxel_size), background_, 0.0f, 0.0f};
+  params_.bind(slots.params);
 }
 
 void write_nvdb(const std::filesystem::path& file, const NanoGrid& grid, const std::vector<std::filesystem::path>& inputs) {

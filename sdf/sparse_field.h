@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "gpu/gl.h"
+#include "gpu/params.h"
 #include "sdf/grid.h"
 
 namespace ts::sdf {
@@ -49,6 +50,7 @@ inline constexpr int kMaxFieldChunks = 8;
 struct FieldSlots {
   GLuint first = 0;
   std::array<GLuint, kMaxFieldChunks - 1> more{};
+  GLuint params = 0;  // uniform-block slot of its gpu::params::FieldParams
 };
 
 class SparseField {
@@ -81,8 +83,8 @@ class SparseField {
   // NanoVDB index of spec's voxel (0, 0, 0) in the uploaded grid: spec.index_offset + gpu_index_shift(spec).
   Eigen::Vector3i gpu_index_offset() const { return spec_.index_offset + gpu_index_shift(spec_); }
 
-  // Binds the grid's chunks to `slots` and sets the uniforms shaders/common/sparse_field.glsl reads.
-  void bind(const gpu::Program& program, const FieldSlots& slots) const;
+  // Binds the grid's chunks and the parameters shaders/common/sparse_field.glsl reads to `slots`.
+  void bind(const FieldSlots& slots) const;
 
  private:
   GridSpec spec_;
@@ -92,6 +94,8 @@ class SparseField {
   NanoGrid host_;
   int chunk_shift_ = 0;  // log2 of a chunk's words; 0 for one block
   std::vector<gpu::Buffer> chunks_;
+  // Where the grid sits; mutable: bind() uploads it on first use, from a const field.
+  mutable gpu::ParamBlock<gpu::params::FieldParams> params_;
 };
 
 // Writes `grid` as a NanoVDB file (uncompressed, readable by nanovdb_print / nanovdb_validate),

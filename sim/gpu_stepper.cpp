@@ -208,7 +208,7 @@ void GpuStepper::upload(const World& world) {
   allocate_resort(body_count_, particle_count_);
   upload_materials_and_walls(world);
   allocate_statistics();
-  set_uniforms();
+  set_params();
 }
 
 void GpuStepper::upload_bodies(const World& world) {
@@ -281,37 +281,71 @@ void GpuStepper::upload_materials_and_walls(const World& world) {
   cylinders_ = gpu::Buffer::from<SimCylinder>(cylinders);
 }
 
-void GpuStepper::set_uniforms() {
-  const float dt = static_cast<float>(settings_.dt);
+namespace {
+
+// The contact kernel's parameters but the hash table size (set each step); Params: SimContactParams,
+// or SimContactParams64, whose step length is a double.
+template <typename Params>
+void fill_contact_params(Params& p, const StepSettings& s, std::uint32_t particles, std::uint32_t planes,
+                         std::uint32_t cylinders, std::uint32_t materials, double cell_size) {
+  p.sizes = {particles, p.sizes.y, planes, cylinders};
+  p.materials = {materials, 0u, 0u, 0u};
+  p.models = {s.normal_damping == NormalDamping::Tsuji ? 0 : 1, s.tangential == TangentialModel::Spring ? 1 : 0,
+              s.check_penetration ? 1 : 0, 0};
+  p.limits = {static_cast<float>(cell_size),
+              static_cast<float>(s.max_overlap_ratio > 0 ? s.max_overlap_ratio : 1e30), 0.0f, 0.0f};
+  p.step.x = static_cast<decltype(p.step.x)>(s.dt);
+}
+
+// The integration kernel's parameters but the step's end time (set each step); Params:
+// SimIntegrateParams or SimIntegrateParams64.
+template <typename Params>
+void fill_integrate_params(Params& p, const StepSettings& s, std::uint32_t bodies, const Eigen::Vector3d& gravity,
+                           double max_speed) {
+  using Real = decltype(p.time.x);
+  p.sizes = {bodies, 0u, 0u, 0u};
+  p.models = {s.integrator == Integrator::SemiImplicitEuler ? 1 : 0, 0, 0, 0};
+  p.limits = {static_cast<float>(std::min(max_speed, 1e30)), static_cast<float>(s.angular_damping_rate),
+              static_cast<float>(s.angular_damping_speed), 0.0f};
+  p.gravity_dt = {static_cast<Real>(gravity.x()), static_cast<Real>(gravity.y()), static_cast<Real>(gravity.z()),
+                  static_cast<Real>(s.dt)};
+}
+
+}  // namespace
+
+void GpuStepper::set_params() {
   const double max_speed = settings_.cfl > 0 ? settings_.cfl * cell_size_ / settings_.dt : 1e30;
-  update_.set("particle_count", particle_count_);
-  contacts_.set("particle_count", particle_count_);
-  contacts_.set("cell_size", static_cast<float>(cell_size_));
-  contacts_.set("plane_count", plane_count_);
-  contacts_.set("cylinder_count", cylinder_count_);
-  contacts_.set("material_count", material_count_);
-  contacts_.set("damping_model", settings_.normal_damping == NormalDamping::Tsuji ? 0 : 1);
-  contacts_.set("max_overlap_ratio", static_cast<float>(settings_.max_overlap_ratio > 0 ? settings_.max_overlap_ratio : 1e30));
-  contacts_.set("spring_model", settings_.tangential == TangentialModel::Spring ? 1 : 0);
-  contacts_.set("check_penetration", settings_.check_penetration ? 1 : 0);
-  integrate_.set("body_count", body_count_);
+  update_params_.values.count.x = particle_count_;
+  fill_contact_params(contact_params_.values, settings_, particle_count_, plane_count_, cylinder_count_,
+                      material_count_, cell_size_);
+  fill_contact_params(contact_params64_.values, settings_, particle_count_, plane_count_, cylinder_count_,
+                      material_count_, cell_size_);
+  fill_integrate_params(integrate_params_.values, settings_, body_count_, gravity_, max_speed);
+  fill_integrate_params(integrate_params64_.values, settings_, body_count_, gravity_, max_speed);
+  metrics_params_.values.sizes.x = body_count_;
+  metrics_params_.values.gravity = {static_cast<float>(gravity_.x()), static_cast<float>(gravity_.y()),
+                                    static_cast<float>(gravity_.z()), 0.0f};
+  particle_stats_params_.values.count.x = particle_count_;
+}
+
+void GpuStepper::bind_contact_params(std::uint32_t table_size) {
   if (precision_ == Precision::Double) {
-    contacts_.set_double("dt", settings_.dt);
-    integrate_.set_double("dt", settings_.dt);
-    integrate_.set_double("gravity", gravity_.x(), gravity_.y(), gravity_.z());
+    contact_params64_.values.sizes.y = table_size;
+    contact_params64_.bind(TS_SIM_PARAMS);
   } else {
-    contacts_.set("dt", dt);
-    integrate_.set("dt", dt);
-    integrate_.set("gravity", static_cast<float>(gravity_.x()), static_cast<float>(gravity_.y()),
-                   static_cast<float>(gravity_.z()));
+    contact_params_.values.sizes.y = table_size;
+    contact_params_.bind(TS_SIM_PARAMS);
   }
-  integrate_.set("semi_implicit", settings_.integrator == Integrator::SemiImplicitEuler ? 1 : 0);
-  integrate_.set("max_speed", static_cast<float>(std::min(max_speed, 1e30)));
-  integrate_.set("angular_damping_rate", static_cast<float>(settings_.angular_damping_rate));
-  integrate_.set("angular_damping_speed", static_cast<float>(settings_.angular_damping_speed));
-  metrics_.set("body_count", body_count_);
-  metrics_.set("gravity", static_cast<float>(gravity_.x()), static_cast<float>(gravity_.y()), static_cast<float>(gravity_.z()));
-  particle_stats_.set("particle_count", particle_count_);
+}
+
+void GpuStepper::bind_integrate_params(double time_after) {
+  if (precision_ == Precision::Double) {
+    integrate_params64_.values.time.x = time_after;
+    integrate_params64_.bind(TS_SIM_PARAMS);
+  } else {
+    integrate_params_.values.time.x = static_cast<float>(time_after);
+    integrate_params_.bind(TS_SIM_PARAMS);
+  }
 }
 
 void GpuStepper::bind_state() const {
@@ -348,17 +382,14 @@ void GpuStepper::step(int steps) {
     if (settings_.resort_every > 0 && steps_since_resort_ >= settings_.resort_every) resort();
     ++steps_since_resort_;
     bind_state();
+    update_params_.bind(TS_SIM_PARAMS);
     queue_.dispatch_items(update_, particle_count_);
     grid_.build(queue_, particle_position_, particle_count_, static_cast<float>(cell_size_));
     bind_state();
     grid_.bind();
-    contacts_.set("table_size", grid_.table_size());
+    bind_contact_params(grid_.table_size());
     queue_.dispatch_items(contacts_, particle_count_);
-    if (precision_ == Precision::Double) {
-      integrate_.set_double("time_after", time_ + settings_.dt);
-    } else {
-      integrate_.set("time_after", static_cast<float>(time_ + settings_.dt));
-    }
+    bind_integrate_params(time_ + settings_.dt);
     queue_.dispatch_items(integrate_, body_count_);
     time_ += settings_.dt;
   }
@@ -369,7 +400,9 @@ StepStats GpuStepper::statistics() {
   bind_state();
   metric_partials_.bind(TS_SIM_METRIC_PARTIALS);
   stat_partials_.bind(TS_SIM_STAT_PARTIALS);
+  metrics_params_.bind(TS_SIM_PARAMS);
   queue_.dispatch_items(metrics_, body_count_);
+  particle_stats_params_.bind(TS_SIM_PARAMS);
   queue_.dispatch_items(particle_stats_, particle_count_);
   const auto energies = metric_partials_.read<double>(4 * ((body_count_ + 255) / 256));
   double bad = 0.0;
@@ -538,8 +571,8 @@ void GpuStepper::gather(gpu::Buffer& buffer, const gpu::Buffer& index, std::uint
   buffer.bind(TS_SIM_GATHER_SOURCE);
   reordered.bind(TS_SIM_GATHER_DESTINATION);
   index.bind(TS_SIM_GATHER_INDEX);
-  gather_rows_.set("rows", rows);
-  gather_rows_.set("width", width);
+  gather_rows_params_.values.shape = {rows, width, 0u, 0u};
+  gather_rows_params_.bind(TS_SIM_PARAMS);
   queue_.dispatch_items(gather_rows_, rows);
   buffer = std::move(reordered);
 }
@@ -553,9 +586,8 @@ void GpuStepper::resort() {
   sort_key_.bind(TS_SORT_KEY);
   bucket_count_.bind(TS_SORT_BUCKET_COUNT);
   sort_slot_.bind(TS_SORT_SLOT);
-  resort_keys_.set("body_count", body_count_);
-  resort_keys_.set("cell_size", static_cast<float>(cell_size_));
-  resort_keys_.set("table_size", bucket_table_);
+  resort_keys_params_.values = {{body_count_, bucket_table_, 0u, 0u}, {static_cast<float>(cell_size_), 0.0f, 0.0f, 0.0f}};
+  resort_keys_params_.bind(TS_SIM_PARAMS);
   queue_.dispatch_items(resort_keys_, body_count_);
   bucket_sort_.finish(queue_, sort_key_, bucket_count_, sort_slot_, bucket_start_, order_, body_count_, bucket_table_);
 
@@ -563,7 +595,8 @@ void GpuStepper::resort() {
   order_.bind(TS_SIM_RESORT_ORDER);
   body_range_.bind(TS_SIM_BODY_RANGE);
   new_first_.bind(TS_SIM_RESORT_NEW_FIRST);
-  resort_ranges_.set("body_count", body_count_);
+  resort_bodies_params_.values.count.x = body_count_;
+  resort_bodies_params_.bind(TS_SIM_PARAMS);
   queue_.dispatch_items(resort_ranges_, body_count_);
   resort_scan_.run(queue_, new_first_, body_count_);
   order_.bind(TS_SIM_RESORT_ORDER);
@@ -573,7 +606,7 @@ void GpuStepper::resort() {
   source_particle_.bind(TS_SIM_RESORT_SOURCE);
   new_of_old_.bind(TS_SIM_RESORT_DESTINATION);
   owner_.bind(TS_SIM_RESORT_OWNER);
-  resort_particles_.set("body_count", body_count_);
+  resort_bodies_params_.bind(TS_SIM_PARAMS);  // again: the scan's own parameters took the slot
   queue_.dispatch_items(resort_particles_, body_count_);
   std::swap(body_range_, new_range_);
 
@@ -595,8 +628,8 @@ void GpuStepper::resort() {
   new_of_old_.bind(TS_SIM_RESORT_DESTINATION);
   owner_.bind(TS_SIM_RESORT_OWNER);
   springs_.bind(TS_SIM_SPRINGS);
-  resort_fixup_.set("particle_count", particle_count_);
-  resort_fixup_.set("spring_model", springs ? 1 : 0);
+  resort_fixup_params_.values = {{particle_count_, 0u, 0u, 0u}, {springs ? 1 : 0, 0, 0, 0}};
+  resort_fixup_params_.bind(TS_SIM_PARAMS);
   queue_.dispatch_items(resort_fixup_, particle_count_);
 }
 

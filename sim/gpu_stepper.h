@@ -14,6 +14,7 @@
 #include "gpu/gl.h"
 #include "gpu/hash_grid.h"
 #include "gpu/host_sync.h"
+#include "gpu/params.h"
 #include "sim/stepper.h"
 #include "sim/world.h"
 
@@ -78,7 +79,11 @@ class GpuStepper : public Stepper {
   void upload_springs(const World& world);
   void allocate_statistics();
   void upload_materials_and_walls(const World& world);
-  void set_uniforms();
+  // Fills the kernels' parameters that change only with the world (after rebuild).
+  void set_params();
+  // Bind the contact and integration parameters with what changes every step.
+  void bind_contact_params(std::uint32_t table_size);
+  void bind_integrate_params(double time_after);
   void download_springs(World& world) const;
   std::size_t counter_count() const;  // uints of counters_
   Penetration penetration(const std::vector<std::uint32_t>& counters) const;
@@ -105,6 +110,14 @@ class GpuStepper : public Stepper {
   gpu::ShaderLibrary library_;
   gpu::Queue queue_;
   gpu::Program update_, contacts_, integrate_, metrics_, particle_stats_;
+  // Each kernel's parameters (shaders/common/params.h), bound before each of its dispatches. The
+  // contact and integration kernels read the *64 forms in the double-precision pipeline.
+  gpu::ParamBlock<gpu::params::ItemCount> update_params_, particle_stats_params_;
+  gpu::ParamBlock<gpu::params::SimContactParams> contact_params_;
+  gpu::ParamBlock<gpu::params::SimContactParams64> contact_params64_;
+  gpu::ParamBlock<gpu::params::SimIntegrateParams> integrate_params_;
+  gpu::ParamBlock<gpu::params::SimIntegrateParams64> integrate_params64_;
+  gpu::ParamBlock<gpu::params::SimMetricsParams> metrics_params_;
   gpu::HashGrid grid_;
   gpu::Buffer particle_position_, particle_position_exact_, particle_velocity_, particle_info_, particle_local_;
   gpu::Buffer body_position_, body_orientation_, body_velocity_, body_omega_, body_inverse_inertia_, body_range_;
@@ -112,6 +125,10 @@ class GpuStepper : public Stepper {
   gpu::Buffer counters_, metric_partials_, stat_partials_;
   // Re-sorting (see StepSettings::resort_every).
   gpu::Program resort_keys_, resort_ranges_, resort_particles_, resort_fixup_, gather_rows_;
+  gpu::ParamBlock<gpu::params::GridParams> resort_keys_params_;
+  gpu::ParamBlock<gpu::params::ItemCount> resort_bodies_params_;  // resort_ranges_ and resort_particles_
+  gpu::ParamBlock<gpu::params::SimFixupParams> resort_fixup_params_;
+  gpu::ParamBlock<gpu::params::SimGatherParams> gather_rows_params_;
   gpu::BucketSort bucket_sort_;  // the body order by Morton key
   gpu::PrefixScan resort_scan_;  // the new particle ranges
   gpu::Buffer sort_key_, sort_slot_, bucket_count_, bucket_start_, order_, new_first_, new_range_;

@@ -14,6 +14,12 @@
 #ifndef TETRASAND_COMMON_BINDINGS_H
 #define TETRASAND_COMMON_BINDINGS_H
 
+// Uniform-block slots (a namespace of their own in GL) of the kernels' parameter structs
+// (shaders/common/params.h). A kernel's block is bound by gpu::ParamBlock::bind right before it runs,
+// so kernels of different passes share a number.
+#define TS_SCAN_PARAMS 0  // ItemCount: values in this level (common/scan_*.comp)
+#define TS_GRID_PARAMS 0  // GridParams (common/grid_*.comp)
+
 // Exclusive prefix sum (gpu::PrefixScan), one level at a time.
 #define TS_SCAN_VALUES 0      // uint[]: the level scanned in place
 #define TS_SCAN_BLOCK_SUMS 1  // uint[]: one sum per 512-value block (the next level)

@@ -10,13 +10,12 @@ layout(std430, binding = TS_GRID_POSITIONS) readonly buffer Positions { vec4 pos
 layout(std430, binding = TS_SORT_KEY) writeonly buffer CellOf { uint cell_of[]; };
 layout(std430, binding = TS_SORT_BUCKET_COUNT) buffer CellCount { uint cell_count[]; };
 layout(std430, binding = TS_SORT_SLOT) writeonly buffer Slot { uint slot[]; };
-uniform uint count;
-uniform float cell_size;
-uniform uint table_size;
+#include "common/params.h"
+layout(std140, binding = TS_GRID_PARAMS) uniform GridBlock { GridParams params; };
 void main() {
   uint i = dispatch_item();
-  if (i >= count) return;
-  uint h = hash_cell(cell_of_position(positions[i].xyz, cell_size), table_size);
+  if (i >= params.sizes.x) return;
+  uint h = hash_cell(cell_of_position(positions[i].xyz, params.cell.x), params.sizes.y);
   cell_of[i] = h;
   slot[i] = atomicAdd(cell_count[h], 1u);
 }

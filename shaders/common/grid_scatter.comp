@@ -8,8 +8,9 @@ layout(std430, binding = TS_SORT_KEY) readonly buffer CellOf { uint cell_of[]; }
 layout(std430, binding = TS_SORT_SLOT) readonly buffer Slot { uint slot[]; };
 layout(std430, binding = TS_SORT_BUCKET_START) readonly buffer CellStart { uint cell_start[]; };
 layout(std430, binding = TS_SORT_SORTED) writeonly buffer Sorted { uint sorted_ids[]; };
-uniform uint count;
+#include "common/params.h"
+layout(std140, binding = TS_GRID_PARAMS) uniform GridBlock { GridParams params; };
 void main() {
   uint i = dispatch_item();
-  if (i < count) sorted_ids[cell_start[cell_of[i]] + slot[i]] = i;
+  if (i < params.sizes.x) sorted_ids[cell_start[cell_of[i]] + slot[i]] = i;
 }

@@ -8,10 +8,11 @@ layout(local_size_x = 256) in;
 layout(std430, binding = TS_SORT_BUCKET_COUNT) readonly buffer CellCount { uint cell_count[]; };
 layout(std430, binding = TS_SORT_BUCKET_START) readonly buffer CellStart { uint cell_start[]; };
 layout(std430, binding = TS_SORT_SORTED) buffer Sorted { uint sorted_ids[]; };
-uniform uint table_size;
+#include "common/params.h"
+layout(std140, binding = TS_GRID_PARAMS) uniform GridBlock { GridParams params; };
 void main() {
   uint c = dispatch_item();
-  if (c >= table_size) return;
+  if (c >= params.sizes.y) return;
   uint begin = cell_start[c], n = cell_count[c];
   for (uint a = 1u; a < n; ++a) {
     uint key = sorted_ids[begin + a];

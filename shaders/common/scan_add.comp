@@ -6,8 +6,9 @@
 layout(local_size_x = 256) in;
 layout(std430, binding = TS_SCAN_VALUES) buffer Values { uint values[]; };
 layout(std430, binding = TS_SCAN_BLOCK_SUMS) readonly buffer BlockOffsets { uint block_offsets[]; };
-uniform uint count;
+#include "common/params.h"
+layout(std140, binding = TS_SCAN_PARAMS) uniform ScanBlock { ItemCount params; };
 void main() {
   uint i = dispatch_item();
-  if (i < count) values[i] += block_offsets[i / 512u];
+  if (i < params.count.x) values[i] += block_offsets[i / 512u];
 }

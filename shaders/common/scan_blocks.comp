@@ -7,14 +7,15 @@
 layout(local_size_x = 256) in;
 layout(std430, binding = TS_SCAN_VALUES) buffer Values { uint values[]; };
 layout(std430, binding = TS_SCAN_BLOCK_SUMS) writeonly buffer BlockSums { uint block_sums[]; };
-uniform uint count;
+#include "common/params.h"
+layout(std140, binding = TS_SCAN_PARAMS) uniform ScanBlock { ItemCount params; };
 shared uint temp[512];
 void main() {
   uint t = gl_LocalInvocationID.x;
   uint base = dispatch_group() * 512u;
-  if (base >= count) return;  // a group past the end (2D layout): no block, no block sum
-  temp[2u * t] = base + 2u * t < count ? values[base + 2u * t] : 0u;
-  temp[2u * t + 1u] = base + 2u * t + 1u < count ? values[base + 2u * t + 1u] : 0u;
+  if (base >= params.count.x) return;  // a group past the end (2D layout): no block, no block sum
+  temp[2u * t] = base + 2u * t < params.count.x ? values[base + 2u * t] : 0u;
+  temp[2u * t + 1u] = base + 2u * t + 1u < params.count.x ? values[base + 2u * t + 1u] : 0u;
   uint offset = 1u;
   for (uint d = 256u; d > 0u; d >>= 1u) {
     barrier();
@@ -39,6 +40,6 @@ void main() {
     }
   }
   barrier();
-  if (base + 2u * t < count) values[base + 2u * t] = temp[2u * t];
-  if (base + 2u * t + 1u < count) values[base + 2u * t + 1u] = temp[2u * t + 1u];
+  if (base + 2u * t < params.count.x) values[base + 2u * t] = temp[2u * t];
+  if (base + 2u * t + 1u < params.count.x) values[base + 2u * t + 1u] = temp[2u * t + 1u];
 }

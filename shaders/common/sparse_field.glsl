@@ -7,6 +7,11 @@
 #ifndef TETRASAND_COMMON_SPARSE_FIELD_GLSL
 #define TETRASAND_COMMON_SPARSE_FIELD_GLSL
 
+#include "common/params.h"
+// Where the grid sits (sdf::SparseField::bind), at the uniform-block slot the kernel's stage names
+// TS_FIELD_PARAMS (defined, like the chunk slots below, before this file is included).
+layout(std140, binding = TS_FIELD_PARAMS) uniform FieldBlock { FieldParams field_params; };
+
 // A grid larger than one storage block (llvmpipe's is 128 MiB) is uploaded in chunks of 2^TS_FIELD_CHUNK_SHIFT
 // words, TS_FIELD_CHUNKS of them (sdf::SparseField::shader_defines; at most 8): chunk 0 is the block the
 // kernel declares, chunk c > 0 is bound at TS_FIELD_CHUNK_<c>, a slot the kernel's stage header names.
@@ -70,7 +75,6 @@ uint pnanovdb_buf_read_uint32(pnanovdb_buf_t buf, uint byte_offset) {
 #endif
   return 0u;  // past the grid: PNanoVDB never asks
 }
-uniform int field_corner_count;  // 8 (sdf::SparseField::bind): a trilinear value's corners, read in one loop
 uvec2 pnanovdb_buf_read_uint64(pnanovdb_buf_t buf, uint byte_offset) {
   return uvec2(pnanovdb_buf_read_uint32(buf, byte_offset), pnanovdb_buf_read_uint32(buf, byte_offset + 4u));
 }
@@ -81,9 +85,6 @@ uvec2 pnanovdb_buf_read_uint64(pnanovdb_buf_t buf, uint byte_offset) {
 #define PNANOVDB_GLSL
 #include "nanovdb/PNanoVDB.h"
 
-uniform ivec3 field_index_offset;  // NanoVDB index of the grid spec's voxel (0,0,0)
-uniform float field_voxel_size;    // [world units]
-uniform float field_background;    // |value| off the band [world units]
 
 // One accessor per invocation: it caches the last leaf, so neighbouring reads skip the tree walk.
 struct FieldReader {
@@ -141,7 +142,7 @@ FieldReader field_reader() {
 // One PNanoVDB call per read: each call is inlined, and llvmpipe's compile time follows the count.
 float field_voxel(inout FieldReader reader, ivec3 g) {
   pnanovdb_buf_t buf;
-  pnanovdb_coord_t ijk = g + field_index_offset;
+  pnanovdb_coord_t ijk = g + field_params.index_offset.xyz;
   pnanovdb_readaccessor_t walker = reader.accessor;
   pnanovdb_address_t address = pnanovdb_readaccessor_get_value_address(PNANOVDB_GRID_TYPE_FLOAT, buf, walker, ijk);
   if (field_in_first_root_tile(ijk)) reader.accessor = walker;
@@ -159,7 +160,7 @@ float field_trilinear(inout FieldReader reader, vec3 x) {
   // so the read, with its chunk branch, is inlined once instead of 8 times: llvmpipe compiled the
   // unrolled form of the gradient's 56 reads for minutes. Same reads, same order, same weights.
   float corner[8];
-  for (int n = 0; n < field_corner_count; ++n) corner[n] = field_voxel(reader, g + ivec3(n & 1, (n >> 1) & 1, n >> 2));
+  for (int n = 0; n < field_params.index_offset.w; ++n) corner[n] = field_voxel(reader, g + ivec3(n & 1, (n >> 1) & 1, n >> 2));
   float c000 = corner[0], c100 = corner[1], c010 = corner[2], c110 = corner[3];
   float c001 = corner[4], c101 = corner[5], c011 = corner[6], c111 = corner[7];
 #else
@@ -185,7 +186,7 @@ vec4 field_sample(inout FieldReader reader, vec3 x) {
                        field_trilinear(reader, x + vec3(0.0, 0.5, 0.0)) - field_trilinear(reader, x - vec3(0.0, 0.5, 0.0)),
                        field_trilinear(reader, x + vec3(0.0, 0.0, 0.5)) - field_trilinear(reader, x - vec3(0.0, 0.0, 0.5)));
   float len = length(gradient);
-  return vec4(len > 1e-6 * field_voxel_size ? gradient / len : vec3(0.0), value);
+  return vec4(len > 1e-6 * field_params.scale.x ? gradient / len : vec3(0.0), value);
 }
 
 #endif

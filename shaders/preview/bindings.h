@@ -16,6 +16,14 @@
 #ifndef TETRASAND_PREVIEW_BINDINGS_H
 #define TETRASAND_PREVIEW_BINDINGS_H
 
+// Uniform-block slots (a namespace of their own in GL) of the kernels' parameter structs
+// (shaders/common/params.h). A kernel's block is bound by gpu::ParamBlock::bind right before it runs,
+// so kernels of different passes share a number.
+#define TS_PREVIEW_CAMERA 0        // CameraParams (preview/camera.glsl)
+#define TS_PREVIEW_PARAMS 1        // the pass's own: ParticleParams, RaycastParams, ShadeParams
+#define TS_PREVIEW_VOLUME 2        // VolumeParams (preview/volume.glsl)
+#define TS_PREVIEW_FIELD_PARAMS 3  // FieldParams of the sparse field
+
 #define TS_PREVIEW_SPHERES 27  // vec4[]: xyz centre relative to the scene centre [m], w radius [m]
 #define TS_PREVIEW_COLORS 28   // uint[]: sRGB colour per sphere, RGBA8 with red in the low byte
 #define TS_PREVIEW_SPARSE_FIELD 29  // uint[]: the NanoVDB level set (sdf::SparseField), as PNanoVDB.h reads it

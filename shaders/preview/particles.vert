@@ -11,8 +11,8 @@
 layout(std430, binding = TS_PREVIEW_SPHERES) readonly buffer Spheres { vec4 spheres[]; };
 layout(std430, binding = TS_PREVIEW_COLORS) readonly buffer Colors { uint colors[]; };
 
-uniform int per_particle_color;  // 1: colors[], else particle_color
-uniform vec3 particle_color;     // sRGB
+#include "common/params.h"
+layout(std140, binding = TS_PREVIEW_PARAMS) uniform ParticleBlock { ParticleParams params; };
 
 out vec3 v_world;              // the sprite point, relative world [m]
 flat out vec4 v_sphere;        // centre (relative world) and radius [m]
@@ -26,10 +26,10 @@ void main() {
   vec4 sphere = spheres[index];
   vec3 c = sphere.xyz;
   float r = sphere.w;
-  vec3 u = view_right, v = view_up;
+  vec3 u = camera.right.xyz, v = camera.up.xyz;
   float half_size = r;
-  if (orthographic == 0) {
-    vec3 to_center = c - eye;
+  if (camera.lens.x == 0) {
+    vec3 to_center = c - camera.eye.xyz;
     float dist = length(to_center);
     if (dist <= 1.0001 * r) {  // the eye is inside the sphere: drop it
       gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
@@ -38,12 +38,12 @@ void main() {
     // The silhouette cone (half-angle asin(r / dist)) crosses the plane through the centre,
     // perpendicular to the ray, in a circle of radius r dist / sqrt(dist^2 - r^2).
     vec3 w = to_center / dist;
-    u = normalize(abs(dot(w, view_up)) < 0.99 ? cross(w, view_up) : cross(w, view_right));
+    u = normalize(abs(dot(w, camera.up.xyz)) < 0.99 ? cross(w, camera.up.xyz) : cross(w, camera.right.xyz));
     v = cross(u, w);
     half_size = r * dist / sqrt(dist * dist - r * r);
   }
   v_world = c + (corner.x * u + corner.y * v) * (1.02 * half_size);
   v_sphere = sphere;
-  v_color = per_particle_color == 1 ? unpackUnorm4x8(colors[index]).rgb : particle_color;
-  gl_Position = view_projection * vec4(v_world, 1.0);
+  v_color = params.flags.x == 1 ? unpackUnorm4x8(colors[index]).rgb : params.color.xyz;
+  gl_Position = camera.view_projection * vec4(v_world, 1.0);
 }

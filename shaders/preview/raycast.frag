@@ -11,11 +11,8 @@
 #include "preview/volume.glsl"
 
 layout(binding = TS_PREVIEW_UNIT_PARTICLE_DEPTH) uniform sampler2D particle_depth;  // window depth of the particle layer (1: none)
-uniform int use_particle_depth;
-uniform int depth_only;            // shadow pass: depth, no normal
-uniform int max_steps;
-uniform float min_step;            // [voxels]: grazing rays still advance
-uniform vec3 surface_color;        // sRGB
+#include "common/params.h"
+layout(std140, binding = TS_PREVIEW_PARAMS) uniform RaycastBlock { RaycastParams params; };
 
 in vec3 v_world;
 
@@ -24,8 +21,8 @@ in vec3 v_world;
 bool trace_window(vec3 o, vec3 dir, float t, float t_end, out float t_hit) {
   float f = sdf_at(o + t * dir);
   t_hit = t;
-  for (int i = 0; i < max_steps; ++i) {
-    float t_next = min(t + max(f, min_step), t_end);
+  for (int i = 0; i < params.flags.z; ++i) {
+    float t_next = min(t + max(f, params.steps.x), t_end);
     float f_next = sdf_at(o + t_next * dir);
     if (f_next <= 0.0) {
       float a = t, fa = f, b = t_next, fb = f_next;
@@ -62,14 +59,14 @@ bool find_surface(vec3 o, vec3 dir, float t, float t_exit, out float t_hit) {
   ensure_volume_reader();
   pnanovdb_buf_t buf;
   t_hit = t;
-  pnanovdb_vec3_t origin = o + vec3(field_index_offset) + vec3(0.5);
+  pnanovdb_vec3_t origin = o + vec3(field_params.index_offset.xyz) + vec3(0.5);
   pnanovdb_vec3_t direction = dir;
   float t_min = t, t_max = t_exit;
   pnanovdb_vec3_t box_min = pnanovdb_coord_to_vec3(pnanovdb_root_get_bbox_min(buf, volume_reader.accessor.root));
   pnanovdb_vec3_t box_max = pnanovdb_coord_to_vec3(pnanovdb_coord_add(
       pnanovdb_root_get_bbox_max(buf, volume_reader.accessor.root), pnanovdb_coord_uniform(1)));
   if (!pnanovdb_hdda_ray_clip(box_min, box_max, origin, t_min, direction, t_max)) return false;
-  float near_surface = kNearSurface * voxel_size;  // field values are in world units
+  float near_surface = kNearSurface * volume.origin_voxel.w;  // field values are in world units
   float traced_to = t_min;  // the field has no crossing before here
   pnanovdb_vec3_t pos = pnanovdb_hdda_ray_start(origin, t_min, direction);
   pnanovdb_coord_t ijk = pnanovdb_hdda_pos_to_ijk(pos);
@@ -112,16 +109,16 @@ void main() {
   if (seg_length <= 0.0) discard;
   vec3 dir = segment / seg_length;
   vec3 o = to_voxel(start);
-  float t_exit = seg_length / voxel_size;
-  if (use_particle_depth == 1) {
+  float t_exit = seg_length / volume.origin_voxel.w;
+  if (params.flags.x == 1) {
     float particle = texelFetch(particle_depth, ivec2(gl_FragCoord.xy), 0).r;
     if (particle < 1.0) {
-      t_exit = min(t_exit, dot(world_from_window(gl_FragCoord.xy, particle) - start, dir) / voxel_size);
+      t_exit = min(t_exit, dot(world_from_window(gl_FragCoord.xy, particle) - start, dir) / volume.origin_voxel.w);
     }
   }
   // Entry: the slab test against the voxel-centre box [0, dims - 1].
   vec3 safe = mix(dir, vec3(1e-20), lessThan(abs(dir), vec3(1e-20)));
-  vec3 t0 = -o / safe, t1 = (volume_dims - 1.0 - o) / safe;
+  vec3 t0 = -o / safe, t1 = (volume.dims_band.xyz - 1.0 - o) / safe;
   vec3 near3 = min(t0, t1);
   float t = max(max(near3.x, near3.y), max(near3.z, 0.0));
   if (t >= t_exit) discard;
@@ -131,10 +128,10 @@ void main() {
   bool hit = entered_inside || find_surface(o, dir, t, t_exit, t_hit);
   if (!hit) discard;
 
-  vec3 p = start + dir * (t_hit * voxel_size);
+  vec3 p = start + dir * (t_hit * volume.origin_voxel.w);
   gl_FragDepth = window_depth(p);
-  if (depth_only == 1) return;
+  if (params.flags.y == 1) return;
   vec3 n = entered_inside ? -dir : sdf_normal(o + t_hit * dir);
-  albedo = vec4(surface_color, 1.0);
+  albedo = vec4(params.surface_color.xyz, 1.0);
   normal_layer = vec4(n, float(TS_PREVIEW_LAYER_SURFACE));
 }

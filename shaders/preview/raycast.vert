@@ -16,6 +16,6 @@ const int kCube[36] = int[](0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4
 void main() {
   int c = kCube[gl_VertexID];
   vec3 corner = vec3(float(c & 1), float((c >> 1) & 1), float((c >> 2) & 1));
-  v_world = volume_origin + voxel_size * corner * (volume_dims - 1.0);
-  gl_Position = view_projection * vec4(v_world, 1.0);
+  v_world = volume.origin_voxel.xyz + volume.origin_voxel.w * corner * (volume.dims_band.xyz - 1.0);
+  gl_Position = camera.view_projection * vec4(v_world, 1.0);
 }

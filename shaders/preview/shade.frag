@@ -12,23 +12,9 @@ layout(binding = TS_PREVIEW_UNIT_ALBEDO) uniform sampler2D albedo_texture;
 layout(binding = TS_PREVIEW_UNIT_NORMAL) uniform sampler2D normal_texture;
 layout(binding = TS_PREVIEW_UNIT_DEPTH) uniform sampler2D depth_texture;
 layout(binding = TS_PREVIEW_UNIT_SHADOW) uniform sampler2DShadow shadow_map;
-uniform mat4 light_view_projection;  // relative world -> the light's clip space
-uniform int shadows;
-uniform float shadow_texel;          // [m] per shadow-map texel
-uniform float shadow_bias;           // window-depth units
-uniform vec2 shadow_texel_uv;        // 1 / shadow-map size
+#include "common/params.h"
+layout(std140, binding = TS_PREVIEW_PARAMS) uniform ShadeBlock { ShadeParams params; };
 
-uniform vec3 light_dir;              // unit, towards the key light
-uniform vec3 world_up;               // unit
-uniform int has_volume;
-uniform int ground;                  // 1: draw the ground plane
-uniform float ground_level;          // the plane dot(world_up, p) = ground_level [m, relative]
-uniform vec3 ground_center;          // relative world [m]
-uniform float ground_radius;         // [m]: the ground fades out towards this distance
-uniform vec3 ground_color;           // sRGB
-uniform vec3 background_top;         // sRGB
-uniform vec3 background_bottom;      // sRGB
-uniform int transparent;             // 1: alpha 0 background, the ground only as its shadow
 
 out vec4 color;
 
@@ -37,25 +23,25 @@ vec3 to_srgb(vec3 c) { return pow(clamp(c, 0.0, 1.0), vec3(1.0 / 2.2)); }
 
 // 1 lit .. 0 in shadow. The point is pushed along its normal by two texels against acne.
 float light_visibility(vec3 p, vec3 n) {
-  if (shadows == 0) return 1.0;
-  vec4 c = light_view_projection * vec4(p + n * (2.0 * shadow_texel), 1.0);
+  if (params.flags.x == 0) return 1.0;
+  vec4 c = params.light_view_projection * vec4(p + n * (2.0 * params.shadow.x), 1.0);
   vec3 s = 0.5 * c.xyz / c.w + 0.5;
   if (any(lessThan(s.xy, vec2(0.0))) || any(greaterThan(s.xy, vec2(1.0)))) return 1.0;
-  float ref = min(s.z, 1.0) - shadow_bias;
+  float ref = min(s.z, 1.0) - params.shadow.y;
   float lit = 0.0;
   for (int y = -1; y <= 1; ++y)
-    for (int x = -1; x <= 1; ++x) lit += texture(shadow_map, vec3(s.xy + vec2(x, y) * shadow_texel_uv, ref));
+    for (int x = -1; x <= 1; ++x) lit += texture(shadow_map, vec3(s.xy + vec2(x, y) * params.shadow.zw, ref));
   return lit / 9.0;
 }
 
 // Ambient occlusion of the ray-cast surface: how much the SDF, sampled outward along the normal,
 // falls short of the distance travelled (the surface's own neighbourhood closing in).
 float surface_occlusion(vec3 p, vec3 n) {
-  if (has_volume == 0) return 1.0;
+  if (params.flags.y == 0) return 1.0;
   vec3 u = to_voxel(p);
   float occlusion = 0.0, weight = 0.5;
   for (int k = 1; k <= 4; ++k) {
-    float delta = 0.25 * float(k) * band;
+    float delta = 0.25 * float(k) * volume.dims_band.w;
     occlusion += weight * clamp((delta - sdf_at(u + n * delta)) / delta, 0.0, 1.0);
     weight *= 0.5;
   }
@@ -64,10 +50,10 @@ float surface_occlusion(vec3 p, vec3 n) {
 
 vec3 lit(vec3 base, vec3 p, vec3 n, vec3 view, float specular, float occlusion) {
   float visibility = light_visibility(p, n);
-  float diffuse = max(dot(n, light_dir), 0.0);
-  vec3 h = normalize(light_dir + view);
+  float diffuse = max(dot(n, params.light_dir.xyz), 0.0);
+  vec3 h = normalize(params.light_dir.xyz + view);
   float spec = diffuse > 0.0 ? specular * pow(max(dot(n, h), 0.0), 48.0) : 0.0;
-  float ambient = mix(0.07, 0.26, 0.5 + 0.5 * dot(n, world_up));
+  float ambient = mix(0.07, 0.26, 0.5 + 0.5 * dot(n, params.world_up.xyz));
   float fill = 0.10 * max(dot(n, view), 0.0);  // a weak light from the camera keeps shadows readable
   return base * ((ambient + fill) * occlusion + 0.8 * diffuse * visibility) + vec3(spec * visibility);
 }
@@ -90,22 +76,22 @@ void main() {
     return;
   }
 
-  float height = gl_FragCoord.y / viewport.y;
-  vec3 sky = mix(background_bottom, background_top, height);
-  color = transparent == 1 ? vec4(0.0) : vec4(sky, 1.0);
-  float along = dot(world_up, ray);
-  if (ground == 0 || along >= 0.0) return;
-  float t = (ground_level - dot(world_up, near_point)) / along;
+  float height = gl_FragCoord.y / camera.viewport.y;
+  vec3 sky = mix(params.background_bottom.xyz, params.background_top.xyz, height);
+  color = params.flags.w == 1 ? vec4(0.0) : vec4(sky, 1.0);
+  float along = dot(params.world_up.xyz, ray);
+  if (params.flags.z == 0 || along >= 0.0) return;
+  float t = (params.ground.w - dot(params.world_up.xyz, near_point)) / along;
   if (t <= 0.0) return;
   vec3 g = near_point + t * ray;
-  float fade = 1.0 - smoothstep(0.3 * ground_radius, ground_radius, length(g - ground_center));
+  float fade = 1.0 - smoothstep(0.3 * params.ground_color.w, params.ground_color.w, length(g - params.ground.xyz));
   if (fade <= 0.0) return;
-  float visibility = light_visibility(g, world_up);
-  if (transparent == 1) {
+  float visibility = light_visibility(g, params.world_up.xyz);
+  if (params.flags.w == 1) {
     color = vec4(0.0, 0.0, 0.0, 0.55 * fade * (1.0 - visibility));
   } else {
-    vec3 base = to_linear(ground_color);
-    float diffuse = max(dot(world_up, light_dir), 0.0);
+    vec3 base = to_linear(params.ground_color.xyz);
+    float diffuse = max(dot(params.world_up.xyz, params.light_dir.xyz), 0.0);
     vec3 c = base * (0.32 + 0.75 * diffuse * visibility);
     color = vec4(mix(sky, to_srgb(c), fade), 1.0);
   }

@@ -7,6 +7,8 @@
 #include "preview/bindings.h"
 
 layout(std430, binding = TS_PREVIEW_SPARSE_FIELD) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
+// The field's parameter block at this stage's slot.
+#define TS_FIELD_PARAMS TS_PREVIEW_FIELD_PARAMS
 // Chunks 1-7 of a field larger than one storage block, at this stage's slots.
 #define TS_FIELD_CHUNK_1 TS_PREVIEW_FIELD_CHUNK_1
 #define TS_FIELD_CHUNK_2 TS_PREVIEW_FIELD_CHUNK_2
@@ -17,10 +19,8 @@ layout(std430, binding = TS_PREVIEW_SPARSE_FIELD) readonly buffer SparseField { 
 #define TS_FIELD_CHUNK_7 TS_PREVIEW_FIELD_CHUNK_7
 #include "common/sparse_field.glsl"
 
-uniform vec3 volume_origin;  // voxel (0,0,0)'s centre, relative to the scene centre [m]
-uniform float voxel_size;    // [m]
-uniform vec3 volume_dims;    // voxels along x, y, z
-uniform float band;          // |distance| saturates here [voxels]
+#include "common/params.h"
+layout(std140, binding = TS_PREVIEW_VOLUME) uniform VolumeBlock { VolumeParams volume; };
 
 // One accessor per invocation, made on first use: it caches the last node, so the neighbouring
 // reads of a march skip most of the tree walk.
@@ -33,12 +33,12 @@ void ensure_volume_reader() {
   volume_reader_ready = true;
 }
 
-vec3 to_voxel(vec3 p) { return (p - volume_origin) / voxel_size; }
+vec3 to_voxel(vec3 p) { return (p - volume.origin_voxel.xyz) / volume.origin_voxel.w; }
 
 // Signed distance [voxels] at voxel coordinates u.
 float sdf_at(vec3 u) {
   ensure_volume_reader();
-  return clamp(field_trilinear(volume_reader, u) / voxel_size, -band, band);
+  return clamp(field_trilinear(volume_reader, u) / volume.origin_voxel.w, -volume.dims_band.w, volume.dims_band.w);
 }
 
 // Unit outward normal: central differences one voxel apart, so the normal varies smoothly across

@@ -18,6 +18,12 @@
 #ifndef TETRASAND_SAMPLER_BINDINGS_H
 #define TETRASAND_SAMPLER_BINDINGS_H
 
+// Uniform-block slots (a namespace of their own in GL) of the kernels' parameter structs
+// (shaders/common/params.h). A kernel's block is bound by gpu::ParamBlock::bind right before it runs,
+// so kernels of different passes share a number.
+#define TS_SAMPLER_PARAMS 0        // the kernel's own: RelaxParams, CertifyParams, or ItemCount
+#define TS_SAMPLER_FIELD_PARAMS 1  // FieldParams of the sparse field (sampler/sdf_sample.glsl)
+
 // TS_GRID_POSITIONS comes from shaders/common/bindings.h: a user includes both headers.
 
 #define TS_SAMPLER_POSITIONS_IN TS_GRID_POSITIONS  // vec4: xyz position [m]; w: 1 mobile, 0 frozen

@@ -30,17 +30,8 @@ layout(std430, binding = TS_CERT_BOUNDS) writeonly buffer Bounds { vec4 bounds[]
 // floats order like their bits, so atomicMax on uints is exact and order-independent); [2], [3] unused.
 layout(std430, binding = TS_CERT_TOTALS) buffer Totals { uint totals[]; };
 
-uniform uint count;             // sub-triangles in the queue
-uniform float cell_size;        // of the hashed grid [m]
-uniform uint table_size;
-uniform int max_shells;         // the search stops after this many shells around the centroid's cell
-uniform float search_slack;     // [m]: float error of cell indices; shell R is complete to R cell - slack
-uniform float test_radius;      // [m]: the ball radius, less the float margin
-uniform float floor_length;     // [m]: a sub-triangle whose longest edge is at most this is not split
-uniform float hole_resolution;  // [m]: the same for partly uncovered ones once a hole is proven
-uniform float refine_tol;       // [m]: sub-triangles with U > witness_so_far + refine_tol are split
-uniform float witness_so_far;   // [m]: largest witness of the earlier levels
-uniform uint no_split;          // 1: every sub-triangle is final (the queue budget was reached)
+#include "common/params.h"
+layout(std140, binding = TS_SAMPLER_PARAMS) uniform CertifyBlock { CertifyParams params; };
 
 const int kMaxLevel = 24;  // i, j and the step 2^-level stay exact in float
 
@@ -67,7 +58,7 @@ struct Search {
 
 // Every centre in one hashed cell (a bucket shared with other cells only adds candidates).
 void visit_cell(ivec3 cell, vec3 v0, vec3 v1, vec3 v2, vec3 g, inout Search s) {
-  uint h = hash_cell(cell, table_size);
+  uint h = hash_cell(cell, params.sizes.y);
   uint begin = cell_start[h], end = begin + cell_count[h];
   for (uint k = begin; k < end; ++k) {
     vec3 p = centres[sorted_ids[k]].xyz;
@@ -88,11 +79,11 @@ void visit_shell(ivec3 c, int R, vec3 v0, vec3 v1, vec3 v2, vec3 g, inout Search
 
 void main() {
   uint e = dispatch_item();
-  if (e == count) {  // the extra zero that makes the scanned value at `count` the total
+  if (e == params.sizes.x) {  // the extra zero that makes the scanned value at `count` the total
     splits[e] = 0u;
     uncovered[e] = 0u;
   }
-  if (e >= count) return;
+  if (e >= params.sizes.x) return;
   uvec4 id = queue[e];
   CertTriangle t = triangles[id.x];
   int level = int(id.y & 0xffu);
@@ -105,11 +96,11 @@ void main() {
   // from some corner, so it cannot lower U once U is within that radius.
   const float infinity = uintBitsToFloat(0x7f800000u);
   Search s = Search(infinity, infinity);  // U is infinite until a centre is seen
-  ivec3 c = cell_of_position(g, cell_size);
+  ivec3 c = cell_of_position(g, params.lengths.x);
   float searched = 0.0;  // radius around g within which every centre was seen [m]
-  for (int R = 0; R <= max_shells; ++R) {
+  for (int R = 0; R <= params.search.x; ++R) {
     visit_shell(c, R, v0, v1, v2, g, s);
-    searched = max(float(R) * cell_size - search_slack, 0.0);
+    searched = max(float(R) * params.lengths.x - params.lengths.y, 0.0);
     if (s.best2 <= searched * searched) break;
   }
   float bound = sqrt(s.best2);
@@ -118,10 +109,10 @@ void main() {
   float rho = sqrt(max(max(squared(v0 - g), squared(v1 - g)), squared(v2 - g)));
   float edge = ldexp(t.edge1.w, -level);
 
-  bool covered = bound <= test_radius;
+  bool covered = bound <= params.lengths.z;
   // Every point of T is farther than the radius from every centre: splitting cannot find cover.
-  bool wholly_uncovered = witness - rho > test_radius;
-  bool at_floor = edge <= floor_length || level >= kMaxLevel || no_split != 0u;
+  bool wholly_uncovered = witness - rho > params.lengths.z;
+  bool at_floor = edge <= params.lengths.w || level >= kMaxLevel || params.sizes.z != 0u;
   // The search ended at max_shells before it could rule out a nearer centre (U may be infinite).
   // Either T is large (its corners lie beyond the search, though a centre is near its centroid) or
   // it sits in a hole deeper than the search. A large T is split like an undecided one: its children
@@ -130,13 +121,13 @@ void main() {
   // exact nearest centre.
   bool complete = bound <= searched;
   bool near_centre = s.nearest2 <= searched * searched;  // g's nearest centre was seen
-  float resolution = witness_so_far > test_radius ? hole_resolution : floor_length;
+  float resolution = params.refine.z > params.lengths.z ? params.refine.x : params.lengths.w;
   bool split;
   if (!complete) {
     split = !at_floor && !wholly_uncovered && (rho > searched || (near_centre && edge > resolution));
   } else {
     bool undecided = !covered && !wholly_uncovered && edge > resolution;
-    split = !at_floor && (bound > witness_so_far + refine_tol || undecided);
+    split = !at_floor && (bound > params.refine.z + params.refine.y || undecided);
   }
   splits[e] = split ? 4u : 0u;
   uncovered[e] = !split && !covered ? 1u : 0u;

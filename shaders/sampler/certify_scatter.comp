@@ -18,7 +18,8 @@ layout(std430, binding = TS_CERT_BOUNDS) readonly buffer Bounds { vec4 bounds[];
 layout(std430, binding = TS_CERT_NEXT_QUEUE) writeonly buffer NextQueue { uvec4 next_queue[]; };
 layout(std430, binding = TS_CERT_HOLES) writeonly buffer Holes { CertLeaf holes[]; };
 
-uniform uint count;
+#include "common/params.h"
+layout(std140, binding = TS_SAMPLER_PARAMS) uniform ScatterBlock { ItemCount params; };
 
 uvec4 child(uint triangle, uint level, bool down, uint i, uint j) {
   return uvec4(triangle, level | (down ? 1u << 8 : 0u), i, j);
@@ -26,7 +27,7 @@ uvec4 child(uint triangle, uint level, bool down, uint i, uint j) {
 
 void main() {
   uint e = dispatch_item();
-  if (e >= count) return;
+  if (e >= params.count.x) return;
   uvec4 id = queue[e];
   uint first = split_offset[e];
   if (split_offset[e + 1u] > first) {

@@ -8,10 +8,11 @@
 #include "sampler/sdf_sample.glsl"
 layout(local_size_x = 128) in;
 layout(std430, binding = TS_SAMPLER_POSITIONS) buffer Positions { vec4 positions[]; };
-uniform uint count;
+#include "common/params.h"
+layout(std140, binding = TS_SAMPLER_PARAMS) uniform ProjectBlock { ItemCount params; };
 void main() {
   uint i = dispatch_item();
-  if (i >= count) return;
+  if (i >= params.count.x) return;
   vec4 pw = positions[i];
   if (pw.w == 0.0) return;  // frozen: already on the exact surface
   vec4 s = sample_sdf(pw.xyz);

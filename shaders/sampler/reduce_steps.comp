@@ -8,12 +8,13 @@
 layout(local_size_x = 256) in;
 layout(std430, binding = TS_SAMPLER_STEP_INFO) readonly buffer StepInfo { vec4 step_info[]; };
 layout(std430, binding = TS_SAMPLER_PARTIALS) writeonly buffer Partials { vec4 partials[]; };
-uniform uint count;
+#include "common/params.h"
+layout(std140, binding = TS_SAMPLER_PARAMS) uniform ReduceBlock { ItemCount params; };
 shared vec4 scratch[256];
 void main() {
   uint i = dispatch_item(), t = gl_LocalInvocationID.x;
-  if (dispatch_group() * gl_WorkGroupSize.x >= count) return;  // past the end: no partial
-  scratch[t] = i < count ? step_info[i] : vec4(0.0);
+  if (dispatch_group() * gl_WorkGroupSize.x >= params.count.x) return;  // past the end: no partial
+  scratch[t] = i < params.count.x ? step_info[i] : vec4(0.0);
   for (uint stride = 128u; stride > 0u; stride >>= 1u) {
     barrier();
     if (t < stride) {

@@ -31,25 +31,19 @@ layout(std430, binding = TS_GRID_SORTED) readonly buffer Sorted { uint sorted_id
 // the arrangement, and the exact projection fixes the normal position afterwards), y: |phi| [m], z: 1 if outside the band, w: 1 if mobile
 layout(std430, binding = TS_SAMPLER_STEP_INFO) writeonly buffer StepInfo { vec4 step_info[]; };
 
-uniform uint count;
-uniform float cell_size;       // = repulsion cutoff [m]
-uniform uint table_size;
-uniform float inv_two_sigma2;  // 1 / (2 sigma^2) [1/m^2]
-uniform float repulsion_gain;  // dimensionless step on the kernel sum
-uniform float momentum;        // beta in [0, 1)
-uniform float max_move;        // CFL guard: at most this far per step [m]
-uniform float band_limit;      // |phi| beyond which a particle has left the band [m]
+#include "common/params.h"
+layout(std140, binding = TS_SAMPLER_PARAMS) uniform RelaxBlock { RelaxParams params; };
 
 vec3 repulsion_at(uint i, vec3 p) {
-  ivec3 c = cell_of_position(p, cell_size);
-  float cutoff2 = cell_size * cell_size;
+  ivec3 c = cell_of_position(p, params.kernel.x);
+  float cutoff2 = params.kernel.x * params.kernel.x;
   vec3 repulsion = vec3(0.0);
   uint visited[27];
   int visited_count = 0;
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
-        uint h = hash_cell(c + ivec3(dx, dy, dz), table_size);
+        uint h = hash_cell(c + ivec3(dx, dy, dz), params.sizes.y);
         // Two neighbour cells may share a hash bucket: visit each bucket once.
         bool seen = false;
         for (int v = 0; v < visited_count; ++v) seen = seen || visited[v] == h;
@@ -63,8 +57,8 @@ vec3 repulsion_at(uint i, vec3 p) {
           float d2 = dot(x, x);
           // Coincident particles feel no Gaussian force (x = 0): part them along a fixed axis, the
           // lower id one way and the higher the other; the tangential projection below keeps it on the surface.
-          if (d2 == 0.0) x = (i < j ? 1e-3 : -1e-3) * cell_size * vec3(0.6, 0.48, 0.64);
-          if (d2 < cutoff2) repulsion += exp(-d2 * inv_two_sigma2) * x;
+          if (d2 == 0.0) x = (i < j ? 1e-3 : -1e-3) * params.kernel.x * vec3(0.6, 0.48, 0.64);
+          if (d2 < cutoff2) repulsion += exp(-d2 * params.kernel.y) * x;
         }
       }
   return repulsion;
@@ -72,32 +66,32 @@ vec3 repulsion_at(uint i, vec3 p) {
 
 void main() {
   uint i = dispatch_item();
-  if (i >= count) return;
+  if (i >= params.sizes.x) return;
   vec4 pw = p_in[i];
   vec3 p = pw.xyz;
   vec4 s = sample_sdf(p);
   vec3 n = s.xyz;
   float phi = s.w;
-  bool outside = abs(phi) >= band_limit;
+  bool outside = abs(phi) >= params.limits.y;
   if (pw.w == 0.0) {
     p_out[i] = pw;
     step_info[i] = vec4(0.0, abs(phi), outside ? 1.0 : 0.0, 0.0);
     return;
   }
   vec3 f = repulsion_at(i, p);
-  f = repulsion_gain * (f - dot(f, n) * n);
+  f = params.kernel.z * (f - dot(f, n) * n);
   // Adaptive restart (O'Donoghue & Candes 2015, per particle): momentum that points against the
   // force is dropped. Without it a particle that flips sides of a feature thinner than a voxel (the
   // tangent plane turning over from step to step) or one squeezed against frozen neighbours rings
   // instead of settling.
   vec3 v_old = velocity[i].xyz;
-  vec3 v = (dot(v_old, f) > 0.0 ? momentum * v_old : vec3(0.0)) + f;
+  vec3 v = (dot(v_old, f) > 0.0 ? params.kernel.w * v_old : vec3(0.0)) + f;
   v -= dot(v, n) * n;
   vec3 move = v - phi * n;
   float length_move = length(move);
-  if (length_move > max_move) {
-    move *= max_move / length_move;
-    v *= max_move / length_move;
+  if (length_move > params.limits.x) {
+    move *= params.limits.x / length_move;
+    v *= params.limits.x / length_move;
   }
   velocity[i] = vec4(v, 0.0);
   p_out[i] = vec4(p + move, 1.0);

@@ -6,6 +6,8 @@
 #define TETRASAND_SAMPLER_SDF_SAMPLE_GLSL
 
 layout(std430, binding = TS_SAMPLER_SPARSE_FIELD) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
+// The field's parameter block at this stage's slot.
+#define TS_FIELD_PARAMS TS_SAMPLER_FIELD_PARAMS
 // Chunks 1-7 of a field larger than one storage block, at this stage's slots.
 #define TS_FIELD_CHUNK_1 TS_SAMPLER_FIELD_CHUNK_1
 #define TS_FIELD_CHUNK_2 TS_SAMPLER_FIELD_CHUNK_2
@@ -19,7 +21,7 @@ layout(std430, binding = TS_SAMPLER_SPARSE_FIELD) readonly buffer SparseField { 
 // xyz: unit gradient (zero where undefined, as off the band), w: signed distance [m].
 vec4 sample_sdf(vec3 p) {
   FieldReader reader = field_reader();
-  return field_sample(reader, p / field_voxel_size);
+  return field_sample(reader, p / field_params.scale.x);
 }
 
 #endif

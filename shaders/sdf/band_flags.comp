@@ -8,13 +8,12 @@
 layout(local_size_x = 256) in;
 layout(binding = TS_SDF_UNIT_SLAB) uniform sampler2DArray slab;  // xyz unit gradient, w distance [voxels]
 layout(std430, binding = TS_SDF_BAND_FLAGS) writeonly buffer Flags { uint flags[]; };
-uniform ivec2 layer_size;  // voxels along x, y
-uniform uint voxels;       // layer_size.x * layer_size.y * layers
-uniform float band;        // half-width [voxels]
+#include "common/params.h"
+layout(std140, binding = TS_SDF_BAND_PARAMS) uniform BandBlock { BandParams params; };
 void main() {
   uint v = dispatch_item();
-  if (v >= voxels) return;
-  uint per_layer = uint(layer_size.x * layer_size.y);
-  ivec3 texel = ivec3(int(v % uint(layer_size.x)), int((v % per_layer) / uint(layer_size.x)), int(v / per_layer));
-  flags[v] = abs(texelFetch(slab, texel, 0).w) < band ? 1u : 0u;
+  if (v >= params.voxels.x) return;
+  uint per_layer = uint(params.layer_size.x * params.layer_size.y);
+  ivec3 texel = ivec3(int(v % uint(params.layer_size.x)), int((v % per_layer) / uint(params.layer_size.x)), int(v / per_layer));
+  flags[v] = abs(texelFetch(slab, texel, 0).w) < params.band.x ? 1u : 0u;
 }

@@ -10,16 +10,15 @@ layout(binding = TS_SDF_UNIT_SLAB) uniform sampler2DArray slab;
 layout(std430, binding = TS_SDF_BAND_OFFSETS) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = TS_SDF_BAND_INDICES) writeonly buffer Indices { uint band_indices[]; };
 layout(std430, binding = TS_SDF_BAND_VALUES) writeonly buffer Values { vec4 band_values[]; };
-uniform ivec2 layer_size;
-uniform uint voxels;
-uniform float band;
+#include "common/params.h"
+layout(std140, binding = TS_SDF_BAND_PARAMS) uniform BandBlock { BandParams params; };
 void main() {
   uint v = dispatch_item();
-  if (v >= voxels) return;
-  uint per_layer = uint(layer_size.x * layer_size.y);
-  ivec3 texel = ivec3(int(v % uint(layer_size.x)), int((v % per_layer) / uint(layer_size.x)), int(v / per_layer));
+  if (v >= params.voxels.x) return;
+  uint per_layer = uint(params.layer_size.x * params.layer_size.y);
+  ivec3 texel = ivec3(int(v % uint(params.layer_size.x)), int((v % per_layer) / uint(params.layer_size.x)), int(v / per_layer));
   vec4 value = texelFetch(slab, texel, 0);
-  if (!(abs(value.w) < band)) return;
+  if (!(abs(value.w) < params.band.x)) return;
   band_indices[offsets[v]] = v;
   band_values[offsets[v]] = value;
 }

@@ -12,6 +12,12 @@
 #ifndef TETRASAND_SDF_BINDINGS_H
 #define TETRASAND_SDF_BINDINGS_H
 
+// Uniform-block slots (a namespace of their own in GL) of the kernels' parameter structs
+// (shaders/common/params.h). A kernel's block is bound by gpu::ParamBlock::bind right before it runs,
+// so kernels of different passes share a number.
+#define TS_SDF_SCAN_PARAMS 0  // ScanConvertParams: one entry per draw (gpu::ParamArray)
+#define TS_SDF_BAND_PARAMS 0  // BandParams (band_flags.comp, band_scatter.comp)
+
 #define TS_SDF_TRIANGLES 0     // SdfTriangle[]: the triangles in grid-local voxel units
 #define TS_SDF_PRISMS 1        // SdfPrism[]: each triangle's bounding prism
 

@@ -9,8 +9,8 @@
 
 layout(std430, binding = TS_SDF_TRIANGLES) readonly buffer Triangles { SdfTriangle triangles[]; };
 
-uniform int slab_first_z;
-uniform float depth_range;  // |d| [voxels] that maps to depth 1; beyond it the fragment is dropped
+#include "common/params.h"
+layout(std140, binding = TS_SDF_SCAN_PARAMS) uniform ScanConvertBlock { ScanConvertParams params; };
 
 flat in uint g_triangle;
 // xyz: unit gradient of the signed distance (from the closest point towards the voxel, flipped
@@ -19,7 +19,7 @@ layout(location = 0) out vec4 value;
 
 void main() {
   // Voxel centres sit at integer voxel coordinates, pixel centres at +0.5.
-  vec3 p = vec3(gl_FragCoord.xy - 0.5, float(slab_first_z + gl_Layer));
+  vec3 p = vec3(gl_FragCoord.xy - 0.5, float(params.layers.x + gl_Layer));
   SdfTriangle t = triangles[g_triangle];
   int feature;
   // Work relative to vertex 0 so the error does not grow with the grid coordinate.
@@ -31,9 +31,9 @@ void main() {
                                                  : t.vertex_normal[feature - FEATURE_VERTEX].xyz;
   vec3 delta = p - q;
   float d = length(delta);
-  if (d >= depth_range) discard;
+  if (d >= params.grid.z) discard;
   float s = dot(delta, pseudonormal) >= 0.0 ? 1.0 : -1.0;
   vec3 gradient = d > 1e-6 ? s * delta / d : pseudonormal;
-  gl_FragDepth = d / depth_range;
+  gl_FragDepth = d / params.grid.z;
   value = vec4(gradient, s * d);
 }

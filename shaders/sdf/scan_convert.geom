@@ -22,18 +22,15 @@ layout(triangle_strip, max_vertices = 96) out;
 
 layout(std430, binding = TS_SDF_PRISMS) readonly buffer Prisms { SdfPrism prisms[]; };
 
-uniform int slab_first_z;      // grid z index of render-target layer 0
-uniform int slab_layers;       // layers in the render target
-uniform int draw_first_layer;  // first render-target layer this draw covers
-uniform int draw_layers;       // layers this draw covers (at most INVOCATIONS * LAYERS_PER_INVOCATION)
-uniform vec2 grid_xy;          // grid dims along x and y = viewport size
+#include "common/params.h"
+layout(std140, binding = TS_SDF_SCAN_PARAMS) uniform ScanConvertBlock { ScanConvertParams params; };
 
 flat in uint v_triangle[];
 flat out uint g_triangle;
 
 void emit(vec3 p, int layer) {
   // Voxel centre i sits at pixel centre i + 0.5.
-  gl_Position = vec4((p.xy + 0.5) / grid_xy * 2.0 - 1.0, 0.0, 1.0);
+  gl_Position = vec4((p.xy + 0.5) / params.grid.xy * 2.0 - 1.0, 0.0, 1.0);
   gl_Layer = layer;
   g_triangle = v_triangle[0];
   EmitVertex();
@@ -102,13 +99,13 @@ void main() {
   }
   // Invocations start at the prism's own first layer in this draw (not at the draw's first layer):
   // the host sends a triangle to the variant whose INVOCATIONS cover its span.
-  int start = max(draw_first_layer, int(ceil(zmin)) - slab_first_z);
+  int start = max(params.layers.z, int(ceil(zmin)) - params.layers.x);
   int first = start + gl_InvocationID * LAYERS_PER_INVOCATION;
-  int last = min(min(first + LAYERS_PER_INVOCATION - 1, slab_layers - 1), draw_first_layer + draw_layers - 1);
+  int last = min(min(first + LAYERS_PER_INVOCATION - 1, params.layers.y - 1), params.layers.z + params.layers.w - 1);
   int layer_lo = first;
-  int layer_hi = min(last, int(floor(zmax)) - slab_first_z);
+  int layer_hi = min(last, int(floor(zmax)) - params.layers.x);
   for (int layer = layer_lo; layer <= layer_hi; ++layer) {
-    float z = float(slab_first_z + layer);
+    float z = float(params.layers.x + layer);
     slice_triangular_prism(lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], z, layer);
     if (corners == 4) slice_triangular_prism(lo[0], lo[2], lo[3], hi[0], hi[2], hi[3], z, layer);
   }

@@ -27,6 +27,10 @@
 #ifndef TETRASAND_SIM_BINDINGS_H
 #define TETRASAND_SIM_BINDINGS_H
 
+// Uniform-block slot (a namespace of its own in GL) of each kernel's parameter struct
+// (shaders/common/params.h), bound by gpu::ParamBlock::bind right before the kernel runs.
+#define TS_SIM_PARAMS 0
+
 // Aliases of shaders/common/bindings.h names (TS_SORT_*) expand where they are used: a user includes
 // both headers.
 

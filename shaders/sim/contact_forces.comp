@@ -36,17 +36,12 @@ layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots64 sprin
 layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots springs[]; };
 #endif
 
-uniform uint particle_count;
-uniform float cell_size;
-uniform uint table_size;
-uniform uint plane_count;  // walls
-uniform uint cylinder_count;
-uniform int damping_model;
-uniform float max_overlap_ratio;  // overlap clamp (thesis 3.3.1): delta <= ratio * min radius
-uniform uint material_count;
-uniform int spring_model;  // 1: tangential springs (static friction), 0: viscous eq. 3.28
-uniform real dt;           // [s], advances the springs
-uniform int check_penetration;  // 1: count dynamic particles that passed through a wall (StepSettings)
+#include "common/params.h"
+#ifdef TS_FP64
+layout(std140, binding = TS_SIM_PARAMS) uniform ContactBlock { SimContactParams64 params; };
+#else
+layout(std140, binding = TS_SIM_PARAMS) uniform ContactBlock { SimContactParams params; };
+#endif
 
 // This particle's contact history: the old slots, read once, and how many new ones are written.
 int old_partner[TS_SIM_SPRING_SLOTS];
@@ -64,11 +59,11 @@ void load_springs(uint i) {
 // (zero when new) and keeps it, advanced, in the next free slot (counted when none is left).
 real3 contact_force(uint i, bool with_springs, int partner, real3 n, real delta, real3 vc, real effective_radius,
                     real effective_mass, SimPair c) {
-  if (!with_springs) return hertz_contact_force(n, delta, vc, effective_radius, effective_mass, c, damping_model);
+  if (!with_springs) return hertz_contact_force(n, delta, vc, effective_radius, effective_mass, c, params.models.x);
   real3 spring = real3(0.0);
   for (uint s = 0u; s < TS_SIM_SPRING_SLOTS; ++s)
     if (old_partner[s] == partner) spring = old_spring[s];
-  real3 f = hertz_spring_contact_force(n, delta, vc, effective_radius, effective_mass, c, damping_model, dt, spring);
+  real3 f = hertz_spring_contact_force(n, delta, vc, effective_radius, effective_mass, c, params.models.x, params.step.x, spring);
   if (slots_used == TS_SIM_SPRING_SLOTS) {
     ++slot_overflows;
   } else {
@@ -88,7 +83,7 @@ void note_penetration(uint i, uint slot) {
 
 void main() {
   uint i = dispatch_item();
-  if (i >= particle_count) return;
+  if (i >= params.sizes.x) return;
   uint body_i = particle_info[i].x;
   real4 xi4 = POSITION(i);
   real3 xi = xi4.xyz;
@@ -96,29 +91,29 @@ void main() {
   real3 vi = particle_velocity[i].xyz;
   real3 wi = body_omega[body_i].xyz;
   real inv_mass_i = body_position[body_i].w;
-  uint pair_row = particle_info[i].y * material_count;
+  uint pair_row = particle_info[i].y * params.materials.x;
   real3 force = real3(0.0), torque = real3(0.0);
   real3 arm_i = xi - body_position[body_i].xyz;
   // Static and kinematic particles keep no springs (their partners hold the contact's), as on the CPU.
-  bool with_springs = spring_model != 0 && inv_mass_i > 0.0;
+  bool with_springs = params.models.y != 0 && inv_mass_i > 0.0;
   if (with_springs) load_springs(i);
 
-  ivec3 c = cell_of_position(particle_position[i].xyz, cell_size);
+  ivec3 c = cell_of_position(particle_position[i].xyz, params.limits.x);
   float pair_contacts = 0.0, walls = 0.0, clamps = 0.0, worst_overlap = 0.0;
-  real overlap_cap = real(max_overlap_ratio);
+  real overlap_cap = real(params.limits.y);
   // The 27 cells in a fixed sweep, like CpuStepper::compute_forces: a bucket shared with another
   // cell is visited once per cell, keeping only that cell's particles.
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         ivec3 cell = c + ivec3(dx, dy, dz);
-        uint h = hash_cell(cell, table_size);
+        uint h = hash_cell(cell, params.sizes.y);
         // A bucket ends where the next begins (the last one at the particle count).
-        uint begin = cell_start[h], end = h + 1u < table_size ? cell_start[h + 1u] : particle_count;
+        uint begin = cell_start[h], end = h + 1u < params.sizes.y ? cell_start[h + 1u] : params.sizes.x;
         for (uint k = begin; k < end; ++k) {
           uint j = sorted_ids[k];
           uint body_j = particle_info[j].x;
-          if (body_j == body_i || cell_of_position(particle_position[j].xyz, cell_size) != cell) continue;
+          if (body_j == body_i || cell_of_position(particle_position[j].xyz, params.limits.x) != cell) continue;
           real inv_mass_j = body_position[body_j].w;
           if (inv_mass_i == 0.0 && inv_mass_j == 0.0) continue;  // neither body can move
           real4 xj4 = POSITION(j);
@@ -146,7 +141,7 @@ void main() {
 
   if (inv_mass_i > 0.0) {
     // Smooth walls in declaration order: planes, then cylinders (as the CPU reference).
-    for (uint k = 0u; k < plane_count; ++k) {
+    for (uint k = 0u; k < params.sizes.z; ++k) {
       SimPlane plane = planes[k];
       real3 n = real3(plane.normal_offset.xyz);
       real raw = ri - (dot(n, xi) - real(plane.normal_offset.w));
@@ -156,7 +151,7 @@ void main() {
         real lateral = length(rel - dot(rel, n) * n);
         if (plane.extent.w > 0.0 ? lateral > real(plane.extent.w) : lateral < real(-plane.extent.w)) continue;
       }
-      if (check_penetration != 0 && raw > 2.0 * ri) note_penetration(i, k);
+      if (params.models.z != 0 && raw > 2.0 * ri) note_penetration(i, k);
       real delta = min(raw, overlap_cap * ri);
       real3 arm = -(ri - 0.5 * raw) * n;
       real3 f = contact_force(i, with_springs, -1 - int(k), n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i,
@@ -167,7 +162,7 @@ void main() {
       worst_overlap = max(worst_overlap, float(delta / ri));
       clamps += raw > delta ? 1.0 : 0.0;
     }
-    for (uint k = 0u; k < cylinder_count; ++k) {
+    for (uint k = 0u; k < params.sizes.w; ++k) {
       SimCylinder cyl = cylinders[k];
       if (xi.z < real(cyl.range.x) || xi.z > real(cyl.range.y)) continue;
       real2 radial = xi.xy - real2(cyl.axis_radius.xy);
@@ -176,10 +171,10 @@ void main() {
       real raw = ri - (real(cyl.axis_radius.w) - distance);
       if (raw <= 0.0) continue;
       real3 n = real3(-radial / distance, 0.0);
-      if (check_penetration != 0 && raw > 2.0 * ri) note_penetration(i, plane_count + k);
+      if (params.models.z != 0 && raw > 2.0 * ri) note_penetration(i, params.sizes.z + k);
       real delta = min(raw, overlap_cap * ri);
       real3 arm = -(ri - 0.5 * raw) * n;
-      real3 f = contact_force(i, with_springs, -1 - int(plane_count + k), n, delta, vi + cross(wi, arm), ri,
+      real3 f = contact_force(i, with_springs, -1 - int(params.sizes.z + k), n, delta, vi + cross(wi, arm), ri,
                               1.0 / inv_mass_i, pair_table[pair_row + cyl.material.x]);
       force += f;
       torque += cross(arm_i + arm, f);

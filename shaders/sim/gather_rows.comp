@@ -8,11 +8,11 @@ layout(local_size_x = 128) in;
 layout(std430, binding = TS_SIM_GATHER_SOURCE) readonly buffer Src { uvec4 src[]; };
 layout(std430, binding = TS_SIM_GATHER_DESTINATION) writeonly buffer Dst { uvec4 dst[]; };
 layout(std430, binding = TS_SIM_GATHER_INDEX) readonly buffer Index { uint index[]; };
-uniform uint rows;
-uniform uint width;
+#include "common/params.h"
+layout(std140, binding = TS_SIM_PARAMS) uniform GatherBlock { SimGatherParams params; };
 void main() {
   uint r = dispatch_item();
-  if (r >= rows) return;
-  uint from = index[r] * width, to = r * width;
-  for (uint k = 0u; k < width; ++k) dst[to + k] = src[from + k];
+  if (r >= params.shape.x) return;
+  uint from = index[r] * params.shape.y, to = r * params.shape.y;
+  for (uint k = 0u; k < params.shape.y; ++k) dst[to + k] = src[from + k];
 }

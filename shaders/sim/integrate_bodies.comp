@@ -23,24 +23,22 @@ layout(std430, binding = TS_SIM_BODY_MOMENTUM) buffer BL { real4 body_momentum[]
 layout(std430, binding = TS_SIM_KEYFRAMES) readonly buffer K { real4 keyframes[]; };
 #include "sim/keyframes.glsl"
 
-uniform uint body_count;
-uniform real dt;                       // [s]
-uniform real3 gravity;                 // [m/s^2]
-uniform int semi_implicit;             // 0: forward Euler (thesis), 1: semi-implicit Euler
-uniform float max_speed;               // CFL clamp: cfl * cell / dt [m/s]
-uniform float angular_damping_rate;    // [1/s], 0 = off (thesis pseudocode 4.4)
-uniform float angular_damping_speed;   // [m/s]: damp when |v| + |w| reach is below it
-uniform real time_after;               // [s]: the time this step ends at (keyframed bodies)
+#include "common/params.h"
+#ifdef TS_FP64
+layout(std140, binding = TS_SIM_PARAMS) uniform IntegrateBlock { SimIntegrateParams64 params; };
+#else
+layout(std140, binding = TS_SIM_PARAMS) uniform IntegrateBlock { SimIntegrateParams params; };
+#endif
 
 void main() {
   uint b = dispatch_item();
-  if (b >= body_count) return;
+  if (b >= params.sizes.x) return;
   uint motion = uint(body_velocity[b].w);
   if (motion == TS_MOTION_STATIC) return;
-  real h = dt;
+  real h = params.gravity_dt.w;
   real4 q = body_orientation[b];
   if (motion == TS_MOTION_KINEMATIC && body_range[b].w > 0u) {
-    KinematicState state = sample_track(body_range[b].z, body_range[b].w, time_after);
+    KinematicState state = sample_track(body_range[b].z, body_range[b].w, params.time.x);
     body_position[b].xyz = state.position;
     body_orientation[b] = state.orientation;
     body_velocity[b].xyz = state.velocity;
@@ -61,15 +59,15 @@ void main() {
   real3 row0 = body_inverse_inertia[3u * b].xyz, row1 = body_inverse_inertia[3u * b + 1u].xyz,
         row2 = body_inverse_inertia[3u * b + 2u].xyz;
   real reach = body_inverse_inertia[3u * b].w;
-  real3 acceleration = gravity + body_position[b].w * force;
+  real3 acceleration = params.gravity_dt.xyz + body_position[b].w * force;
   real3 momentum = body_momentum[b].xyz + torque * h;
-  real3 w_move = semi_implicit != 0 ? apply_world_inverse_inertia(q, row0, row1, row2, momentum) : body_omega[b].xyz;
+  real3 w_move = params.models.x != 0 ? apply_world_inverse_inertia(q, row0, row1, row2, momentum) : body_omega[b].xyz;
   real4 q_new = integrate_orientation(q, w_move, h);
   real3 w = apply_world_inverse_inertia(q_new, row0, row1, row2, momentum);
   real3 v = body_velocity[b].xyz + acceleration * h;
-  body_position[b].xyz += (semi_implicit != 0 ? v : body_velocity[b].xyz) * h;
+  body_position[b].xyz += (params.models.x != 0 ? v : body_velocity[b].xyz) * h;
 
-  real limit = real(max_speed);
+  real limit = real(params.limits.x);
   if (length(v) > limit) {
     v *= limit / length(v);
     atomicAdd(counters[0], 1u);
@@ -80,8 +78,8 @@ void main() {
     momentum *= factor;  // omega is linear in L
     atomicAdd(counters[1], 1u);
   }
-  if (angular_damping_rate > 0.0 && length(v) + length(w) * reach < real(angular_damping_speed)) {
-    real factor = max(real(0.0), 1.0 - real(angular_damping_rate) * h);
+  if (params.limits.y > 0.0 && length(v) + length(w) * reach < real(params.limits.z)) {
+    real factor = max(real(0.0), 1.0 - real(params.limits.y) * h);
     w *= factor;
     momentum *= factor;
   }

@@ -13,19 +13,19 @@ layout(std430, binding = TS_SIM_BODY_VELOCITY) readonly buffer BV { real4 body_v
 layout(std430, binding = TS_SIM_BODY_OMEGA) readonly buffer BW { real4 body_omega[]; };
 layout(std430, binding = TS_SIM_BODY_MOMENTUM) readonly buffer BL { real4 body_momentum[]; };
 layout(std430, binding = TS_SIM_METRIC_PARTIALS) writeonly buffer Partials { dvec4 partials[]; };
-uniform uint body_count;
-uniform vec3 gravity;
+#include "common/params.h"
+layout(std140, binding = TS_SIM_PARAMS) uniform MetricsBlock { SimMetricsParams params; };
 shared dvec4 scratch[256];
 void main() {
   uint b = dispatch_item(), t = gl_LocalInvocationID.x;
-  if (dispatch_group() * gl_WorkGroupSize.x >= body_count) return;  // past the end: no partial
+  if (dispatch_group() * gl_WorkGroupSize.x >= params.sizes.x) return;  // past the end: no partial
   dvec4 e = dvec4(0.0);
-  if (b < body_count && uint(body_velocity[b].w) == TS_MOTION_DYNAMIC) {
+  if (b < params.sizes.x && uint(body_velocity[b].w) == TS_MOTION_DYNAMIC) {
     double m = 1.0 / double(body_position[b].w);
     dvec3 v = dvec3(body_velocity[b].xyz);
     e.x = 0.5 * m * dot(v, v);
     e.y = 0.5 * dot(dvec3(body_omega[b].xyz), dvec3(body_momentum[b].xyz));
-    e.z = -m * dot(dvec3(gravity), dvec3(body_position[b].xyz));
+    e.z = -m * dot(dvec3(params.gravity.xyz), dvec3(body_position[b].xyz));
     bool bad = any(isnan(body_position[b].xyz)) || any(isinf(body_position[b].xyz)) || any(isnan(body_velocity[b].xyz)) ||
                any(isinf(body_velocity[b].xyz)) || any(isnan(body_omega[b].xyz));
     e.w = bad ? 1.0 : 0.0;

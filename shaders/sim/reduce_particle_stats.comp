@@ -8,12 +8,13 @@
 layout(local_size_x = 256) in;
 layout(std430, binding = TS_SIM_PARTICLE_STATS) readonly buffer S { vec4 particle_stats[]; };
 layout(std430, binding = TS_SIM_STAT_PARTIALS) writeonly buffer Partials { vec4 partials[]; };
-uniform uint particle_count;
+#include "common/params.h"
+layout(std140, binding = TS_SIM_PARAMS) uniform StatsBlock { ItemCount params; };
 shared vec4 scratch[256];
 void main() {
   uint i = dispatch_item(), t = gl_LocalInvocationID.x;
-  if (dispatch_group() * gl_WorkGroupSize.x >= particle_count) return;  // past the end: no partial
-  scratch[t] = i < particle_count ? particle_stats[i] : vec4(0.0);
+  if (dispatch_group() * gl_WorkGroupSize.x >= params.count.x) return;  // past the end: no partial
+  scratch[t] = i < params.count.x ? particle_stats[i] : vec4(0.0);
   for (uint stride = 128u; stride > 0u; stride >>= 1u) {
     barrier();
     if (t < stride) {

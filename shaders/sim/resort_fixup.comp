@@ -15,13 +15,13 @@ layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots64 sprin
 #else
 layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots springs[]; };
 #endif
-uniform uint particle_count;
-uniform int spring_model;
+#include "common/params.h"
+layout(std140, binding = TS_SIM_PARAMS) uniform FixupBlock { SimFixupParams params; };
 void main() {
   uint i = dispatch_item();
-  if (i >= particle_count) return;
+  if (i >= params.sizes.x) return;
   particle_info[i].x = owner[i];
-  if (spring_model == 0) return;
+  if (params.models.x == 0) return;
   for (uint s = 0u; s < TS_SIM_SPRING_SLOTS; ++s) {
     int partner = springs[i].partner[s / 4u][s % 4u];
     if (partner >= 0 && partner != TS_SIM_NO_PARTNER) springs[i].partner[s / 4u][s % 4u] = int(new_of_old[partner]);

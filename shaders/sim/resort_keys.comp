@@ -15,9 +15,8 @@ layout(std430, binding = TS_SIM_BODY_POSITION) readonly buffer BP { real4 body_p
 layout(std430, binding = TS_SORT_KEY) writeonly buffer Key { uint key[]; };
 layout(std430, binding = TS_SORT_BUCKET_COUNT) buffer Count { uint bucket_count[]; };
 layout(std430, binding = TS_SORT_SLOT) writeonly buffer Slot { uint slot[]; };
-uniform uint body_count;
-uniform float cell_size;
-uniform uint table_size;
+#include "common/params.h"
+layout(std140, binding = TS_SIM_PARAMS) uniform KeysBlock { GridParams params; };
 
 // Spreads the low 10 bits of v to every third bit.
 uint spread_bits(uint v) {
@@ -31,9 +30,9 @@ uint spread_bits(uint v) {
 
 void main() {
   uint b = dispatch_item();
-  if (b >= body_count) return;
-  uvec3 c = uvec3(cell_of_position(vec3(body_position[b].xyz), cell_size));
-  uint k = (spread_bits(c.x) | (spread_bits(c.y) << 1u) | (spread_bits(c.z) << 2u)) & (table_size - 1u);
+  if (b >= params.sizes.x) return;
+  uvec3 c = uvec3(cell_of_position(vec3(body_position[b].xyz), params.cell.x));
+  uint k = (spread_bits(c.x) | (spread_bits(c.y) << 1u) | (spread_bits(c.z) << 2u)) & (params.sizes.y - 1u);
   key[b] = k;
   slot[b] = atomicAdd(bucket_count[k], 1u);
 }

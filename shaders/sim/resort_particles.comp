@@ -14,10 +14,11 @@ layout(std430, binding = TS_SIM_RESORT_NEW_RANGE) writeonly buffer NewRange { uv
 layout(std430, binding = TS_SIM_RESORT_SOURCE) writeonly buffer Source { uint source_particle[]; };  // new particle -> old
 layout(std430, binding = TS_SIM_RESORT_DESTINATION) writeonly buffer Destination { uint new_of_old[]; };  // old particle -> new
 layout(std430, binding = TS_SIM_RESORT_OWNER) writeonly buffer Owner { uint owner[]; };             // new particle -> new body
-uniform uint body_count;
+#include "common/params.h"
+layout(std140, binding = TS_SIM_PARAMS) uniform ParticlesBlock { ItemCount params; };
 void main() {
   uint b = dispatch_item();
-  if (b >= body_count) return;
+  if (b >= params.count.x) return;
   uvec4 old_range = body_range[order[b]];
   uint first = new_first[b];
   new_range[b] = uvec4(first, old_range.y, old_range.z, old_range.w);

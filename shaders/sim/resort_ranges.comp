@@ -10,8 +10,9 @@ layout(local_size_x = 256) in;
 layout(std430, binding = TS_SIM_RESORT_ORDER) readonly buffer Order { uint order[]; };  // new body -> old body
 layout(std430, binding = TS_SIM_BODY_RANGE) readonly buffer BR { uvec4 body_range[]; };
 layout(std430, binding = TS_SIM_RESORT_NEW_FIRST) writeonly buffer NewFirst { uint new_first[]; };
-uniform uint body_count;
+#include "common/params.h"
+layout(std140, binding = TS_SIM_PARAMS) uniform RangesBlock { ItemCount params; };
 void main() {
   uint b = dispatch_item();
-  if (b < body_count) new_first[b] = body_range[order[b]].y;
+  if (b < params.count.x) new_first[b] = body_range[order[b]].y;
 }

@@ -17,10 +17,11 @@ layout(std430, binding = TS_SIM_BODY_OMEGA) readonly buffer BW { real4 body_omeg
 #ifdef TS_FP64
 layout(std430, binding = TS_SIM_PARTICLE_POSITION_EXACT) writeonly buffer PX { dvec4 particle_position_exact[]; };
 #endif
-uniform uint particle_count;
+#include "common/params.h"
+layout(std140, binding = TS_SIM_PARAMS) uniform UpdateBlock { ItemCount params; };
 void main() {
   uint i = dispatch_item();
-  if (i >= particle_count) return;
+  if (i >= params.count.x) return;
   uint b = particle_info[i].x;
   real3 arm = rotate(body_orientation[b], particle_local[i].xyz);
   real3 x = body_position[b].xyz + arm;

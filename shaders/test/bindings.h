@@ -5,6 +5,12 @@
 #ifndef TETRASAND_TEST_BINDINGS_H
 #define TETRASAND_TEST_BINDINGS_H
 
+// Uniform-block slots (a namespace of their own in GL) of the kernels' parameter structs
+// (shaders/common/params.h). A kernel's block is bound by gpu::ParamBlock::bind right before it runs,
+// so kernels of different passes share a number.
+#define TS_TEST_PARAMS 0        // the kernel's own: SaxpyParams, SolidColorParams, FieldProbeParams
+#define TS_TEST_FIELD_PARAMS 1  // FieldParams of sparse_field_probe.comp's field
+
 #define TS_TEST_SAXPY_X 0  // float[]: x, read
 #define TS_TEST_SAXPY_Y 1  // float[]: y, y <- a x + y
 

@@ -6,9 +6,9 @@
 layout(local_size_x = 64) in;
 layout(std430, binding = TS_TEST_SAXPY_X) readonly buffer X { float x[]; };
 layout(std430, binding = TS_TEST_SAXPY_Y) buffer Y { float y[]; };
-uniform float a;
-uniform uint count;
+#include "common/params.h"
+layout(std140, binding = TS_TEST_PARAMS) uniform SaxpyBlock { SaxpyParams params; };
 void main() {
   uint i = dispatch_item();
-  if (i < count) y[i] = a * x[i] + y[i];
+  if (i < params.count.x) y[i] = params.scale.x * x[i] + y[i];
 }

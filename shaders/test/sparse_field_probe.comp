@@ -13,6 +13,8 @@
 #include "test/bindings.h"
 layout(local_size_x = 64) in;
 layout(std430, binding = TS_TEST_FIELD_GRID) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
+// The field's parameter block at this stage's slot.
+#define TS_FIELD_PARAMS TS_TEST_FIELD_PARAMS
 // Chunks 1-7 of a field larger than one storage block, at this stage's slots.
 #define TS_FIELD_CHUNK_1 TS_TEST_FIELD_CHUNK_1
 #define TS_FIELD_CHUNK_2 TS_TEST_FIELD_CHUNK_2
@@ -24,18 +26,19 @@ layout(std430, binding = TS_TEST_FIELD_GRID) readonly buffer SparseField { uint 
 #include "common/sparse_field.glsl"
 layout(std430, binding = TS_TEST_FIELD_POINTS) readonly buffer Points { vec4 points[]; };
 layout(std430, binding = TS_TEST_FIELD_VALUES) writeonly buffer Values { vec4 values[]; };
-uniform uint count;
+#include "common/params.h"
+layout(std140, binding = TS_TEST_PARAMS) uniform ProbeBlock { FieldProbeParams params; };
 // TS_PROBE_MODE, when defined, fixes the mode at compile time, so a program holds one mode's reads:
 // with a chunked field each PNanoVDB read inlines the chunk branch, and llvmpipe's compile time
 // follows the count (all modes at once: minutes).
-#ifdef TS_PROBE_MODE
-const int mode = TS_PROBE_MODE;
-#else
-uniform int mode;
-#endif
 void main() {
+#ifdef TS_PROBE_MODE
+  const int mode = TS_PROBE_MODE;
+#else
+  int mode = params.mode.x;
+#endif
   uint i = dispatch_item();
-  if (i >= count) return;
+  if (i >= params.count.x) return;
   FieldReader reader = field_reader();
   vec3 x = points[i].xyz;
   if (mode == 5) reader.accessor.root.address.byte_offset = 0u;
@@ -50,7 +53,7 @@ void main() {
     pnanovdb_grid_handle_t grid;
     grid.address.byte_offset = 0u;
     pnanovdb_root_handle_t root = pnanovdb_tree_get_root(buf, pnanovdb_grid_get_tree(buf, grid));
-    pnanovdb_coord_t ijk = ivec3(round(x)) + field_index_offset;
+    pnanovdb_coord_t ijk = ivec3(round(x)) + field_params.index_offset.xyz;
     pnanovdb_uint64_t key = pnanovdb_coord_to_key(ijk);
     if (mode == 3) {
       values[i] = uintBitsToFloat(uvec4(root.address.byte_offset, pnanovdb_root_get_tile_count(buf, root), key.x, key.y));

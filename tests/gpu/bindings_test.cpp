@@ -1,12 +1,15 @@
 // Static checks of the binding slots shared by GLSL and C++ (shaders/*/bindings.h): no shader or host
 // call uses a bare slot number, no two blocks of one pass share a slot, and the simulator and the
-// preview renderer, which share a context in `tetrasand sim`, use disjoint slots. And one of the host
-// sources: only the gpu layer, which counts them, makes the GL calls that wait for the GPU. Reads the
-// sources only; no GL context.
+// preview renderer, which share a context in `tetrasand sim`, use disjoint slots. Kernel parameters
+// travel only in the typed blocks of shaders/common/params.h: no shader declares a loose uniform and
+// no host code sets one by name. And one of the host sources: only the gpu layer, which counts them,
+// makes the GL calls that wait for the GPU. Reads the sources only; no GL context.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <regex>
 #include <set>
@@ -170,6 +173,78 @@ TEST(Bindings, NoHostCallBindsABareSlotNumber) {
   const auto hits =
       host_lines_matching(bare, {"core", "gpu", "sdf", "sampler", "sim", "preview", "app", "bench", "tests"});
   EXPECT_TRUE(hits.empty()) << "use the slot's name from shaders/*/bindings.h:\n" << ::testing::PrintToString(hits);
+}
+
+// `text` without its comments, line breaks kept (so line numbers stay).
+std::string without_comments(const std::string& text) {
+  static const std::regex comment(R"(//[^\n]*|/\*[\s\S]*?\*/)");
+  std::string out;
+  auto last = text.cbegin();
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), comment); it != std::sregex_iterator(); ++it) {
+    out.append(last, (*it)[0].first);
+    for (char c : it->str()) if (c == '\n') out += '\n';
+    last = (*it)[0].second;
+  }
+  out.append(last, text.cend());
+  return out;
+}
+
+// "file:line: name" of each loose uniform in `text`: a `uniform` declaration that is neither a block
+// (`uniform Name {`) nor an opaque type (sampler*, image*), which GL would let a host set by name.
+std::vector<std::string> loose_uniforms(const std::string& text, const std::string& file) {
+  static const std::regex declaration(
+      R"(\buniform\s+(?:(?:lowp|mediump|highp|precise|invariant|readonly|writeonly|coherent|volatile|restrict)\s+)*)"
+      R"((\w+)\s*(\{|\w+))");
+  const std::string code = without_comments(text);
+  std::vector<std::string> hits;
+  for (auto it = std::sregex_iterator(code.begin(), code.end(), declaration); it != std::sregex_iterator(); ++it) {
+    const std::string type = (*it)[1], next = (*it)[2];
+    if (next == "{" || type.find("sampler") != std::string::npos || type.find("image") != std::string::npos) continue;
+    const auto line = std::count(code.cbegin(), (*it)[0].first, '\n') + 1;
+    hits.push_back(file + ":" + std::to_string(line) + ": uniform " + type + " " + next);
+  }
+  return hits;
+}
+
+TEST(Params, TheLooseUniformScanFindsWhatItMustAndOnlyThat) {
+  const std::string sample =
+      "layout(std140, binding = TS_X) uniform Block { ItemCount params; };\n"
+      "layout(binding = TS_UNIT) uniform sampler2D albedo;  // uniform float not_this;\n"
+      "/* uniform int nor_this; */ uniform highp\n  vec3 gravity;\n"
+      "layout(binding = 0, r32f) uniform writeonly image2D target;\n";
+  EXPECT_EQ(loose_uniforms(sample, "x"), std::vector<std::string>{"x:3: uniform vec3 gravity"});
+}
+
+TEST(Params, NoShaderDeclaresALooseUniform) {
+  std::vector<std::string> hits;
+  std::size_t blocks = 0;
+  const std::regex block(R"(\buniform\s+\w+\s*\{)");
+  for (const fs::path& file : files_below(kSource / "shaders", {".comp", ".vert", ".geom", ".frag", ".glsl", ".h"})) {
+    const std::string text = read_text(kSource / "shaders" / file);
+    for (auto& hit : loose_uniforms(text, file.generic_string())) hits.push_back(hit);
+    blocks += static_cast<std::size_t>(std::distance(std::sregex_iterator(text.begin(), text.end(), block),
+                                                     std::sregex_iterator()));
+  }
+  EXPECT_GE(blocks, 30u);  // the check must see the parameter blocks it stands beside
+  EXPECT_TRUE(hits.empty()) << "put kernel parameters in a struct of shaders/common/params.h, read from a "
+                               "uniform block and uploaded with gpu::ParamBlock:\n"
+                            << ::testing::PrintToString(hits);
+}
+
+// With no gpu::Program::set left, a by-name uniform could only come back through the GL calls that
+// take a uniform location; product code makes none (tests may).
+TEST(Params, NoProductCodeSetsAUniformByName) {
+  const std::regex by_name(R"(^[^/]*\bgl(Program)?Uniform(\d|Matrix)\w*\s*\(|^[^/]*\bglGetUniformLocation\s*\()");
+  std::vector<std::string> dirs;
+  for (const auto& entry : fs::directory_iterator(kSource)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_directory() && name != "tests" && name != "shaders" && name[0] != '.' && name.rfind("build", 0) != 0)
+      dirs.push_back(name);
+  }
+  ASSERT_GE(dirs.size(), 6u);
+  const auto hits = host_lines_matching(by_name, dirs);
+  EXPECT_TRUE(hits.empty()) << "upload a struct of shaders/common/params.h with gpu::ParamBlock instead:\n"
+                            << ::testing::PrintToString(hits);
 }
 
 // Reads of GPU memory, finishes, fence waits and query results drain the GPU's queue; gpu/host_sync.h

@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "gpu/context.h"
 #include "gpu/gl.h"
+#include "gpu/params.h"
 #include "gpu/shader_library.h"
 #include "shaders/test/bindings.h"
 
@@ -66,8 +67,9 @@ TEST(GpuQueue, DispatchComputesSaxpyAndReadsBack) {
   Buffer bx = Buffer::from<float>(x), by = Buffer::from<float>(y);
   bx.bind(TS_TEST_SAXPY_X);
   by.bind(TS_TEST_SAXPY_Y);
-  saxpy.set("a", 2.0f);
-  saxpy.set("count", n);
+  ParamBlock<params::SaxpyParams> params;
+  params.values = {{n, 0u, 0u, 0u}, {2.0f, 0.0f, 0.0f, 0.0f}};
+  params.bind(TS_TEST_PARAMS);
   Queue queue(/*timings=*/true, /*check_errors=*/true);
   queue.dispatch_items(saxpy, n);
   queue.dispatch_items(saxpy, n);
@@ -79,6 +81,38 @@ TEST(GpuQueue, DispatchComputesSaxpyAndReadsBack) {
   EXPECT_EQ(timings[0].calls, 2u);
   EXPECT_GE(timings[0].milliseconds, 0.0);
   EXPECT_NE(queue.timing_report().find("test/saxpy.comp"), std::string::npos);
+}
+
+// A ParamBlock rewritten between two dispatches: the first reads what it was issued with, the second
+// the new values, and binding unchanged values again uploads nothing new yet still binds the block.
+TEST(GpuParamBlock, EachDispatchReadsTheValuesBoundBeforeIt) {
+  Context context;
+  ShaderLibrary library;
+  Program saxpy = Program::compute(library, "test/saxpy.comp");
+  const unsigned n = 300;
+  std::vector<float> x(n), y(n, 1.0f);
+  std::iota(x.begin(), x.end(), 0.0f);
+  Buffer bx = Buffer::from<float>(x), by = Buffer::from<float>(y);
+  bx.bind(TS_TEST_SAXPY_X);
+  by.bind(TS_TEST_SAXPY_Y);
+  ParamBlock<params::SaxpyParams> params, other;
+  Queue queue(/*timings=*/false, /*check_errors=*/true);
+  params.values = {{n, 0u, 0u, 0u}, {2.0f, 0.0f, 0.0f, 0.0f}};
+  params.bind(TS_TEST_PARAMS);
+  queue.dispatch_items(saxpy, n);
+  params.values.scale.x = 3.0f;
+  params.values.count.x = n / 2;  // the second dispatch covers the first half only
+  params.bind(TS_TEST_PARAMS);
+  queue.dispatch_items(saxpy, n);
+  other.values = {{n, 0u, 0u, 0u}, {100.0f, 0.0f, 0.0f, 0.0f}};
+  other.bind(TS_TEST_PARAMS);  // takes the slot ...
+  params.bind(TS_TEST_PARAMS);  // ... and gives it back, unchanged values: no upload, still bound
+  queue.dispatch_items(saxpy, n);
+  const auto result = by.read<float>(n);
+  for (unsigned i = 0; i < n; ++i) {
+    const float expected = 1.0f + (i < n / 2 ? 8.0f : 2.0f) * static_cast<float>(i);
+    ASSERT_FLOAT_EQ(result[i], expected) << i;
+  }
 }
 
 TEST(GpuQueue, GroupGridCoversEveryGroupInRowsNoWiderThanTheLimit) {
@@ -111,8 +145,9 @@ TEST(GpuQueue, ItemsPastTheGroupLimitAlongXAreEachComputedOnce) {
   Buffer bx = Buffer::from<float>(x), by = Buffer::from<float>(y);
   bx.bind(TS_TEST_SAXPY_X);
   by.bind(TS_TEST_SAXPY_Y);
-  saxpy.set("a", 2.0f);
-  saxpy.set("count", static_cast<unsigned>(n));
+  ParamBlock<params::SaxpyParams> params;
+  params.values = {{static_cast<unsigned>(n), 0u, 0u, 0u}, {2.0f, 0.0f, 0.0f, 0.0f}};
+  params.bind(TS_TEST_PARAMS);
   Queue queue(/*timings=*/false, /*check_errors=*/true);
   queue.dispatch_items(saxpy, n);
   const auto result = by.read<float>(n + 64);

@@ -16,7 +16,9 @@
 #include "core/error.h"
 #include "gpu/context.h"
 #include "gpu/gl.h"
+#include "gpu/params.h"
 #include "gpu/shader_library.h"
+#include "shaders/test/bindings.h"
 
 namespace ts::gpu {
 namespace {
@@ -246,7 +248,9 @@ TEST(Graphics, DrawArraysFillsTheTargetAndIsTimedUnderItsName) {
   context();
   ShaderLibrary library;
   const Program solid = Program::graphics(library, "preview/shade.vert", "", "test/solid_color.frag");
-  solid.set("color", 0.0f, 1.0f, 0.0f, 1.0f);
+  ParamBlock<params::SolidColorParams> params;
+  params.values.color = {0.0f, 1.0f, 0.0f, 1.0f};
+  params.bind(TS_TEST_PARAMS);
   const Texture colour = Texture::create_2d(GL_RGBA8, 5, 3, "test colour");
   Framebuffer target("test target");
   target.attach_color(0, colour);

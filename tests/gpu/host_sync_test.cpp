@@ -10,6 +10,7 @@
 
 #include "gpu/context.h"
 #include "gpu/gl.h"
+#include "gpu/params.h"
 #include "shaders/test/bindings.h"
 
 namespace ts::gpu {
@@ -68,8 +69,9 @@ TEST_F(HostSync, TimerQueriesAreReadOnlyAtTheEnd) {
   Buffer x(4), y(4);
   x.bind(TS_TEST_SAXPY_X);
   y.bind(TS_TEST_SAXPY_Y);
-  saxpy.set("a", 1.0f);
-  saxpy.set("count", 1u);
+  ParamBlock<params::SaxpyParams> params;
+  params.values = {{1u, 0u, 0u, 0u}, {1.0f, 0.0f, 0.0f, 0.0f}};
+  params.bind(TS_TEST_PARAMS);
   Queue queue(/*timings=*/true);
   const HostSyncCounts before = host_sync_counts();
   const int kernels = 600;  // more than the 256 after which timers were once read mid-run

@@ -18,6 +18,7 @@
 #include "core/primitives.h"
 #include "gpu/context.h"
 #include "gpu/gl.h"
+#include "gpu/params.h"
 #include "sdf/host_field.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
@@ -53,12 +54,16 @@ class SparseFieldTest : public ::testing::Test {
     gpu::Program program = gpu::Program::compute(library, "test/sparse_field_probe.comp", defines);
     gpu::Buffer in = gpu::Buffer::from<Eigen::Vector4f>(points);
     gpu::Buffer out(points.size() * sizeof(Eigen::Vector4f));
-    field.bind(program, {TS_TEST_FIELD_GRID,
-                         {TS_TEST_FIELD_CHUNK_1, TS_TEST_FIELD_CHUNK_2, TS_TEST_FIELD_CHUNK_3, TS_TEST_FIELD_CHUNK_4,
-                          TS_TEST_FIELD_CHUNK_5, TS_TEST_FIELD_CHUNK_6, TS_TEST_FIELD_CHUNK_7}});
+    field.bind({TS_TEST_FIELD_GRID,
+                {TS_TEST_FIELD_CHUNK_1, TS_TEST_FIELD_CHUNK_2, TS_TEST_FIELD_CHUNK_3, TS_TEST_FIELD_CHUNK_4,
+                 TS_TEST_FIELD_CHUNK_5, TS_TEST_FIELD_CHUNK_6, TS_TEST_FIELD_CHUNK_7},
+                TS_TEST_FIELD_PARAMS});
     in.bind(TS_TEST_FIELD_POINTS);
     out.bind(TS_TEST_FIELD_VALUES);
-    program.set("count", static_cast<unsigned>(points.size()));
+    gpu::ParamBlock<gpu::params::FieldProbeParams> params;
+    params.values.count.x = static_cast<unsigned>(points.size());
+    params.values.mode.x = mode;
+    params.bind(TS_TEST_PARAMS);
     gpu::Queue queue(false, true);
     queue.dispatch_items(program, points.size(), GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     return out.read<Eigen::Vector4f>(points.size());
