@@ -44,14 +44,9 @@ std::vector<fs::path> replaced_with(const fs::path& json_path) {
           json_path.parent_path() / (name.substr(0, name.size() - kSuffix.size()) + ".particles.ply")};
 }
 
-// Writes `bytes` to a temporary path; a failed write names `target`.
-std::function<void(const fs::path&)> bytes_writer(const fs::path& target, const std::string& bytes) {
-  return [target, &bytes](const fs::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) throw InputError(target, "cannot write file (disk full or no permission?)");
-  };
+// Writes `bytes` into a replacement's checked stream (core/atomic_file.h reports a failed write).
+StreamWriter bytes_writer(const std::string& bytes) {
+  return [&bytes](std::ostream& out) { out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); };
 }
 
 // Which file a path names now (a replacement renames a new file over it): device and inode, or
@@ -228,7 +223,10 @@ void validate_for_writing(const fs::path& json_path, const ParticleBody& b) {
 
 Json parse_json(const fs::path& json_path) {
   try {
-    return Json::parse(read_file(json_path));
+    // body.json holds keys and a few small arrays; the particles are in the PLY beside it.
+    constexpr std::uint64_t kMostJsonBytes = std::uint64_t{64} << 20;
+    return Json::parse(
+        read_file(json_path, kMostJsonBytes, "a body.json holds keys; the particles are in its PLY"));
   } catch (const nlohmann::json::exception& e) {
     throw InputError(json_path, fmt::format("not valid JSON: {}", e.what()));
   }
@@ -408,8 +406,8 @@ fs::path write_body(const fs::path& dir, const std::string& name, const Particle
   // the new one.
   const std::string json_text = body_json(body, ply_name).dump(2) + "\n";
   const std::string ply_bytes = particles_ply_bytes(body.positions, body.normals);
-  write_files_atomically(journal_of(json_path), {{dir / ply_name, bytes_writer(dir / ply_name, ply_bytes)},
-                                                 {json_path, bytes_writer(json_path, json_text)}});
+  write_files_atomically(journal_of(json_path),
+                         {{dir / ply_name, bytes_writer(ply_bytes)}, {json_path, bytes_writer(json_text)}});
   return json_path;
 }
 

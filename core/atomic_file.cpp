@@ -9,11 +9,13 @@
 #include <cerrno>
 #include <charconv>
 #include <fstream>
-#include <random>
 #include <sstream>
 #include <system_error>
 
+#include "core/checked_output.h"
 #include "core/error.h"
+#include "core/input_file.h"
+#include "core/temporary_name.h"
 
 namespace ts {
 namespace fs = std::filesystem;
@@ -26,17 +28,10 @@ bool same_file(const fs::path& a, const fs::path& b) {
   return fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
 }
 
-// A temporary name in the target's directory, so the final rename never crosses file systems.
+// A temporary name in the target's directory, so the final rename never crosses file systems; it
+// carries this run's id (core/temporary_name.h), so a later clean-up removes it only once we are gone.
 fs::path temporary_sibling(const fs::path& target) {
-  std::random_device device;
-  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "." + std::string temporaries.
-  std::string name(".");
-  name.append(target.filename().string());
-  name.append(".tmp.");
-  name.append(std::to_string(::getpid()));
-  name.append(".");
-  name.append(std::to_string(device() & 0xffffff));
-  return target.parent_path() / name;
+  return target.parent_path() / format_temporary_name(temporary_name_for(target.filename().string()));
 }
 
 // Refuses `target` where it is one of `inputs` or a directory; makes the directory it goes in.
@@ -65,26 +60,23 @@ bool process_is_dead(long pid) {
   return pid > 0 && pid != ::getpid() && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
 }
 
-// The writer's process id in the temporary name `name` of `target` (".TARGET.tmp.PID.N"), or 0.
-long temporary_owner(const std::string& name, const fs::path& target) {
-  std::string prefix(".");  // piece by piece, as in temporary_sibling (GCC 12's -Wrestrict)
-  prefix.append(target.filename().string());
-  prefix.append(".tmp.");
-  if (!name.starts_with(prefix)) return 0;
-  long pid = 0;
-  const char* first = name.data() + prefix.size();
-  const auto [end, error] = std::from_chars(first, name.data() + name.size(), pid);
-  return error == std::errc() && end != first && *end == '.' ? pid : 0;
+// Removes the temporary files that dead processes left beside `target` (best effort: a directory
+// that cannot be changed keeps them). Only names that parse as ours are looked at.
+void remove_dead_temporaries_of(const fs::path& target) {
+  remove_dead_temporaries(directory_of(target), target.filename().string());
 }
 
-// Removes the temporary files that dead processes left beside `target` (best effort: a directory
-// that cannot be changed keeps them).
-void remove_dead_temporaries(const fs::path& target) {
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(directory_of(target), ec)) {
-    if (process_is_dead(temporary_owner(entry.path().filename().string(), target)))
-      fs::remove(entry.path(), ec);
+// Writes a temporary file through a checked stream: every write, the flush, fsync and close.
+void write_checked(const fs::path& tmp, const fs::path& target, const StreamWriter& write) {
+  CheckedOutputFile file(tmp, target);
+  try {
+    write(file.stream());
+  } catch (...) {
+    // A writer that saw the failed write itself (NanoVDB's does) reports it without the reason.
+    file.throw_if_failed();
+    throw;
   }
+  file.finish();
 }
 
 // A journal of write_files_atomically: its writer, then one line per file, "TMP\tTARGET" (names in
@@ -112,7 +104,8 @@ Journal parse_journal(const fs::path& path) {
   };
   if (!std::getline(in, line) || line != kJournalFirstLine) throw malformed();
   if (!std::getline(in, line) || !line.starts_with("pid ")) throw malformed();
-  journal.pid = std::atol(line.c_str() + 4);
+  const auto [end, error] = std::from_chars(line.data() + 4, line.data() + line.size(), journal.pid);
+  if (error != std::errc() || end != line.data() + line.size()) throw malformed();
   while (std::getline(in, line)) {
     const auto tab = line.find('\t');
     if (tab == std::string::npos || tab == 0 || tab + 1 == line.size()) throw malformed();
@@ -149,7 +142,7 @@ std::vector<std::pair<fs::path, fs::path>> write_temporaries(const std::vector<F
     for (const FileWrite& file : files) {
       renames.emplace_back(temporary_sibling(directory_of(file.target) / file.target.filename()),
                            file.target);
-      file.write(renames.back().first);
+      write_checked(renames.back().first, file.target, file.write);
     }
   } catch (...) {
     std::error_code ec;
@@ -175,8 +168,8 @@ bool complete_interrupted_writes(const fs::path& journal, const std::vector<fs::
     complete_journal(journal, pending);
     completed = true;
   }
-  remove_dead_temporaries(journal);
-  for (const fs::path& target : targets) remove_dead_temporaries(target);
+  remove_dead_temporaries_of(journal);
+  for (const fs::path& target : targets) remove_dead_temporaries_of(target);
   return completed;
 }
 
@@ -200,18 +193,23 @@ void write_files_atomically(const fs::path& journal, const std::vector<FileWrite
     }
     for (const auto& [tmp, target] : renames) fs::rename(tmp, target);
     fs::remove(journal);
+    sync_directory(directory_of(journal));
   } catch (const fs::filesystem_error& e) {
     cannot_write(targets.front(), e);
   }
 }
 
-void write_atomically(const fs::path& target, const std::function<void(const fs::path&)>& write,
-                      const std::vector<fs::path>& inputs) {
+namespace {
+
+// The shared part of write_atomically and write_stream_atomically: `produce(tmp)` writes and syncs the
+// temporary file; only then is it renamed over `target`, and the directory synced.
+void replace_with(const fs::path& target, const std::function<void(const fs::path&)>& produce,
+                  const std::vector<fs::path>& inputs) {
   prepare_target(target, inputs);
   std::error_code ec;
   const fs::path tmp = temporary_sibling(target.parent_path().empty() ? fs::path(".") / target : target);
   try {
-    write(tmp);
+    produce(tmp);
     fs::rename(tmp, target);
   } catch (const fs::filesystem_error& e) {
     // An unwritable place (read-only file system, no permission, no space) is the user's to fix.
@@ -221,30 +219,38 @@ void write_atomically(const fs::path& target, const std::function<void(const fs:
     fs::remove(tmp, ec);
     throw;
   }
+  sync_directory(directory_of(target));
 }
 
-void write_file_atomically(const fs::path& target, std::string_view contents,
-                           const std::vector<fs::path>& inputs) {
-  write_atomically(
+}  // namespace
+
+void write_atomically(const fs::path& target, const std::function<void(const fs::path&)>& write,
+                      const std::vector<fs::path>& inputs) {
+  replace_with(
       target,
       [&](const fs::path& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-        out.close();
-        if (!out) throw InputError(target, "cannot write file (disk full or no permission?)");
+        write(tmp);
+        sync_written_file(tmp, target);
       },
       inputs);
 }
 
-std::string read_file(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(path, "no such file");
-  if (fs::is_directory(path, ec)) throw InputError(path, "is a directory, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open file for reading (permission?)");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+void write_stream_atomically(const fs::path& target, const StreamWriter& write,
+                             const std::vector<fs::path>& inputs) {
+  replace_with(
+      target, [&](const fs::path& tmp) { write_checked(tmp, target, write); }, inputs);
+}
+
+void write_file_atomically(const fs::path& target, std::string_view contents,
+                           const std::vector<fs::path>& inputs) {
+  write_stream_atomically(
+      target,
+      [&](std::ostream& out) { out.write(contents.data(), static_cast<std::streamsize>(contents.size())); },
+      inputs);
+}
+
+std::string read_file(const fs::path& path, std::uint64_t max_bytes, std::string_view why) {
+  return read_regular_file(path, max_bytes, why);
 }
 
 std::string sha256_file(const fs::path& path) {

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -372,17 +373,11 @@ std::optional<std::uint64_t> buffer_bytes(const std::filesystem::path& path, con
 
 }  // namespace
 
-void check_gltf_json(const std::filesystem::path& path, std::string_view json,
-                     std::optional<std::uint64_t> glb_binary) {
-  const Json doc = Json::parse(json, nullptr, /*allow_exceptions=*/false);
-  if (doc.is_discarded()) throw InputError(path, "glTF: its JSON does not parse");
-  if (!doc.is_object()) throw InputError(path, "glTF: its JSON is not an object");
-  // glTF 1.0 (asset.version "1.x") has another layout; assimp's reader of it is left as it is.
-  if (doc.contains("asset") && doc["asset"].is_object() && doc["asset"].contains("version") &&
-      doc["asset"]["version"].is_string() && !doc["asset"]["version"].get<std::string>().starts_with("2"))
-    return;
-  const GltfChecker gltf(path, doc);
+namespace {
 
+// The declared length of every buffer, each checked against the bytes behind it.
+std::vector<std::uint64_t> check_buffers(const GltfChecker& gltf, const std::filesystem::path& path,
+                                         std::optional<std::uint64_t> glb_binary) {
   std::vector<std::uint64_t> buffer_lengths;
   for (std::size_t i = 0; i < gltf.array("buffers").size(); ++i) {
     const Json& buffer = gltf.array("buffers")[i];
@@ -393,11 +388,17 @@ void check_gltf_json(const std::filesystem::path& path, std::string_view json,
       gltf.fail(fmt::format("{} declares {} bytes; its data has {}", what, declared, *available));
     buffer_lengths.push_back(declared);
   }
+  return buffer_lengths;
+}
 
-  struct View {
-    std::uint64_t length;
-    std::optional<std::uint64_t> stride;
-  };
+struct View {
+  std::uint64_t length;
+  std::optional<std::uint64_t> stride;
+};
+
+// Every bufferView, checked to lie inside its buffer.
+std::vector<View> check_buffer_views(const GltfChecker& gltf,
+                                     const std::vector<std::uint64_t>& buffer_lengths) {
   std::vector<View> views;
   for (std::size_t i = 0; i < gltf.array("bufferViews").size(); ++i) {
     const Json& view = gltf.array("bufferViews")[i];
@@ -412,18 +413,46 @@ void check_gltf_json(const std::filesystem::path& path, std::string_view json,
     const std::uint64_t stride = gltf.number(view, "byteStride", what, 0);
     views.push_back({length, stride == 0 ? std::nullopt : std::optional<std::uint64_t>(stride)});
   }
+  return views;
+}
 
-  // Where assimp copies an accessor's elements from: `count` elements of `element` bytes, `stride`
-  // apart, from `offset` into a bufferView.
-  const auto check_span = [&](const std::string& what, std::uint64_t view, std::uint64_t offset, std::uint64_t count,
-                              std::uint64_t element, std::uint64_t stride) {
-    if (count == 0) return;
-    const long double end = static_cast<long double>(offset) + static_cast<long double>(count - 1) * stride + element;
-    if (end > views[view].length)
-      gltf.fail(fmt::format("{} reads {} elements of {} bytes, {} apart, from byte {} of bufferView {}: up to byte "
-                            "{}, past its {} bytes",
-                            what, count, element, stride, offset, view, end, views[view].length));
-  };
+// Where assimp copies an accessor's elements from: `count` elements of `element` bytes, `stride`
+// apart, from `offset` into bufferView `view`; all of it inside the view.
+void check_span(const GltfChecker& gltf, const std::vector<View>& views, const std::string& what,
+                std::uint64_t view, std::uint64_t offset, std::uint64_t count, std::uint64_t element,
+                std::uint64_t stride) {
+  if (count == 0) return;
+  const long double end =
+      static_cast<long double>(offset) + static_cast<long double>(count - 1) * stride + element;
+  if (end > views[view].length)
+    gltf.fail(
+        fmt::format("{} reads {} elements of {} bytes, {} apart, from byte {} of bufferView {}: up to byte "
+                    "{}, past its {} bytes",
+                    what, count, element, stride, offset, view, end, views[view].length));
+}
+
+// A sparse accessor's indices and values (elements of `element` bytes) inside their views.
+void check_sparse(const GltfChecker& gltf, const std::vector<View>& views, const Json& sparse,
+                  const std::string& what, std::uint64_t element) {
+  const std::string sparse_what = what + "'s sparse";
+  const std::uint64_t sparse_count = gltf.number(sparse, "count", sparse_what);
+  if (!sparse.contains("indices") || !sparse.contains("values"))
+    gltf.fail(sparse_what + " lacks indices or values");
+  const Json& indices = sparse["indices"];
+  const Json& values = sparse["values"];
+  const std::string indices_what = sparse_what + " indices";
+  const std::string values_what = sparse_what + " values";
+  const std::uint64_t index_bytes =
+      accessor_component_bytes(gltf, gltf.number(indices, "componentType", indices_what), indices_what);
+  const std::uint64_t index_view = gltf.index(indices, "bufferView", "bufferViews", indices_what);
+  check_span(gltf, views, indices_what, index_view, gltf.number(indices, "byteOffset", indices_what, 0),
+             sparse_count, index_bytes, index_bytes);
+  const std::uint64_t value_view = gltf.index(values, "bufferView", "bufferViews", values_what);
+  check_span(gltf, views, values_what, value_view, gltf.number(values, "byteOffset", values_what, 0),
+             sparse_count, element, element);
+}
+
+void check_accessors(const GltfChecker& gltf, const std::vector<View>& views) {
   for (std::size_t i = 0; i < gltf.array("accessors").size(); ++i) {
     const Json& accessor = gltf.array("accessors")[i];
     const std::string what = fmt::format("accessor {}", i);
@@ -432,52 +461,207 @@ void check_gltf_json(const std::filesystem::path& path, std::string_view json,
     const std::uint64_t count = gltf.number(accessor, "count", what);
     if (accessor.contains("bufferView")) {
       const std::uint64_t view = gltf.index(accessor, "bufferView", "bufferViews", what);
-      check_span(what, view, gltf.number(accessor, "byteOffset", what, 0), count, element,
+      check_span(gltf, views, what, view, gltf.number(accessor, "byteOffset", what, 0), count, element,
                  views[view].stride.value_or(element));
     }
-    if (accessor.contains("sparse")) {
-      const Json& sparse = accessor["sparse"];
-      const std::string sparse_what = what + "'s sparse";
-      const std::uint64_t sparse_count = gltf.number(sparse, "count", sparse_what);
-      if (!sparse.contains("indices") || !sparse.contains("values")) gltf.fail(sparse_what + " lacks indices or values");
-      const Json& indices = sparse["indices"];
-      const Json& values = sparse["values"];
-      const std::uint64_t index_bytes = accessor_component_bytes(
-          gltf, gltf.number(indices, "componentType", sparse_what + " indices"), sparse_what + " indices");
-      const std::uint64_t index_view = gltf.index(indices, "bufferView", "bufferViews", sparse_what + " indices");
-      check_span(sparse_what + " indices", index_view, gltf.number(indices, "byteOffset", sparse_what + " indices", 0),
-                 sparse_count, index_bytes, index_bytes);
-      const std::uint64_t value_view = gltf.index(values, "bufferView", "bufferViews", sparse_what + " values");
-      check_span(sparse_what + " values", value_view, gltf.number(values, "byteOffset", sparse_what + " values", 0),
-                 sparse_count,
-                 element, element);
-    }
+    if (accessor.contains("sparse")) check_sparse(gltf, views, accessor["sparse"], what, element);
   }
+}
 
-  // The accessors the meshes name exist.
+// One primitive of a mesh: the accessors it names exist, and it has positions.
+void check_primitive(const GltfChecker& gltf, const Json& primitive, const std::string& what) {
+  if (!primitive.is_object()) gltf.fail(what + " is not an object");
+  if (primitive.contains("indices")) gltf.index(primitive, "indices", "accessors", what);
+  // assimp's reader builds a primitive's faces on its positions: a line loop without them
+  // dereferenced a null vertex array (SIGSEGV, fuzz_mesh, 2026-12-06).
+  if (!primitive.contains("attributes") || !primitive["attributes"].is_object() ||
+      !primitive["attributes"].contains("POSITION"))
+    gltf.fail(what + " has no POSITION attribute: its faces would have no vertices");
+  std::vector<const Json*> attribute_sets{&primitive["attributes"]};
+  if (primitive.contains("targets") && primitive["targets"].is_array())
+    for (const Json& target : primitive["targets"]) attribute_sets.push_back(&target);
+  for (const Json* attributes : attribute_sets) {
+    if (!attributes->is_object()) gltf.fail(what + ": attributes are not an object");
+    for (const auto& [name, value] : attributes->items())
+      gltf.index_of(value, name, "accessors", what + " attribute " + name);
+  }
+}
+
+void check_meshes(const GltfChecker& gltf) {
   for (std::size_t m = 0; m < gltf.array("meshes").size(); ++m) {
     const Json& mesh = gltf.array("meshes")[m];
     if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
-    for (std::size_t p = 0; p < mesh["primitives"].size(); ++p) {
-      const Json& primitive = mesh["primitives"][p];
-      const std::string what = fmt::format("mesh {} primitive {}", m, p);
-      if (!primitive.is_object()) gltf.fail(what + " is not an object");
-      if (primitive.contains("indices")) gltf.index(primitive, "indices", "accessors", what);
-      // assimp's reader builds a primitive's faces on its positions: a line loop without them
-      // dereferenced a null vertex array (SIGSEGV, fuzz_mesh, 2026-12-06).
-      if (!primitive.contains("attributes") || !primitive["attributes"].is_object() ||
-          !primitive["attributes"].contains("POSITION"))
-        gltf.fail(what + " has no POSITION attribute: its faces would have no vertices");
-      std::vector<const Json*> attribute_sets;
-      if (primitive.contains("attributes")) attribute_sets.push_back(&primitive["attributes"]);
-      if (primitive.contains("targets") && primitive["targets"].is_array())
-        for (const Json& target : primitive["targets"]) attribute_sets.push_back(&target);
-      for (const Json* attributes : attribute_sets) {
-        if (!attributes->is_object()) gltf.fail(what + ": attributes are not an object");
-        for (const auto& [name, value] : attributes->items())
-          gltf.index_of(value, name, "accessors", what + " attribute " + name);
+    for (std::size_t p = 0; p < mesh["primitives"].size(); ++p)
+      check_primitive(gltf, mesh["primitives"][p], fmt::format("mesh {} primitive {}", m, p));
+  }
+}
+
+// The node graph is a forest (one parent at most, no cycle) of at most kMostNodes nodes and
+// kMostNodeDepth levels: assimp's glTF reader builds it recursively, and a chain of tens of thousands
+// of nodes overflowed its stack (SIGSEGV; issue 46). Iterative, linear in the nodes.
+void check_node_tree(const GltfChecker& gltf) {
+  const Json& nodes = gltf.array("nodes");
+  if (nodes.size() > kMostNodes)
+    gltf.fail(fmt::format("{} nodes; at most {} are read", nodes.size(), kMostNodes));
+  std::vector<std::int64_t> parent(nodes.size(), -1);
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const std::string what = fmt::format("node {}", i);
+    if (!nodes[i].is_object()) gltf.fail(what + " is not an object");
+    if (!nodes[i].contains("children")) continue;
+    if (!nodes[i]["children"].is_array()) gltf.fail(what + ": 'children' is not an array");
+    for (const Json& child : nodes[i]["children"]) {
+      const std::uint64_t c = gltf.index_of(child, "children", "nodes", what);
+      if (parent[c] >= 0 || c == i)
+        gltf.fail(fmt::format("node {} is a child of node {} and of node {}: the nodes do not form a tree", c,
+                              parent[c] >= 0 ? parent[c] : static_cast<std::int64_t>(i), i));
+      parent[c] = static_cast<std::int64_t>(i);
+    }
+  }
+  // Each node's depth: walk up to a node of known depth, then back down the path.
+  std::vector<std::size_t> depth(nodes.size(), 0);  // 0: not known yet
+  std::vector<std::size_t> path;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    path.clear();
+    std::int64_t at = static_cast<std::int64_t>(i);
+    while (at >= 0 && depth[static_cast<std::size_t>(at)] == 0) {
+      if (path.size() > nodes.size()) gltf.fail(fmt::format("node {} is its own ancestor", i));
+      path.push_back(static_cast<std::size_t>(at));
+      at = parent[static_cast<std::size_t>(at)];
+    }
+    std::size_t level = at >= 0 ? depth[static_cast<std::size_t>(at)] : 0;
+    for (auto it = path.rbegin(); it != path.rend(); ++it) depth[*it] = ++level;
+    if (level > kMostNodeDepth)
+      gltf.fail(fmt::format("the node tree is {} levels deep (node {}); at most {} are read", level, i,
+                            kMostNodeDepth));
+  }
+}
+
+}  // namespace
+
+void check_gltf_json(const std::filesystem::path& path, std::string_view json,
+                     std::optional<std::uint64_t> glb_binary) {
+  check_json_nesting(path, json);
+  const Json doc = Json::parse(json, nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded()) throw InputError(path, "glTF: its JSON does not parse");
+  if (!doc.is_object()) throw InputError(path, "glTF: its JSON is not an object");
+  // glTF 1.0 (asset.version "1.x") has another layout; assimp's reader of it is left as it is.
+  if (doc.contains("asset") && doc["asset"].is_object() && doc["asset"].contains("version") &&
+      doc["asset"]["version"].is_string() && !doc["asset"]["version"].get<std::string>().starts_with("2"))
+    return;
+  const GltfChecker gltf(path, doc);
+  const std::vector<View> views = check_buffer_views(gltf, check_buffers(gltf, path, glb_binary));
+  check_accessors(gltf, views);
+  check_meshes(gltf);
+  check_node_tree(gltf);
+}
+
+void check_json_nesting(const std::filesystem::path& path, std::string_view json) {
+  std::size_t depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;  // the escaped character, a quote included
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMostNesting)
+        throw InputError(path,
+                         fmt::format("its JSON nests arrays and objects more than {} deep", kMostNesting));
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+}
+
+namespace {
+
+// Past the markup construct that starts at `at` ("<!--", "<?", "<![CDATA[", "<!DOCTYPE ...[...]>"):
+// the index of its last character, or the text's end when it is not closed.
+std::size_t skip_markup(std::string_view xml, std::size_t at) {
+  const auto past = [&](std::string_view end) {
+    const std::size_t found = xml.find(end, at);
+    return found == std::string_view::npos ? xml.size() : found + end.size() - 1;
+  };
+  if (xml.substr(at).starts_with("<!--")) return past("-->");
+  if (xml.substr(at).starts_with("<![CDATA[")) return past("]]>");
+  if (xml.substr(at).starts_with("<?")) return past("?>");
+  // A declaration; its internal subset (between [ and ]) may hold '>'.
+  int brackets = 0;
+  for (std::size_t i = at + 2; i < xml.size(); ++i) {
+    if (xml[i] == '[') {
+      ++brackets;
+    } else if (xml[i] == ']') {
+      --brackets;
+    } else if (xml[i] == '>' && brackets <= 0) {
+      return i;
+    }
+  }
+  return xml.size();
+}
+
+// The end ('>') of the tag that starts at `at`, past quoted attribute values.
+std::size_t tag_end(std::string_view xml, std::size_t at) {
+  char quote = 0;
+  for (std::size_t i = at + 1; i < xml.size(); ++i) {
+    if (quote) {
+      if (xml[i] == quote) quote = 0;
+    } else if (xml[i] == '"' || xml[i] == '\'') {
+      quote = xml[i];
+    } else if (xml[i] == '>') {
+      return i;
+    }
+  }
+  return xml.size();
+}
+
+// A tag's element name without its namespace prefix ("node" of "<dae:node id='a'>").
+std::string_view local_name(std::string_view xml, std::size_t at, std::size_t end) {
+  std::size_t stop = at + 1;
+  while (stop < end && xml[stop] != '/' && !std::isspace(static_cast<unsigned char>(xml[stop]))) ++stop;
+  std::string_view name = xml.substr(at + 1, stop - at - 1);
+  const std::size_t colon = name.rfind(':');
+  return colon == std::string_view::npos ? name : name.substr(colon + 1);
+}
+
+}  // namespace
+
+void check_xml_nesting(const std::filesystem::path& path, std::string_view xml) {
+  std::vector<bool> open_is_node;  // one entry per open element, at most kMostNesting
+  std::size_t node_depth = 0, nodes = 0;
+  for (std::size_t i = xml.find('<'); i < xml.size(); i = xml.find('<', i + 1)) {
+    if (i + 1 >= xml.size()) break;
+    if (xml[i + 1] == '!' || xml[i + 1] == '?') {
+      i = skip_markup(xml, i);
+      continue;
+    }
+    const std::size_t end = tag_end(xml, i);
+    if (end >= xml.size()) break;  // unclosed: the parser reports it
+    if (xml[i + 1] == '/') {
+      if (!open_is_node.empty()) {
+        node_depth -= open_is_node.back() ? 1 : 0;
+        open_is_node.pop_back();
+      }
+    } else {
+      const bool is_node = local_name(xml, i, end) == "node";
+      if (is_node && ++nodes > kMostNodes)
+        throw InputError(
+            path, fmt::format("more than {} <node> elements; at most {} are read", kMostNodes, kMostNodes));
+      if (xml[end - 1] != '/') {
+        open_is_node.push_back(is_node);
+        node_depth += is_node ? 1 : 0;
+        if (node_depth > kMostNodeDepth)
+          throw InputError(path, fmt::format("<node> elements nest more than {} deep; at most {} are read",
+                                             kMostNodeDepth, kMostNodeDepth));
+        if (open_is_node.size() > kMostNesting)
+          throw InputError(path, fmt::format("its XML elements nest more than {} deep", kMostNesting));
       }
     }
+    i = end;
   }
 }
 

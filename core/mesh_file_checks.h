@@ -5,12 +5,21 @@
 // clamped or replaced, so a broken file loads as a plausible but wrong mesh. These checks stream
 // through the file (a PLY through the one PLY parser, core/ply.h), never trusting a declared count
 // for an allocation, and throw ts::InputError naming the file, the line (text files) and the problem.
-#include <filesystem>
+#include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string_view>
 
 namespace ts::detail {
+
+// Node trees are read to this depth and this many nodes: assimp's readers and the flattening of
+// core/mesh_io.cpp recurse once per level, and a tree tens of thousands of levels deep overflowed
+// assimp's stack before any check of the imported scene could run (issue 46).
+inline constexpr std::size_t kMostNodeDepth = 1000;
+inline constexpr std::size_t kMostNodes = 100000;
+// JSON and XML nest at most this deep (assimp's JSON and XML readers recurse per level too).
+inline constexpr std::size_t kMostNesting = 2000;
 
 // `text` is the whole file. Accepts OFF, COFF, NOFF, CNOFF (extra per-vertex values are ignored).
 void check_off_file(const std::filesystem::path& path, std::string_view text);
@@ -31,7 +40,16 @@ void check_glb_file(const std::filesystem::path& path, std::string_view bytes);
 // buffer, and every accessor (sparse ones too) reads only inside its bufferView. An accessor 5 bytes
 // past its view made assimp read past the BIN chunk's block (fuzz_mesh, 2026-12-05). The indices the
 // meshes name exist, and every primitive has positions. glTF 1.0 documents are left to assimp.
+// Then the node graph: a forest of at most kMostNodes nodes and kMostNodeDepth levels.
 void check_gltf_json(const std::filesystem::path& path, std::string_view json,
                      std::optional<std::uint64_t> glb_binary = std::nullopt);
+
+// A streaming pass over JSON text: arrays and objects nest at most kMostNesting deep (before any
+// parser that recurses sees it).
+void check_json_nesting(const std::filesystem::path& path, std::string_view json);
+
+// A streaming pass over an XML document (Collada and assimp's other XML formats): elements nest at
+// most kMostNesting deep, <node> elements at most kMostNodeDepth deep and kMostNodes in all.
+void check_xml_nesting(const std::filesystem::path& path, std::string_view xml);
 
 }  // namespace ts::detail

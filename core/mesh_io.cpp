@@ -15,6 +15,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 #include "core/mesh_file_checks.h"
 
 namespace ts {
@@ -22,11 +23,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Only a regular file reaches assimp: a FIFO blocked it forever, a device like /dev/zero it read
+// without end (core/input_file.h).
 void check_readable_file(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(path, "no such file");
-  if (fs::is_directory(path, ec)) throw InputError(path, "is a directory, not a mesh file");
-  if (fs::file_size(path, ec) == 0) throw InputError(path, "is empty");
+  if (require_regular_file(path) == 0) throw InputError(path, "is empty");
   std::ifstream probe(path, std::ios::binary);
   if (!probe) throw InputError(path, "cannot be opened for reading (permission?)");
 }
@@ -59,14 +59,24 @@ bool starts_as_off(std::string_view bytes) { return lowercase(std::string(bytes.
 // assimp's PLY reader unchecked and hung it (fuzz_mesh, 2026-12-04), and an OFF named .glb its OFF
 // reader (2026-12-05: a crash, and 48 GB asked for). A file named .glb that is no binary glTF is
 // refused outright: any of assimp's forty readers could claim it.
+// An XML document (Collada, X3D, AMF, ...): its first character past a byte order mark and white
+// space is '<'.
+bool starts_as_xml(std::string_view bytes) {
+  if (bytes.starts_with("\xEF\xBB\xBF")) bytes.remove_prefix(3);
+  const std::size_t first = bytes.find_first_not_of(" \t\r\n");
+  return first != std::string_view::npos && bytes[first] == '<';
+}
+
 void check_before_assimp(const fs::path& path) {
   const std::string ext = lowercase_extension(path);
-  const std::string start = file_start(path, 8);
+  const std::string start = file_start(path, 64);
   const bool ply_content = starts_as_ply(start);
   const bool off_content = starts_as_off(start);
   const bool glb_content = start.starts_with("glTF");  // binary glTF's magic, whatever the name
+  // Collada and the other XML formats: their node trees nest as elements (check_xml_nesting).
+  const bool xml_content = starts_as_xml(start) || ext == ".dae";
   if (ext != ".off" && ext != ".ply" && ext != ".gltf" && ext != ".glb" && !ply_content && !off_content &&
-      !glb_content)
+      !glb_content && !xml_content)
     return;
   const std::string bytes = read_file(path);
   if (glb_content) {
@@ -77,6 +87,8 @@ void check_before_assimp(const fs::path& path) {
     detail::check_off_file(path, bytes);
   } else if (ext == ".gltf") {
     detail::check_gltf_json(path, bytes);
+  } else if (xml_content) {
+    detail::check_xml_nesting(path, bytes);
   }
   if (ext == ".glb" && !glb_content)
     throw InputError(path, "is named .glb but is not a binary glTF file (it does not start with 'glTF')");
@@ -132,9 +144,9 @@ void check_mesh_before_post_processing(
 
 // Nodes name meshes that exist, and the graph is a tree of bounded depth (the flattening recurses).
 void check_nodes(const fs::path& path, const aiScene& scene, const aiNode& node, unsigned depth) {
-  constexpr unsigned kMaxDepth = 1000;
-  if (depth > kMaxDepth)
-    throw InputError(path, fmt::format("the node hierarchy is deeper than {} levels", kMaxDepth));
+  if (depth > detail::kMostNodeDepth)
+    throw InputError(path,
+                     fmt::format("the node hierarchy is deeper than {} levels", detail::kMostNodeDepth));
   for (unsigned k = 0; k < node.mNumMeshes; ++k) {
     if (!node.mMeshes || node.mMeshes[k] >= scene.mNumMeshes) {
       throw InputError(path,

@@ -23,6 +23,9 @@ struct MeshReport {
   std::size_t components = 0;              // connected through shared vertices
   std::size_t self_intersecting_pairs = 0;  // triangle pairs that cross (CGAL exact predicates)
   bool self_intersections_exact = true;    // false: degenerate triangles of non-manifold input not tested
+  // Triangle pairs of a non-manifold soup whose boxes overlap, each tested exactly: the work of that
+  // check (a repeated triangle is tested once, so copies add none). Not printed.
+  std::size_t self_intersection_candidates = 0;
   double area = 0;                         // m^2
   double signed_volume = 0;                // m^3; negative: inside out
   Aabb box;

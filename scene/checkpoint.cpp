@@ -4,17 +4,16 @@
 
 #include <fmt/format.h>
 #include <openssl/evp.h>
-#include <signal.h>
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <regex>
 #include <type_traits>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/temporary_name.h"
 
 namespace ts::scene {
 namespace fs = std::filesystem;
@@ -85,16 +84,9 @@ std::vector<std::pair<std::int64_t, fs::path>> list_checkpoints(const fs::path& 
 }  // namespace
 
 void remove_stale_temporaries(const fs::path& dir) {
-  static const std::regex name(R"(\..+\.tmp\.(\d+)\.\d+)");
-  std::error_code ec;
-  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
-    std::smatch m;
-    const std::string base = e.path().filename().string();
-    if (!std::regex_match(base, m, name)) continue;
-    const long pid = std::stol(m[1].str());
-    const bool alive = ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
-    if (!alive) fs::remove(e.path(), ec);
-  }
+  // Only names that are exactly a temporary name of core/temporary_name.h, of a writer that is gone:
+  // a user's look-alike file in the folder is never touched.
+  remove_dead_temporaries(dir);
 }
 
 namespace {

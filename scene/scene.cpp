@@ -737,7 +737,12 @@ Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
   return read_scene(table, file);
 }
 
-Scene load_scene(const std::filesystem::path& file) { return parse_scene(read_file(file), file); }
+Scene load_scene(const std::filesystem::path& file) {
+  // A scene is a text of keys (the largest bundled one is a few kB); the bound refuses a huge file
+  // at once instead of reading it (a device or a FIFO is refused by read_file).
+  constexpr std::uint64_t kMostSceneBytes = std::uint64_t{64} << 20;
+  return parse_scene(read_file(file, kMostSceneBytes, "a scene file is a text of keys"), file);
+}
 
 std::string scene_location(const Scene& scene, std::string_view key, int line) {
   if (line == 0) {

@@ -36,6 +36,16 @@ void check_lattice(const Scene& scene, const Emitter& e, double sites, std::stri
 }
 
 void check_emitter(const Scene& scene, const Emitter& e, double bound) {
+  // The lattice is bounded before any loop over it: a grain radius of 1e308 made its spacing infinite,
+  // the site counts below 0, and a column's layer loop never ended (issue 46).
+  if (!(bound > 0) || !std::isfinite(lattice_spacing(bound))) {
+    fail(scene, e.line, "emitter",
+         fmt::format(
+             "its largest grain is {:.3g} m in bounding radius (the [grain] radius and edge times the size "
+             "scale), so its lattice spacing (2.2 times that) is not a finite length; every size must be "
+             "finite and positive",
+             bound));
+  }
   const double particles = 4.0 * static_cast<double>(e.count);
   if (particles > kMaxParticles) {
     fail(scene, e.line, "emitter.count",

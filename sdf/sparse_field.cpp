@@ -139,11 +139,12 @@ void SparseField::bind(const FieldSlots& slots) const {
 }
 
 void write_nvdb(const std::filesystem::path& file, const NanoGrid& grid, const std::vector<std::filesystem::path>& inputs) {
-  write_atomically(
+  // Through the checked stream of core/atomic_file.h: NanoVDB's writer by name never checks its writes.
+  write_stream_atomically(
       file,
-      [&](const std::filesystem::path& tmp) {
+      [&](std::ostream& out) {
         try {
-          nanovdb::io::writeGrid(tmp.string(), grid, nanovdb::io::Codec::NONE);
+          nanovdb::io::writeGrid(out, grid, nanovdb::io::Codec::NONE);
         } catch (const std::exception& e) {
           throw InputError(file, fmt::format("cannot write the NanoVDB file: {}", e.what()));
         }

@@ -21,6 +21,7 @@
 #include "core/allocation_cap.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 #include "sdf/vdb_layout.h"
 
 namespace ts::sdf {
@@ -39,6 +40,16 @@ std::string openvdb_problem(const std::string& message) {
   return out;
 }
 
+// What openvdb::io::File::write writes (a seekable archive: grid offsets in the descriptors), but into
+// a stream of ours: File opens a std::ofstream it never checks after writing, so a full disk left a
+// truncated .vdb that was renamed over a good one (issue 46). core/atomic_file.h checks this stream.
+class SeekableStreamArchive : public openvdb::io::Archive {
+ public:
+  void write_to(std::ostream& out, const openvdb::GridPtrVec& grids) const {
+    Archive::write(out, grids, /*seekable=*/true);
+  }
+};
+
 }  // namespace
 
 void write_vdb(const std::filesystem::path& path, const openvdb::FloatGrid::Ptr& grid,
@@ -46,14 +57,11 @@ void write_vdb(const std::filesystem::path& path, const openvdb::FloatGrid::Ptr&
                const std::vector<std::filesystem::path>& inputs) {
   ensure_openvdb_initialized();
   for (const auto& [key, value] : metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
-  write_atomically(
+  write_stream_atomically(
       path,
-      [&](const std::filesystem::path& tmp) {
+      [&](std::ostream& out) {
         try {
-          openvdb::io::File file(tmp.string());
-          openvdb::GridPtrVec grids{grid};
-          file.write(grids);
-          file.close();
+          SeekableStreamArchive().write_to(out, openvdb::GridPtrVec{grid});
         } catch (const openvdb::IoError& e) {  // the place is not writable (permission, space)
           throw InputError(path, std::string("cannot write file (") + e.what() + ")");
         }
@@ -72,6 +80,7 @@ openvdb::GridPtrVecPtr detail::read_grids_in_this_process(const std::filesystem:
                                                           UncheckedGrids unchecked) {
   // Every length, count and chunk OpenVDB's reader would trust, compared with the file first: the
   // reader overruns its buffers on some broken files (fuzz/findings/README.md).
+  require_regular_file(path);  // also for the fuzz target, which calls this directly
   const VdbLayout layout = check_vdb_layout(path);
   if (!layout.complete() && unchecked == UncheckedGrids::Refuse)
     throw InputError(path, "holds " + layout.unchecked + ", whose layout tetrasand's check does not cover");
@@ -182,9 +191,8 @@ struct Pipe {
 
 openvdb::FloatGrid::Ptr read_level_set(const std::filesystem::path& path) {
   ensure_openvdb_initialized();
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such file");
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory, not a .vdb file");
+  // A FIFO or a device would block or never end in the layout walk and in OpenVDB's reader.
+  require_regular_file(path);
   // OpenVDB's reader is run on the file in a child process: some broken files make it write past
   // its buffers (fuzz/findings/: a segmentation fault in Release), which must not corrupt or end
   // this process. The child streams back what it read as OpenVDB itself writes it, a stream whose

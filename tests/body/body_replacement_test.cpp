@@ -18,6 +18,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/mass_properties.h"
+#include "core/temporary_name.h"
 #include "tests/body/test_bodies.h"
 #include "tests/input_error.h"
 #include "tests/test_meshes.h"
@@ -185,8 +186,8 @@ TEST(BodyReplacement, ADeadWritersPublishedJournalIsCompletedByTheNextWrite) {
   const pid_t dead = ::fork();
   if (dead == 0) ::_exit(0);
   ::waitpid(dead, nullptr, 0);
-  const std::string tmp_ply = fmt::format(".b.particles.ply.tmp.{}.7", dead);
-  const std::string tmp_json = fmt::format(".b.body.json.tmp.{}.8", dead);
+  const std::string tmp_ply = format_temporary_name({"b.particles.ply", dead, 0, 7});
+  const std::string tmp_json = format_temporary_name({"b.body.json", dead, 0, 8});
   const fs::path other = test::temp_dir();
   write_body(other, "b", random_body(300, 2));
   fs::copy_file(other / "b.particles.ply", dir / tmp_ply);
@@ -204,12 +205,13 @@ TEST(BodyReplacement, StaleTemporaryFilesOfADeadProcessAreRemovedByTheNextRun) {
   const pid_t dead = ::fork();
   if (dead == 0) ::_exit(0);
   ::waitpid(dead, nullptr, 0);
-  write_bytes(dir / fmt::format(".b.particles.ply.tmp.{}.1", dead), "half a file");
-  write_bytes(dir / fmt::format(".b.body.json.tmp.{}.2", dead), "{");
+  write_bytes(dir / format_temporary_name({"b.particles.ply", dead, 0, 1}), "half a file");
+  write_bytes(dir / format_temporary_name({"b.body.json", dead, 0, 2}), "{");
   // The journal's own temporary file (write_atomically's name for ".b.body.json.journal").
-  write_bytes(dir / fmt::format("..b.body.json.journal.tmp.{}.3", dead), "tetrasand jou");
+  write_bytes(dir / format_temporary_name({".b.body.json.journal", dead, 0, 3}), "tetrasand jou");
   // Another live process's temporary file (this one's parent: alive) stays.
-  const std::string live = fmt::format(".b.body.json.tmp.{}.4", ::getppid());
+  const std::string live =
+      format_temporary_name({"b.body.json", ::getppid(), process_start_time(::getppid()), 4});
   write_bytes(dir / live, "{");
   write_body(dir, "b", random_body(100, 1));
   std::vector<std::string> names;

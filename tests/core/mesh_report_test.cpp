@@ -1,13 +1,36 @@
 #include "core/mesh_report.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <string>
+
+#include "core/atomic_file.h"
 #include "core/mesh_io.h"
 #include "core/primitives.h"
 #include "tests/test_support.h"
 
 namespace ts {
 namespace {
+
+// A glTF whose `copies` nodes all place the same unit cube (8 positions, 12 triangles) at the origin.
+std::string instanced_cube_gltf(int copies) {
+  std::string nodes, roots;
+  for (int i = 0; i < copies; ++i) {
+    nodes += i ? ",{\"mesh\":0}" : "{\"mesh\":0}";
+    roots += i ? "," : "";
+    roots += std::to_string(i);
+  }
+  return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[)" + roots + R"(]}],"nodes":[)" + nodes +
+         R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"accessors":[)"
+         R"({"bufferView":0,"componentType":5126,"count":8,"type":"VEC3","min":[0,0,0],"max":[1,1,1]},)"
+         R"({"bufferView":1,"componentType":5123,"count":36,"type":"SCALAR"}],)"
+         R"("bufferViews":[{"buffer":0,"byteLength":96},{"buffer":0,"byteOffset":96,"byteLength":72}],)"
+         R"("buffers":[{"byteLength":168,"uri":"data:application/octet-stream;base64,)"
+         R"(AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAIA/AACAPwAAAAAAAIA/)"
+         R"(AACAPwAAgD8AAIA/AAAAAAAAgD8AAIA/AAACAAEAAAADAAIABAAFAAYABAAGAAcAAAABAAUAAAAFAAQAAQACAAYAAQAGAAUA)"
+         R"(AgADAAcAAgAHAAYAAwAAAAQAAwAEAAcA"}]})";
+}
 
 TEST(MeshReport, GeneratedAssetsAreWatertightAndOutward) {
   for (const char* name : {"sphere.obj", "cube.obj", "torus.obj", "trefoil.obj", "plate.obj", "bunny.obj"}) {
@@ -187,6 +210,32 @@ TEST(MeshReport, JsonCarriesTheCounts) {
   EXPECT_EQ(json["triangles"], 12);
   EXPECT_EQ(json["watertight"], true);
   EXPECT_EQ(json["genus"], 0);
+}
+
+// Repeated triangles cost the checks no more than linear work: the self-intersection pass tests each
+// distinct triangle once. Before, a glTF instancing one cube 4000 times took 54 s (every copy's box
+// against every other's: quadratic). The sweep counts the pairs tested exactly, not seconds.
+TEST(MeshReport, RepeatedTrianglesAreCheckedInLinearWork) {
+  const auto dir = test::temp_dir();
+  std::size_t candidates_small = 0;
+  for (const int copies : {250, 2000}) {
+    const auto file = dir / fmt::format("cubes{}.gltf", copies);
+    write_file_atomically(file, instanced_cube_gltf(copies));
+    const TriangleMesh mesh = load_mesh(file);
+    ASSERT_EQ(mesh.triangle_count(), 12u * copies);
+    const MeshReport r = analyze_mesh(mesh);
+    EXPECT_EQ(r.duplicate_triangles, 12u * (copies - 1));
+    EXPECT_EQ(r.self_intersecting_pairs, 0u);
+    EXPECT_GT(r.self_intersection_candidates, 0u);  // the pass ran (the copies make the cube non-manifold)
+    if (copies == 250) {
+      candidates_small = r.self_intersection_candidates;
+    } else {
+      // 8 times the triangles: linear work grows 8 times at most, quadratic 64 times; n^1.5 is 22.6.
+      EXPECT_LT(static_cast<double>(r.self_intersection_candidates),
+                22.6 * static_cast<double>(candidates_small))
+          << candidates_small << " pairs for 250 copies";
+    }
+  }
 }
 
 }  // namespace
