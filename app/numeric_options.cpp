@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <limits>
 
+#include "core/checked_values.h"
+
 namespace ts::app {
 namespace detail {
 
@@ -15,7 +17,8 @@ std::optional<std::string> number_problem(const std::string& text, double lo, do
   errno = 0;
   const double value = std::strtod(text.c_str(), &end);
   if (text.empty() || end != text.c_str() + text.size()) return std::nullopt;
-  if (!std::isfinite(value)) return fmt::format("'{}' is not a finite number", text);
+  // The same finiteness check as every scene, body and checkpoint value (core/checked_values.h).
+  if (!finite_problem(value).empty()) return fmt::format("'{}' is not a finite number", text);
   const bool below = lo_open ? !(value > lo) : !(value >= lo);
   if (!below && value <= hi) return std::string();
   const std::string upper = hi == std::numeric_limits<double>::max() ? "" : fmt::format(" and <= {:g}", hi);

@@ -9,21 +9,40 @@
 #include <numbers>
 #include <optional>
 #include <set>
+#include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "core/atomic_file.h"
+#include "core/checked_values.h"
 #include "core/error.h"
-#include "sim/grain.h"
 #include "scene/grain_mix.h"
 #include "scene/scene_runner.h"
 #include "scene/scene_world.h"
+#include "sim/grain.h"
 
 namespace ts::exporter {
 namespace {
 
 namespace fs = std::filesystem;
 
-// Round-trip precision for every number LAMMPS reads back.
-std::string num(double v) { return fmt::format("{:.17g}", v); }
+// A number the deck would hold that is not finite: LAMMPS cannot read `inf` or `-nan` back, and
+// `sim` refuses the same values. Thrown by num() while a file's text is built; write_deck() turns
+// it into a refusal naming the file, before anything is written.
+class NonFiniteNumber : public std::runtime_error {
+ public:
+  explicit NonFiniteNumber(double value) : std::runtime_error(finite_problem(value)), value_(value) {}
+  double value() const { return value_; }
+
+ private:
+  double value_;
+};
+
+// Round-trip precision for every number LAMMPS reads back; every one passes the value checker.
+std::string num(double v) {
+  if (!finite_problem(v).empty()) throw NonFiniteNumber(v);
+  return fmt::format("{:.17g}", v);
+}
 std::string vec(const Eigen::Vector3d& v) { return fmt::format("{} {} {}", num(v.x()), num(v.y()), num(v.z())); }
 
 [[noreturn]] void refuse(const Scene& scene, const std::string& what) {
@@ -800,14 +819,10 @@ double lammps_restitution_for_alpha(double alpha) {
 
 namespace {
 
-LammpsDeck write_deck(const DeckPlan& plan, const fs::path& dir) {
+// The deck's files by name, their text built whole before any is written.
+std::vector<std::pair<std::string, std::string>> deck_texts(const DeckPlan& plan, const LammpsDeck& deck) {
   const Scene& scene = plan.scene;
-  LammpsDeck deck;
-  deck.dt = plan.dt;
-  deck.steps = plan.steps;
-  deck.dynamic_bodies = plan.dynamic_count;
-  deck.frozen_particles = plan.frozen_particles;
-  deck.approximations = approximations(plan);
+  std::vector<std::pair<std::string, std::string>> texts;
   Script in;
   header_section(plan, deck.approximations, in);
   setup_section(plan, in);
@@ -816,23 +831,45 @@ LammpsDeck write_deck(const DeckPlan& plan, const fs::path& dir) {
   walls_section(plan, in);
   output_section(plan, in);
   run_section(plan, in);
-
-  fs::create_directories(dir);
-  const std::vector<fs::path> inputs{scene.file};
-  deck.input = dir / "in.tetrasand";
-  write_file_atomically(dir / "data.tetrasand",
-                        data_file(plan.world, plan.mol, plan.body_type, plan.types.size(), plan.box, plan.state != nullptr),
-                        inputs);
-  write_file_atomically(dir / "bodies.rigid", bodies_file(plan.world, plan.mol, plan.rigid_count), inputs);
-  write_file_atomically(deck.input, in.text(), inputs);
-  deck.files = {deck.input, dir / "data.tetrasand", dir / "bodies.rigid"};
+  // The input script after the files it reads, as a deck is complete once its script is there.
+  texts.emplace_back("data.tetrasand", data_file(plan.world, plan.mol, plan.body_type, plan.types.size(),
+                                                 plan.box, plan.state != nullptr));
+  texts.emplace_back("bodies.rigid", bodies_file(plan.world, plan.mol, plan.rigid_count));
+  texts.emplace_back("in.tetrasand", in.text());
   const std::vector<std::string> files = template_files(plan);
   for (std::size_t k = 0; k < files.size(); ++k) {
     const GrainTemplate& t = k < plan.templates.size() ? plan.templates[k] : GrainTemplate{0, 1.0};
-    write_file_atomically(dir / files[k],
-                          molecule_file(scaled_grain(scene, t.type, t.scale), scene.grains[t.type].material),
-                          inputs);
-    deck.files.push_back(dir / files[k]);
+    texts.emplace_back(files[k],
+                       molecule_file(scaled_grain(scene, t.type, t.scale), scene.grains[t.type].material));
+  }
+  return texts;
+}
+
+LammpsDeck write_deck(const DeckPlan& plan, const fs::path& dir) {
+  const Scene& scene = plan.scene;
+  LammpsDeck deck;
+  deck.dt = plan.dt;
+  deck.steps = plan.steps;
+  deck.dynamic_bodies = plan.dynamic_count;
+  deck.frozen_particles = plan.frozen_particles;
+  deck.approximations = approximations(plan);
+  std::vector<std::pair<std::string, std::string>> texts;
+  try {
+    texts = deck_texts(plan, deck);
+  } catch (const NonFiniteNumber& e) {
+    refuse(scene,
+           fmt::format("the deck would hold the non-finite number {} (a value of the scene or state, or "
+                       "the arithmetic on it, overflows: give finite values of a size the scene's "
+                       "checks accept, as `tetrasand sim` requires)",
+                       e.value()));
+  }
+  fs::create_directories(dir);
+  const std::vector<fs::path> inputs{scene.file};
+  deck.input = dir / "in.tetrasand";
+  deck.files = {deck.input, dir / "data.tetrasand", dir / "bodies.rigid"};
+  for (const auto& [name, text] : texts) {
+    write_file_atomically(dir / name, text, inputs);
+    if (name.ends_with(".mol")) deck.files.push_back(dir / name);
   }
   return deck;
 }

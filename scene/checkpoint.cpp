@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "core/atomic_file.h"
+#include "core/checked_values.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/temporary_name.h"
@@ -140,6 +141,12 @@ RunState read_payload(ByteReader& r) {
   s.engine_state = r.get_string();
   if (!r.done()) r.fail("bytes left after the state");
   if (s.step < 0 || s.stretch_end < s.step || s.frames < 1) r.fail("inconsistent step counters");
+  // The same checks as a fresh scene's dt and duration: finite, > 0, and at least one step.
+  try {
+    checked_step_count(s.duration, s.dt, Where{});
+  } catch (const InputError& e) {
+    r.fail(fmt::format("dt and duration: {}", e.what()));
+  }
   return s;
 }
 

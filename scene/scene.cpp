@@ -15,6 +15,7 @@
 #include <toml++/toml.h>
 
 #include "core/atomic_file.h"
+#include "core/checked_values.h"
 #include "core/error.h"
 
 namespace ts::scene {
@@ -167,10 +168,25 @@ class TableReader {
     if (!v && !fallback) missing(key);
     return v ? *v : *fallback;
   }
+  // Where a key's value lies, for the value checker (core/checked_values.h).
+  Where where(std::string_view key) const {
+    const toml::node* n = key.empty() ? nullptr : table_.get(key);
+    return Where{file_.string(), n ? line_of(*n) : line_of(table_), key.empty() ? path_ : qualified(key)};
+  }
   Eigen::Vector3d unit_vector(std::string_view key, const Eigen::Vector3d& fallback) {
     const Eigen::Vector3d v = vector<3>(key, fallback);
     if (v.norm() < 1e-12) fail(key, "must not be the zero vector");
-    return v.normalized();
+    return checked_unit_vector(v, where(key));
+  }
+  // A velocity (m/s), zero when absent.
+  Eigen::Vector3d velocity(std::string_view key) {
+    return checked_velocity(vector<3>(key, Eigen::Vector3d::Zero()), where(key));
+  }
+  // An orientation [w, x, y, z], identity when absent.
+  Eigen::Quaterniond quaternion(std::string_view key) {
+    const Eigen::Vector4d q = vector<4>(key, Eigen::Vector4d(1, 0, 0, 0));
+    if (q.norm() < 1e-12) fail(key, "quaternion [w, x, y, z] must not be zero");
+    return checked_quaternion(q, where(key));
   }
 
   // Rejects keys nobody asked for: a typo must not be silently ignored.
@@ -401,7 +417,7 @@ void read_emitter(const toml::table& t, const fs::path& file, Scene& scene) {
   e.line = line_of(t);
   e.type = static_cast<EmitterType>(r.choice("type", {"fill", "pour", "column"}, std::nullopt));
   e.count = static_cast<std::size_t>(r.integer("count", std::nullopt, 1));
-  e.velocity = r.vector<3>("velocity", Eigen::Vector3d::Zero());
+  e.velocity = r.velocity("velocity");
   e.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0));
   read_emitter_grains(r, scene, e);
   read_size(r, file, e);
@@ -444,9 +460,7 @@ void read_keyframes(TableReader& prop, const fs::path& file, Prop& p) {
                                  "time once", k.time, p.keyframes.back().time));
     }
     k.position = r.vector<3>("position", std::nullopt);
-    const Eigen::Vector4d q = r.vector<4>("orientation", Eigen::Vector4d(1, 0, 0, 0));
-    if (q.norm() < 1e-12) r.fail("orientation", "quaternion [w, x, y, z] must not be zero");
-    k.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+    k.orientation = r.quaternion("orientation");
     r.reject_unknown_keys();
     p.keyframes.push_back(k);
   }
@@ -511,11 +525,9 @@ void read_prop(const toml::table& t, const fs::path& file, Scene& scene) {
   p.body_file = file.parent_path() / body;
   if (!fs::exists(p.body_file)) r.fail("body", fmt::format("{} does not exist", p.body_file.string()));
   p.position = r.vector<3>("position", Eigen::Vector3d::Zero());
-  const Eigen::Vector4d q = r.vector<4>("orientation", Eigen::Vector4d(1, 0, 0, 0));
-  if (q.norm() < 1e-12) r.fail("orientation", "quaternion [w, x, y, z] must not be zero");
-  p.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+  p.orientation = r.quaternion("orientation");
   p.motion = static_cast<MotionType>(r.choice("motion", {"dynamic", "kinematic", "static"}, 2));
-  p.velocity = r.vector<3>("velocity", Eigen::Vector3d::Zero());
+  p.velocity = r.velocity("velocity");
   p.angular_velocity = r.vector<3>("angular_velocity", Eigen::Vector3d::Zero());
   if (p.motion == MotionType::Static && (p.velocity.norm() > 0 || p.angular_velocity.norm() > 0)) {
     r.fail("velocity", "a static prop cannot move (use motion = \"kinematic\")");
@@ -585,6 +597,8 @@ void read_simulation(TableReader& root, const fs::path& file, Scene& scene) {
     } else {
       r.fail("dt", "must be a time step > 0 (s) or \"auto\"");
     }
+    // dt = inf, or a dt longer than the run, would take no step at all and report success.
+    if (s.dt > 0) checked_step_count(s.duration, s.dt, r.where("dt"));
   }
   s.max_impact_speed = r.non_negative("max_impact_speed", 0.0);
   s.step.normal_damping = static_cast<NormalDamping>(r.choice("normal_damping", {"tsuji", "thesis"}, 0));

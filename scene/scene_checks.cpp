@@ -77,6 +77,40 @@ void check_scene_forces(const Scene& scene, const World& world, const WorldSourc
   check_impact(scene, world, dt);
 }
 
+namespace {
+
+// The first smooth wall (planes, then cylinders, as the engines number them) the sphere at x of
+// radius r lies wholly behind; -1 when none.
+std::int64_t wall_passed(const Walls& walls, const Eigen::Vector3d& x, double r) {
+  for (std::size_t w = 0; w < walls.planes.size(); ++w) {
+    const PlaneWall& p = walls.planes[w];
+    if (p.normal.dot(x - p.point) < -r) return static_cast<std::int64_t>(w);
+  }
+  for (std::size_t c = 0; c < walls.cylinders.size(); ++c) {
+    const CylinderWall& w = walls.cylinders[c];
+    if (x.z() < w.z_min || x.z() > w.z_max) continue;
+    if ((x.head<2>() - w.axis).norm() > w.radius + r)
+      return static_cast<std::int64_t>(walls.planes.size() + c);
+  }
+  return -1;
+}
+
+}  // namespace
+
+Penetration find_wall_penetration(const World& world) {
+  Penetration found;
+  if (world.walls.planes.empty() && world.walls.cylinders.empty()) return found;
+  const std::vector<Eigen::Vector3d> positions = particle_positions(world);
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    if (world.bodies.motion[world.particles.body[i]] != MotionType::Dynamic) continue;
+    const std::int64_t wall = wall_passed(world.walls, positions[i], world.particles.radius[i]);
+    if (wall < 0 || found.count++ > 0) continue;
+    found.particle = static_cast<std::uint32_t>(i);
+    found.wall = wall;
+  }
+  return found;
+}
+
 void ClampWatch::interval(std::size_t clamps, std::int64_t steps, double time) {
   const bool saturated = steps > 0 && clamps >= static_cast<std::size_t>(steps);
   const State before = std::exchange(state_, State{clamps, saturated});

@@ -42,6 +42,13 @@ class ClampWatch {
   State state_;
 };
 
+// The state a stretch of steps ended in, checked as the engines check the state each step starts
+// from: a dynamic particle wholly behind a smooth wall's surface (plane: n . (x - point) < -r;
+// cylinder: between z_min and z_max and farther than radius + r from the axis). The engines see a
+// step's result only when the next step starts, so without this the last step of a run could carry
+// a grain through a wall unnoticed. Count 0: none.
+Penetration find_wall_penetration(const World& world);
+
 // The message for a wall penetration, naming the wall, the body and where the particle is in `world`.
 std::string describe_penetration(const WallPenetration& penetration, const World& world,
                                  const WorldSources& sources);

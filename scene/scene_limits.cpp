@@ -172,7 +172,8 @@ void check_scene_sizes(const Scene& scene) {
   check_total(scene, total_grains(scene), rough, "rough boundaries");
 }
 
-void check_world_sizes(const Scene& scene, const World& world) {
+void check_world_sizes(const Scene& scene, const World& world,
+                       const std::vector<std::uint32_t>& prop_bodies) {
   check_total(scene, total_grains(scene), static_cast<double>(world.particles.size()),
               "rough boundaries and props");
   double radius = 0;  // m: the grid cell is the largest particle's diameter
@@ -181,9 +182,15 @@ void check_world_sizes(const Scene& scene, const World& world) {
   const double cell = 2 * radius;
   for (const Emitter& e : scene.emitters) check_emitter_cells(scene, e, cell);
   for (const Boundary& b : scene.boundaries) check_boundary_cells(scene, b, cell);
-  for (const Prop& p : scene.props) {
+  for (std::size_t i = 0; i < scene.props.size(); ++i) {
+    const Prop& p = scene.props[i];
     check_cell(scene, p.line, "prop.position", p.position, cell);
     for (const Keyframe& k : p.keyframes) check_cell(scene, p.line, "prop.keyframes", k.position, cell);
+    // The body's particles lie within its bounding radius of its centre: one 1e38 m out in the body's
+    // particle file is as far from the origin as a prop placed there.
+    if (i >= prop_bodies.size()) continue;
+    const double reach = world.bodies.bounding_radius[prop_bodies[i]];
+    check_cell(scene, p.line, "prop.body", p.position.cwiseAbs() + Eigen::Vector3d::Constant(reach), cell);
   }
 }
 

@@ -2,6 +2,9 @@
 // The largest sizes a scene may ask for, and the checks that compare the sizes its keys imply with
 // them before anything is allocated (docs/reliability.md, "Sizes checked before allocation"). Every
 // size is computed in double from the keys, so no count overflows on the way.
+#include <cstdint>
+#include <vector>
+
 #include "scene/lattice.h"
 #include "scene/scene.h"
 #include "sim/world.h"
@@ -23,7 +26,8 @@ void check_scene_sizes(const Scene& scene);
 
 // Once the boundaries and props are in `world` (and no grain yet): the whole world's particles with
 // every emitter's grains, and the grid cell coordinates of every place particles start at (the cell
-// is the largest particle diameter). Throws as check_scene_sizes.
-void check_world_sizes(const Scene& scene, const World& world);
+// is the largest particle diameter), a prop's particles included (`prop_bodies`: each prop's body in
+// `world`, in scene order). Throws as check_scene_sizes.
+void check_world_sizes(const Scene& scene, const World& world, const std::vector<std::uint32_t>& prop_bodies);
 
 }  // namespace ts::scene

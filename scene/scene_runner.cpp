@@ -11,15 +11,25 @@
 #include <utility>
 
 #include "core/atomic_file.h"
+#include "core/checked_values.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "scene/checkpoint.h"
-#include "sim/cpu_reference.h"
 #include "scene/scene_checks.h"
 #include "scene/scene_world.h"
 #include "scene/servo.h"
+#include "sim/cpu_reference.h"
 
 namespace ts::scene {
+
+namespace {
+
+int line_of_key(const Scene& scene, const std::string& key) {
+  const auto it = scene.key_lines.find(key);
+  return it == scene.key_lines.end() ? 0 : it->second;
+}
+
+}  // namespace
 
 double resolve_time_step(const Scene& scene, const World& world, std::string* warning) {
   const TimeStepBound bound = scene_time_step_bound(scene, world);
@@ -371,6 +381,12 @@ void SceneRun::advance_to(std::int64_t until) {
   const auto start = Clock::now();
   try {
     stats_ = stepper_->advance(world_, until - step_);
+    // The engines check the state each step starts from; the state this stretch ended in (the run's
+    // last, at the last stretch) is checked the same way here.
+    if (scene_.simulation.step.check_penetration) {
+      if (const Penetration p = find_wall_penetration(world_); p.count > 0)
+        throw WallPenetration(world_.time, p);
+    }
   } catch (const WallPenetration& e) {
     write_particles_ply(last_good_, dir_ / "last_good.ply");
     throw Error(ExitCode::Unstable, describe_penetration(e, world_, sources_));
@@ -452,7 +468,9 @@ RunState SceneRun::state() const {
 
 RunResult SceneRun::run() {
   control_.resume ? resume() : start_fresh();
-  total_ = static_cast<std::int64_t>(std::ceil(duration_ / result_.dt - 1e-9));
+  total_ =
+      checked_step_count(duration_, result_.dt,
+                         Where{scene_.file.string(), line_of_key(scene_, "simulation.dt"), "simulation.dt"});
   if (stretch_end_ > total_)
     stretch_end_ = stretch_output_ = std::max(step_, total_);  // a shorter --duration
   while (step_ < total_) {

@@ -225,7 +225,7 @@ World make_world(const Scene& scene, WorldSources* sources) {
     names.bodies.push_back(
         fmt::format("the prop of [[prop]] at line {} ({})", p.line, p.body_file.filename().string()));
   }
-  check_world_sizes(scene, world);
+  check_world_sizes(scene, world, prop_bodies);
   if (sources) {
     sources->smooth_walls = names.planes;
     sources->smooth_walls.insert(sources->smooth_walls.end(), names.cylinders.begin(), names.cylinders.end());

@@ -3,7 +3,13 @@
 // hangs together, so a damaged or hand-made file cannot index out of range later.
 #include "sim/world_bytes.h"
 
+#include <fmt/format.h>
+
+#include <cmath>
 #include <type_traits>
+
+#include "core/checked_values.h"
+#include "sim/contact_model.h"
 
 namespace ts::sim {
 namespace {
@@ -129,6 +135,88 @@ void check_world(const World& w, ByteReader& r) {
     r.fail("damaged contact springs");
 }
 
+// The numbers a fresh scene's checks guarantee, checked again on a world read back: a crafted file
+// with a recomputed checksum must not resume into NaN outputs. Each refusal names the field.
+class ValueCheck {
+ public:
+  static constexpr std::size_t kWhole = static_cast<std::size_t>(-1);  // a field that is one value
+
+  explicit ValueCheck(ByteReader& r) : r_(r) {}
+  template <typename Derived>
+  void finite(const Eigen::MatrixBase<Derived>& v, const std::string& field,
+              std::size_t index = kWhole) const {
+    if (!v.allFinite()) r_.fail(fmt::format("{} is not finite", name(field, index)));
+  }
+  void finite(double v, const std::string& field, std::size_t index = kWhole) const {
+    if (!std::isfinite(v)) r_.fail(fmt::format("{} is {} (must be finite)", name(field, index), v));
+  }
+  void positive(double v, const std::string& field, std::size_t index) const {
+    if (!(v > 0) || !std::isfinite(v))
+      r_.fail(fmt::format("{} is {} (must be finite and > 0)", name(field, index), v));
+  }
+  void unit(const Eigen::Quaterniond& q, const std::string& field, std::size_t index) const {
+    const std::string problem = quaternion_problem(q.coeffs());
+    if (!problem.empty()) r_.fail(fmt::format("{}: {}", name(field, index), problem));
+  }
+
+ private:
+  static std::string name(const std::string& field, std::size_t index) {
+    return index == kWhole ? field : fmt::format("{} of entry {}", field, index);
+  }
+  ByteReader& r_;
+};
+
+void check_body_values(const Bodies& b, const ValueCheck& check, ByteReader& r) {
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    check.finite(b.position[k], "body position", k);
+    check.unit(b.orientation[k], "body orientation", k);
+    check.finite(b.linear_velocity[k], "body linear_velocity", k);
+    check.finite(b.angular_velocity[k], "body angular_velocity", k);
+    check.finite(b.inverse_inertia[k], "body inverse_inertia", k);
+    check.finite(b.bounding_radius[k], "body bounding_radius", k);
+    // A dynamic body moves by its forces times its inverse mass: 0 would freeze it, inf fling it.
+    if (b.motion[k] == MotionType::Dynamic) {
+      check.positive(b.inverse_mass[k], "body inverse_mass (dynamic)", k);
+    } else if (b.inverse_mass[k] != 0) {
+      r.fail(fmt::format("body inverse_mass of entry {} is {} (must be 0 for a kinematic or static body)", k,
+                         b.inverse_mass[k]));
+    }
+  }
+}
+
+void check_world_values(const World& w, ByteReader& r) {
+  const ValueCheck check(r);
+  check_body_values(w.bodies, check, r);
+  for (std::size_t i = 0; i < w.particles.size(); ++i) {
+    check.finite(w.particles.offset[i], "particle offset", i);
+    check.positive(w.particles.radius[i], "particle radius", i);
+  }
+  for (std::size_t i = 0; i < w.springs.displacement.size(); ++i)
+    check.finite(w.springs.displacement[i], "spring displacement", i);
+  for (std::size_t i = 0; i < w.walls.planes.size(); ++i) {
+    check.finite(w.walls.planes[i].point, "plane wall point", i);
+    const std::string problem = unit_vector_problem(w.walls.planes[i].normal);
+    if (!problem.empty()) r.fail(fmt::format("plane wall normal of entry {}: {}", i, problem));
+  }
+  for (std::size_t i = 0; i < w.walls.cylinders.size(); ++i) {
+    check.finite(w.walls.cylinders[i].axis, "cylinder wall axis", i);
+    check.positive(w.walls.cylinders[i].radius, "cylinder wall radius", i);
+  }
+  for (std::size_t i = 0; i < w.materials.size(); ++i) {
+    if (const std::string problem = validate(w.materials[i]); !problem.empty())
+      r.fail(fmt::format("material of entry {}: {}", i, problem));
+  }
+  for (const KinematicTrack& t : w.tracks) {
+    for (std::size_t i = 0; i < t.keys.size(); ++i) {
+      check.finite(t.keys[i].time, "kinematic key time", i);
+      check.finite(t.keys[i].position, "kinematic key position", i);
+      check.unit(t.keys[i].orientation, "kinematic key orientation", i);
+    }
+  }
+  check.finite(w.gravity, "gravity");
+  check.finite(w.time, "time");
+}
+
 }  // namespace
 
 std::string world_bytes(const World& world) {
@@ -164,6 +252,7 @@ World world_from_bytes(ByteReader& r) {
   r.get(world.time);
   if (!r.done()) r.fail("bytes left after the world");
   check_world(world, r);
+  check_world_values(world, r);
   return world;
 }
 

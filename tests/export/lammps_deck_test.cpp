@@ -243,6 +243,25 @@ TEST(ExportLammps, RefusesThesisDampingNamingTheScene) {
   EXPECT_FALSE(fs::exists(dir / "deck" / "in.tetrasand"));
 }
 
+// Every number the deck holds passes the value checker: a gravity whose norm overflows would write
+// `inf` and `-nan` (a decks LAMMPS cannot read, of a scene `sim` refuses). Nothing is written.
+TEST(ExportLammps, NonFiniteNumbersAreRefusedBeforeAnyFileIsWritten) {
+  const fs::path dir = test::temp_dir();
+  Scene scene = bed_scene(dir);
+  scene.gravity = Eigen::Vector3d(0, 0, -1e200);
+  try {
+    export_lammps(scene, dir / "deck");
+    FAIL() << "exported a deck with a non-finite number";
+  } catch (const InputError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("scene.toml: cannot export to LAMMPS: the deck would hold the non-finite"),
+        std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "deck" / "in.tetrasand"));
+  EXPECT_FALSE(fs::exists(dir / "deck" / "data.tetrasand"));
+}
+
 TEST(ExportLammps, CommandWritesDeckAndFailsOnBadScene) {
   const fs::path dir = test::temp_dir();
   bed_scene(dir);

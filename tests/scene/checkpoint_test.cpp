@@ -6,9 +6,14 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <functional>
+#include <limits>
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -242,6 +247,50 @@ TEST(Checkpoint, MissingCorruptAndMismatchedCheckpointsAreRefusedNamingTheFile) 
             std::string::npos)
       << engine;
   EXPECT_EQ(resume_error(scene, dir / "out"), "");  // the good one still resumes
+}
+
+// A checkpoint crafted with values a fresh scene could never have, its checksum recomputed (written
+// through write_checkpoint), is refused naming the field: it would resume into NaN outputs.
+TEST(Checkpoint, CraftedCheckpointsWithNonFiniteOrMeaninglessValuesAreRefusedNamingTheField) {
+  const fs::path dir = test::temp_dir();
+  Scene scene = write_scene(dir);
+  scene.simulation.duration = 0.01;
+  run_scene(scene, dir / "out");
+  const RunState good = read_latest_checkpoint(dir / "out");
+  std::size_t dynamic = 0;
+  while (good.world.bodies.motion.at(dynamic) != MotionType::Dynamic) ++dynamic;
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::nan("");
+  const std::vector<std::pair<std::string, std::function<void(RunState&)>>> crafted{
+      {"gravity is not finite", [&](RunState& s) { s.world.gravity.z() = inf; }},
+      {"time is nan", [&](RunState& s) { s.world.time = nan; }},
+      {"body inverse_mass (dynamic)", [&](RunState& s) { s.world.bodies.inverse_mass[dynamic] = 0; }},
+      {"particle radius of entry 0 is inf", [&](RunState& s) { s.world.particles.radius[0] = inf; }},
+      {"particle radius of entry 0 is -0.001", [&](RunState& s) { s.world.particles.radius[0] = -1e-3; }},
+      {"body position of entry 1 is not finite", [&](RunState& s) { s.world.bodies.position[1].x() = nan; }},
+      {"body linear_velocity", [&](RunState& s) { s.world.bodies.linear_velocity[dynamic].y() = -inf; }},
+      {"body orientation of entry 0: quaternion",
+       [&](RunState& s) { s.world.bodies.orientation[0].coeffs().setConstant(1e200); }},
+      {"dt must be finite and > 0 (got inf)", [&](RunState& s) { s.dt = inf; }},
+      {"the duration must be finite and > 0", [&](RunState& s) { s.duration = nan; }},
+  };
+  int n = 0;
+  for (const auto& [field, craft] : crafted) {
+    RunState state = good;
+    craft(state);
+    const fs::path out = dir / fmt::format("crafted_{}", n++);
+    write_checkpoint(out, state);
+    std::string message;
+    try {
+      read_latest_checkpoint(out);
+    } catch (const InputError& e) {
+      message = e.what();
+    }
+    EXPECT_NE(message.find(checkpoint_path(out, state.step).string()), std::string::npos)
+        << field << ": " << message;
+    EXPECT_NE(message.find(field), std::string::npos) << field << ": " << message;
+  }
+  write_checkpoint(dir / "untouched", good);
+  EXPECT_EQ(read_latest_checkpoint(dir / "untouched").step, good.step);  // the good state still reads
 }
 
 }  // namespace

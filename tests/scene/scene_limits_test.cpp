@@ -7,6 +7,7 @@
 
 #include <string>
 
+#include "body/body_file.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "export/lammps_deck.h"
@@ -119,6 +120,17 @@ TEST(SceneLimits, ParticlesFartherThanTheGridCellsReachAreRefused) {
   expect_names(message, dir, kFirstTable, "prop.position", "at most 1e+09 cells fit");
   const std::string far = box_emitter("fill", "[-999999999999.9, 0.01, 0.01]", 1, "", "[-1e12, 0.0, 0.0]");
   expect_names(world_error(dir, far), dir, kFirstTable, "emitter.min", "at most 1e+09 cells fit");
+}
+
+// A body whose particle file puts one particle 1e38 m out (a float the file can hold) reaches as far as
+// a prop placed there: refused naming the prop's body, before a grid coordinate overflows.
+TEST(SceneLimits, PropBodyWithAParticleFarBeyondTheGridIsRefused) {
+  const fs::path dir = test::temp_dir();
+  body::ParticleBody far = body::read_body(test::asset("bodies/cube.body.json"));
+  far.positions.at(0) = Eigen::Vector3f(1e38f, 0, 0);
+  const fs::path body = body::write_body(dir, "far", far);
+  const std::string prop = fmt::format("[[prop]]\nbody = \"{}\"\nmaterial = \"sand\"\n", body.string());
+  expect_names(world_error(dir, prop), dir, kFirstTable, "prop.body", "at most 1e+09 cells fit");
 }
 
 }  // namespace
