@@ -12,6 +12,7 @@
 #include "core/log.h"
 #include "core/mesh_io.h"
 #include "core/mesh_report.h"
+#include "gpu/backend.h"
 #include "preview/camera.h"
 #include "preview/image.h"
 #include "preview/inputs.h"
@@ -26,6 +27,7 @@ namespace {
 
 struct Options {
   std::string input, output, particles, size = "800x800", view = "iso", color_by = "none";
+  std::string backend = "auto";  // there is no CPU renderer yet: auto takes the GPU, cpu is refused
   std::vector<double> eye, target, up{0.0, 0.0, 1.0}, light;
   double fov = 30.0, particle_radius = 0.0, color_max = 0.0, voxel = 0.0, band = 3.0, scale = 1.0;
   int resolution = 192, turntable = 1;
@@ -85,6 +87,11 @@ void add_input_options(CLI::App* cmd, Options& o) {
                   "Particle radius [m] (default: the body.json's, else half the median neighbour distance)")
       ->check(positive());
   cmd->add_option("--size", o.size, "Image size WIDTHxHEIGHT [pixels]")->capture_default_str();
+  cmd->add_option("--backend", o.backend,
+                  "auto or gpu: the GL renderer (the preview has no CPU path yet, so auto takes the GPU on a "
+                  "software renderer too and cpu is refused)")
+      ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
+      ->capture_default_str();
 }
 
 // Where the camera is and how it turns.
@@ -159,6 +166,11 @@ void add_lighting_options(CLI::App* cmd, Options& o) {
 // Combinations CLI11 cannot check by itself.
 void check_options(const Options& o) {
   if (o.input.empty() && o.particles.empty()) throw Error(ExitCode::Usage, "preview: give a MESH or an SDF.vdb, or --particles");
+  if (o.backend == "cpu") {
+    throw Error(ExitCode::Usage,
+                "--backend cpu: the preview has only a GPU path for now (no CPU renderer); --backend auto or gpu "
+                "renders on the GL device, llvmpipe included");
+  }
   if (o.contact_sheet && o.turntable < 2) throw Error(ExitCode::Usage, "--contact-sheet needs --turntable N with N >= 2");
   if (o.color_by == "error" && (o.input.empty() || is_vdb(o.input))) {
     throw InputError("--color-by error needs a MESH input: the exact distance comes from the mesh");
@@ -318,6 +330,9 @@ int run_preview(const Options& o, const GlobalOptions& global) {
   check_options(o);
   const Eigen::Vector2i size = parse_size(o.size);
   gpu::Context context(context_options(global));
+  const gpu::Backend requested = gpu::parse_backend(o.backend).value();  // auto or gpu: check_options
+  fmt::print("{}\n", gpu::backend_line(requested, gpu::resolve_backend(requested, &context, false),
+                                       gpu::describe(&context), false));
   preview::Renderer renderer(context, o.timings);
   renderer.check_image_size(size.x(), size.y());
   Content content;

@@ -1,24 +1,25 @@
-// `tetrasand sdf MESH -o OUT.vdb`: narrow-band SDF by GPU scan conversion (or, --backend cpu, the exact
-// CPU path), written as an OpenVDB level set.
+// `tetrasand sdf MESH -o OUT.vdb`: narrow-band SDF by GPU scan conversion or the exact CPU path (chosen
+// by --backend and the one rule of gpu/backend.h), written as an OpenVDB level set.
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-#include <unistd.h>
 
 #include <cctype>
 #include <chrono>
-#include <cstdio>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 #include <openvdb/tools/SignedFloodFill.h>
 
 #include "app/commands.h"
 #include "app/numeric_options.h"
+#include "app/progress.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mesh_io.h"
 #include "core/mesh_report.h"
+#include "gpu/backend.h"
 #include "sdf/exact_sdf.h"
 #include "sdf/grid.h"
 #include "sdf/openvdb_compare.h"
@@ -38,7 +39,7 @@ struct Options {
   double band = 3.0;
   int padding = -1;
   std::string sign = "pseudonormal";
-  std::string backend = "gpu";  // gpu: scan conversion; cpu: the exact SDF (sdf/exact_sdf.h)
+  std::string backend = "auto";  // gpu: scan conversion; cpu: the exact SDF (sdf/exact_sdf.h); auto: the rule
   double scale = 1.0;
   double slab_mb = 1024;
   bool timings = false, compare = false, json = false;
@@ -83,9 +84,9 @@ void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option(
          "--backend", o.backend,
          "gpu: scan conversion on the GL device; cpu: the exact SDF (a sweep over the triangles, double "
-         "precision, TBB on every core; no GL device needed). On llvmpipe cpu is faster in most runs of "
-         "docs/benchmarks.md (SDF)")
-      ->check(CLI::IsMember({"gpu", "cpu"}))
+         "precision, TBB on every core; no GL device needed); auto: cpu on a software renderer (on llvmpipe "
+         "4-7x faster, docs/benchmarks.md SDF), gpu on a hardware GPU")
+      ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
       ->capture_default_str();
   cmd->add_option("--sign", o.sign, "Sign method: pseudonormal (closed meshes) or winding (robust to holes)")
       ->check(CLI::IsMember({"pseudonormal", "winding"}))
@@ -138,28 +139,6 @@ sdf::GridSpec grid_of(const Options& o, const TriangleMesh& mesh) {
   }
   return spec;
 }
-
-// Progress: a live line on a terminal; otherwise (logs, CI) a line per tenth of a grid that takes
-// several slabs, so a long run shows it is alive.
-class ScanProgress {
- public:
-  ScanProgress() : terminal_(::isatty(STDERR_FILENO) != 0) {}
-  void operator()(double done) {
-    if (terminal_) {
-      std::fprintf(stderr, "\rscan conversion %5.1f %%", 100.0 * done);
-    } else if (done < 1.0 && static_cast<int>(10.0 * done) > reported_tenths_) {
-      reported_tenths_ = static_cast<int>(10.0 * done);
-      log::info("scan conversion {:.0f} %", 100.0 * done);
-    }
-  }
-  void end() const {
-    if (terminal_) std::fprintf(stderr, "\n");
-  }
-
- private:
-  bool terminal_;
-  int reported_tenths_ = 0;
-};
 
 // Writes the level set in the format the suffix asks for; returns the size of its NanoVDB form (the
 // GPU field's) when it was made or `measure` asks for it, else 0.
@@ -258,16 +237,17 @@ void print_comparison(const Options& o, const TriangleMesh& mesh, const sdf::Gri
 
 // The GPU path: scan conversion on the GL device, signs by winding number afterwards where asked.
 // *device: the GL device's summary.
-sdf::ScanConvertResult gpu_level_set(const Options& o, const GlobalOptions& global, const TriangleMesh& mesh,
+sdf::ScanConvertResult gpu_level_set(const Options& o, gpu::Context& context, const TriangleMesh& mesh,
                                      const sdf::GridSpec& spec, std::string* device) {
-  gpu::Context context(context_options(global));
   *device = context.summary();
   sdf::ScanConvertOptions scan;
   scan.band = o.band;
   scan.timings = o.timings;
   scan.max_slab_bytes = static_cast<std::size_t>(o.slab_mb * 1048576.0);
-  ScanProgress progress;
-  scan.progress = [&progress](double done) { progress(done); };
+  Progress progress;  // a tenth of the grid a line in a pipe
+  scan.progress = [&progress](double done) {
+    progress.update(fmt::format("scan conversion {:5.1f} %", 100.0 * done), done);
+  };
   const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
   sdf::ScanConvertResult result =
       naming_file(o.mesh, [&] { return sdf::scan_convert(context, mesh, normals, spec, scan); });
@@ -294,20 +274,46 @@ sdf::ScanConvertResult cpu_level_set(const Options& o, const TriangleMesh& mesh,
   return result;
 }
 
-int run_sdf(const Options& o, const GlobalOptions& global) {
-  const auto start = std::chrono::steady_clock::now();
-  is_nanovdb_path(o.output);  // a wrong suffix is a usage error before any work
-  if (o.compare && o.backend == "cpu") {
+// Where the field is built (gpu/backend.h): the options with `backend` set to the path that runs, and
+// the GL context when that is the GPU. --compare-openvdb asks for the scan conversion (it compares the
+// GPU field with the exact one). Prints the backend line (a log line under --json: standard output
+// stays the JSON).
+Options choose_backend(const Options& o, const GlobalOptions& global, std::unique_ptr<gpu::Context>& context) {
+  gpu::Backend requested = gpu::parse_backend(o.backend).value();  // CLI::IsMember checked the spelling
+  if (o.compare && requested == gpu::Backend::Cpu) {
     throw Error(
         ExitCode::Usage,
         "--compare-openvdb compares the GPU field with the exact one; with --backend cpu the field is the "
         "exact one");
   }
+  if (o.compare) requested = gpu::Backend::Gpu;
+  if (requested != gpu::Backend::Cpu) context = std::make_unique<gpu::Context>(context_options(global));
+  const gpu::Backend chosen = gpu::resolve_backend(requested, context.get());
+  const std::string line =
+      gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
+                        chosen == gpu::Backend::Cpu ? "exact SDF" : "scan conversion",
+                        o.compare && o.backend == "auto" ? "--compare-openvdb compares the GPU field" : "");
+  if (o.json) {
+    log::info("{}", line);
+  } else {
+    fmt::print("{}\n", line);
+  }
+  if (chosen == gpu::Backend::Cpu) context.reset();
+  Options run = o;
+  run.backend = gpu::backend_name(chosen);
+  return run;
+}
+
+int run_sdf(const Options& options, const GlobalOptions& global) {
+  const auto start = std::chrono::steady_clock::now();
+  is_nanovdb_path(options.output);  // a wrong suffix is a usage error before any work
+  std::unique_ptr<gpu::Context> context;
+  const Options o = choose_backend(options, global, context);
   const TriangleMesh mesh = load_sdf_mesh(o);
   const sdf::GridSpec spec = naming_file(o.mesh, [&] { return grid_of(o, mesh); });
   std::string device;
   sdf::ScanConvertResult result = o.backend == "cpu" ? cpu_level_set(o, mesh, spec, &device)
-                                                     : gpu_level_set(o, global, mesh, spec, &device);
+                                                     : gpu_level_set(o, *context, mesh, spec, &device);
   Figures figures{result.stats.band_voxels, result.grid->memUsage(), 0, result.stats.peak_gpu_bytes,
                   result.stats.readback_bytes, result.stats.seconds, 0.0};
   figures.nanovdb_bytes = write_level_set(o, result, device, o.timings || o.json);

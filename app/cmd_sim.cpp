@@ -1,17 +1,17 @@
 // `tetrasand sim SCENE.toml`: run a sand scene on the GPU pipeline or the CPU reference (--backend).
 #include <fmt/format.h>
 #include <fmt/ranges.h>
-#include <unistd.h>
 
 #include <chrono>
-#include <cstdio>
 #include <filesystem>
 #include <tuple>
 #include <utility>
 
 #include "app/commands.h"
 #include "app/numeric_options.h"
+#include "app/progress.h"
 #include "core/log.h"
+#include "gpu/backend.h"
 #include "gpu/context.h"
 #include "preview/sim_frames.h"
 #include "sim/gpu_stepper.h"
@@ -64,22 +64,19 @@ void add_options(CLI::App* cmd, Options& o) {
       ->excludes(output);
 }
 
-// A live line on a terminal, else a log line per output: time, step rate, contacts and the time left.
-// `first_step` and `first_time` (s): where this process started (a resumed run starts late).
-void report_progress(double duration, const sim::World& world, const sim::StepStats& stats, std::int64_t step,
-                     Clock::time_point start, std::int64_t first_step, double first_time, bool terminal) {
+// The progress line of one output: time, step rate, contacts and the time left (app/progress.h shows
+// it live on a terminal, a tenth of the run a line in a pipe). `first_step` and `first_time` (s):
+// where this process started (a resumed run starts late).
+void report_progress(Progress& progress, double duration, const sim::World& world, const sim::StepStats& stats,
+                     std::int64_t step, Clock::time_point start, std::int64_t first_step, double first_time) {
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   const double rate = elapsed > 0 ? static_cast<double>(step - first_step) / elapsed : 0.0;
   const double done = world.time - first_time;  // s simulated by this process
   const double remaining = done > 0 ? (duration - world.time) / done * elapsed : 0.0;
-  const std::string line =
-      fmt::format("t = {:.4f} / {:.4f} s  step {}  {:.0f} steps/s  contacts {}  ETA {:.0f} s", world.time,
-                  duration, step, rate, stats.contacts, remaining);
-  if (terminal) {
-    std::fprintf(stderr, "\r%s   ", line.c_str());
-  } else {
-    log::info("{}", line);
-  }
+  const double fraction = duration > first_time ? done / (duration - first_time) : -1.0;
+  progress.update(fmt::format("t = {:.4f} / {:.4f} s  step {}  {:.0f} steps/s  contacts {}  ETA {:.0f} s",
+                              world.time, duration, step, rate, stats.contacts, remaining),
+                  fraction);
 }
 
 // "360 grains; props: 1 dynamic; static bodies: 2 rough walls; smooth walls: 5 planes" (kinds with
@@ -115,44 +112,38 @@ std::string requested_backend(const Options& o) {
   return requested;
 }
 
-// Which engine runs the steps: the GPU pipeline (sim/gpu_stepper.h) or the CPU reference
-// (sim/cpu_reference.h).
-enum class Backend { Gpu, Cpu };
-
 // The GL context a run needs (the GPU pipeline's, or only the frames' renderer's; null when neither)
-// and the backend. auto takes the CPU reference when the GL device is a software renderer and says
-// so in one line; a device that cannot make a context at all stays an error (exit 3), as under
-// --backend gpu: a broken driver on a GPU machine should say so, not turn into a much slower run.
-Backend choose_backend(const Options& o, const GlobalOptions& global, bool frames,
-                       std::unique_ptr<gpu::Context>& context) {
-  const std::string requested = requested_backend(o);
-  if (requested == "cpu") {
-    if (frames) context = std::make_unique<gpu::Context>(context_options(global));
-    return Backend::Cpu;
-  }
-  context = std::make_unique<gpu::Context>(context_options(global));
-  if (requested == "gpu" || !context->software()) return Backend::Gpu;
-  const std::string& renderer = context->renderer();
-  fmt::print(
-      "backend: CPU reference (the GL device is {}, a software renderer; --backend gpu forces the GPU "
-      "pipeline{})\n",
-      renderer.substr(0, renderer.find(" (")),
-      o.precision.empty() ? "" : "; --precision applies to it only, the CPU reference computes in double");
+// and the engine that runs the steps: the GPU pipeline (sim/gpu_stepper.h) or the CPU reference
+// (sim/cpu_reference.h), by the rule of gpu/backend.h, named in its one line. A device that cannot
+// make a context at all stays an error (exit 3) under auto, as under --backend gpu: a broken driver on
+// a GPU machine should say so, not turn into a much slower run.
+gpu::Backend choose_backend(const Options& o, const GlobalOptions& global, bool frames,
+                            std::unique_ptr<gpu::Context>& context) {
+  const gpu::Backend requested = gpu::parse_backend(requested_backend(o)).value();  // IsMember checked it
+  if (requested != gpu::Backend::Cpu || frames) context = std::make_unique<gpu::Context>(context_options(global));
+  const gpu::Backend chosen = gpu::resolve_backend(requested, context.get());
+  const bool cpu = chosen == gpu::Backend::Cpu;
+  const bool precision_ignored = cpu && !o.precision.empty();  // auto only: --cpu with it is refused
+  fmt::print("{}\n", gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
+                                       cpu ? "the CPU reference" : "the GPU pipeline",
+                                       precision_ignored ? "--precision applies to the GPU pipeline only, the "
+                                                           "CPU reference computes in double"
+                                                         : ""));
   std::fflush(stdout);
-  if (!frames) context.reset();
-  return Backend::Cpu;
+  if (cpu && !frames) context.reset();
+  return chosen;
 }
 
 const std::string& output_dir(const Options& o) { return o.resume.empty() ? o.output : o.resume; }
 
 void print_summary(const Options& o, const scene::Scene& scene, const scene::RunResult& result, double seconds,
-                   Backend backend, const gpu::Context* context) {
+                   gpu::Backend backend, const gpu::Context* context) {
   // Steps this process ran (a resumed run started at resumed_from).
   const auto stepped = static_cast<double>(result.steps - std::max<std::int64_t>(result.resumed_from, 0));
   fmt::print("{}: {} steps of {:.3g} s, {} grains, {:.1f} s wall ({:.3g} grain-steps/s, {})\n", o.scene,
              result.steps, result.dt, result.grains, seconds,
              seconds > 0 ? stepped * static_cast<double>(result.grains) / seconds : 0.0,
-             backend == Backend::Cpu ? "CPU reference" : context->summary());
+             backend == gpu::Backend::Cpu ? "CPU reference" : context->summary());
   fmt::print("bodies: {}\n", describe_bodies(result.bodies));
   fmt::print("clamps: {} velocity, {} angular velocity, {} overlap (each clamp means a less accurate result)\n",
              result.last.velocity_clamps, result.last.angular_velocity_clamps, result.last.overlap_clamps);
@@ -175,15 +166,15 @@ int run_sim(const Options& o, const GlobalOptions& global) {
   requested_backend(o);  // a usage error before any work
   const scene::Scene scene = scene::load_scene(o.scene);
   std::unique_ptr<gpu::Context> context;
-  const Backend backend = choose_backend(o, global, scene.output.frames, context);
+  const gpu::Backend backend = choose_backend(o, global, scene.output.frames, context);
   scene::StepperFactory make_stepper;  // empty: the CPU reference
-  if (backend == Backend::Gpu) {
+  if (backend == gpu::Backend::Gpu) {
     const auto precision = o.precision == "double" ? sim::Precision::Double : sim::Precision::Float;
     make_stepper = [&, precision](const sim::StepSettings& settings) -> std::unique_ptr<sim::Stepper> {
       return std::make_unique<sim::GpuStepper>(*context, settings, precision, o.timings);
     };
   }
-  const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  Progress progress;
   const auto start = Clock::now();
   scene::RunHooks hooks;
   std::unique_ptr<preview::SimFrameWriter> frames;  // [output] frames = true: PNGs through the preview renderer
@@ -199,7 +190,7 @@ int run_sim(const Options& o, const GlobalOptions& global) {
       o.duration > 0 ? o.duration : scene.simulation.duration;  // s (a resumed run: its own)
   hooks.on_output = [&](const sim::World& world, const sim::StepStats& stats, std::int64_t step) {
     if (first_step < 0) std::tie(first_step, first_time) = std::pair(step, world.time);
-    report_progress(duration, world, stats, step, start, first_step, first_time, terminal);
+    report_progress(progress, duration, world, stats, step, start, first_step, first_time);
   };
   std::string timing_report;
   if (o.timings) hooks.on_finish = [&](sim::Stepper& stepper) { timing_report = stepper.timing_report(); };
@@ -207,7 +198,7 @@ int run_sim(const Options& o, const GlobalOptions& global) {
   control.resume = !o.resume.empty();
   control.duration = o.duration;
   const scene::RunResult result = scene::run_scene(scene, output_dir(o), hooks, make_stepper, control);
-  if (terminal) std::fprintf(stderr, "\n");
+  progress.end();
   if (!result.time_step_warning.empty()) log::warn("{}", result.time_step_warning);
   print_summary(o, scene, result, std::chrono::duration<double>(Clock::now() - start).count(), backend,
                 context.get());

@@ -148,8 +148,9 @@ def band_trade(exe, mesh, resolutions, bands, work, repeats):
         for band in bands:
             times = []
             for _ in range(repeats):
+                # --backend gpu: the scan conversion's band trade (plain sdf takes the CPU path on llvmpipe).
                 text, _ = run([exe, "-q", "sdf", mesh, "-o", os.path.join(work, "band.vdb"), "--resolution", str(res),
-                               "--band", str(band), "--json"])
+                               "--band", str(band), "--json", "--backend", "gpu"])
                 fig = json.loads(text[text.index("{"):])
                 times.append(fig["scan_seconds"])
             text, _ = run([exe, "-q", "sdf", mesh, "-o", os.path.join(work, "band.vdb"), "--resolution", str(res),

@@ -3,8 +3,9 @@
 // set of a narrow-band SDF are spread evenly over it by Gaussian repulsion, attracted to it by
 // -phi grad(phi) and projected onto it at the end. sampler/gpu_relaxer.h runs it as GL compute kernels
 // (shaders/sampler/relax.comp, project.comp, reduce_steps.comp); sampler/cpu_relaxer.h runs the same
-// algorithm on the CPU with TBB. sample_mesh picks one (SampleBackend). Seeding, coverage repair and
-// output live in sampler/sample_mesh.h; a relaxer only moves particles.
+// algorithm on the CPU with TBB. sample_mesh picks one (SampleSettings::backend, by the rule of
+// gpu/backend.h). Seeding, coverage repair and output live in sampler/sample_mesh.h; a relaxer only
+// moves particles.
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>

@@ -255,35 +255,8 @@ SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& e
       spec.voxel_size, band_voxels, bytes / 1048576.0, where, settings.max_sdf_bytes >> 20, remedy));
 }
 
-// Without a GL context the field can only come from the CPU.
-SdfPath choose_sdf_path(const gpu::Context* context, const SampleSettings& settings) {
-  switch (settings.sdf_backend) {
-    case SdfBackend::Cpu:
-      return SdfPath::Exact;
-    case SdfBackend::Gpu:
-      return SdfPath::Scan;
-    case SdfBackend::OpenVdb:
-      if (settings.sign != sdf::SignMethod::Pseudonormal) {
-        throw InputError("--sdf-backend openvdb signs the field by OpenVDB's own flood fill, which needs a closed "
-                         "mesh: with --sign winding use --sdf-backend cpu or gpu");
-      }
-      return SdfPath::OpenVdb;
-    case SdfBackend::Auto:
-      break;
-  }
-  return context != nullptr && !context->software() ? SdfPath::Scan : SdfPath::Exact;
-}
-
 bool relax_on_cpu(const gpu::Context* context, const SampleSettings& settings) {
-  switch (settings.backend) {
-    case SampleBackend::Cpu:
-      return true;
-    case SampleBackend::Gpu:
-      return false;
-    case SampleBackend::Auto:
-      break;
-  }
-  return context == nullptr || context->software();
+  return gpu::resolve_backend(settings.backend, context) == gpu::Backend::Cpu;
 }
 
 gpu::Context& needed_context(gpu::Context* context, const char* stage) {
@@ -646,6 +619,18 @@ std::string round_trip_report(const gpu::HostSyncCounts& scan, const ParticleRel
 }
 
 }  // namespace
+
+SdfPath choose_sdf_path(const gpu::Context* context, const SampleSettings& settings) {
+  if (settings.cpu_sdf == CpuSdfMethod::OpenVdb) {
+    if (settings.sign != sdf::SignMethod::Pseudonormal) {
+      throw InputError("--sdf-backend openvdb signs the field by OpenVDB's own flood fill, which needs a closed "
+                       "mesh: with --sign winding use --sdf-backend cpu or gpu");
+    }
+    return SdfPath::OpenVdb;
+  }
+  // Without a GL context the rule gives the CPU: the field can only come from there.
+  return gpu::resolve_backend(settings.sdf_backend, context) == gpu::Backend::Gpu ? SdfPath::Scan : SdfPath::Exact;
+}
 
 const char* sdf_path_name(SdfPath path) {
   switch (path) {

@@ -1,10 +1,10 @@
 #pragma once
 // The main job: a closed mesh becomes a particle rigid body (thesis 6.3; Bell, Yu & Mucha 2005).
-//   1. SDF by GPU scan conversion (or exact CPU distance: SdfBackend), voxel = r / 2 unless set
+//   1. SDF by GPU scan conversion (or exact CPU distance: sdf_backend), voxel = r / 2 unless set
 //      (see SampleSettings::voxel_size);
 //   2. seeds spread area-uniformly with the injected seed, as many as the coverage target needs;
 //   3. relaxation (attraction to the zero level set + Gaussian repulsion) on the GPU or the CPU
-//      (SampleBackend; sampler/relaxer.h);
+//      (SampleSettings::backend; sampler/relaxer.h);
 //   4. exact projection onto the mesh, crowded pairs (closer than 0.6 spacing) thinned, coverage
 //      certified (sampler/coverage_certificate.h), particles injected at the deepest
 //      uncovered points it proves; the first 3 rounds relax them with their neighbours (the rest
@@ -19,6 +19,7 @@
 
 #include "body/particle_body.h"
 #include "core/mesh.h"
+#include "gpu/backend.h"
 #include "gpu/context.h"
 #include "sampler/coverage_certificate.h"
 #include "sampler/relaxer.h"
@@ -27,26 +28,27 @@
 
 namespace ts::sampler {
 
-// Where the SDF is built: by GPU scan conversion (sdf/scan_convert.h), on the CPU by exact distance
-// (sdf::exact_sdf_grid: a sweep over the triangles, TBB), or on the CPU by OpenVDB's meshToVolume
-// (sdf::openvdb_index_level_set; approximate, about 0.01 voxel on average and a few wrong signs next to
-// the surface, docs/benchmarks.md "SDF"; closed meshes only). Auto: the exact CPU path on a software
-// renderer or without a GL context (llvmpipe runs the scan conversion's geometry and fragment work on
-// the same cores; the exact sweep is also faster than OpenVDB at every size measured, the 1M-particle
-// bunny's band in 12 s; docs/benchmarks.md, "sample fixed costs"), the GPU scan otherwise.
-enum class SdfBackend { Auto, Gpu, Cpu, OpenVdb };
+// Where each stage runs follows the one rule of gpu/backend.h (gpu::Backend; auto: the CPU on a
+// software renderer or without a GL context, the GPU on a hardware device):
+// - the SDF (SampleSettings::sdf_backend): GPU scan conversion (sdf/scan_convert.h), or on the CPU by
+//   `cpu_sdf` (below). On llvmpipe the scan conversion's geometry and fragment work runs on the same
+//   cores; the exact sweep is also faster than OpenVDB at every size measured, the 1M-particle bunny's
+//   band in 12 s (docs/benchmarks.md, "sample fixed costs").
+// - the relaxation and the coverage certificate (SampleSettings::backend): GL compute kernels
+//   (sampler/gpu_relaxer.h, sampler/coverage_certificate.h) or the same algorithms on the CPU with TBB
+//   (sampler/cpu_relaxer.h, sampler/cpu_coverage_certificate.h). llvmpipe runs the kernels on the same
+//   cores, with a fixed cost per dispatch that small counts do not amortise and a 128 MiB storage block
+//   that stops the sparse field of a 10^6-particle body (docs/benchmarks.md, "sample fixed costs").
+
+// The method of a field built on the CPU: exact distance (sdf::exact_sdf_grid: a sweep over the
+// triangles, TBB), or OpenVDB's meshToVolume (sdf::openvdb_index_level_set; approximate, about 0.01
+// voxel on average and a few wrong signs next to the surface, docs/benchmarks.md "SDF"; closed meshes
+// only). OpenVdb is a CPU method: it takes the CPU whatever sdf_backend says.
+enum class CpuSdfMethod { Exact, OpenVdb };
 // What built a run's field.
 enum class SdfPath { Scan, Exact, OpenVdb };
 // "gpu", "cpu", "openvdb": the --sdf-backend value that names the path.
 const char* sdf_path_name(SdfPath path);
-
-// Where the relaxation and the coverage certificate run: GL compute kernels (sampler/gpu_relaxer.h,
-// sampler/coverage_certificate.h) or the same algorithms on the CPU with TBB (sampler/cpu_relaxer.h,
-// sampler/cpu_coverage_certificate.h). Auto: the CPU on a software renderer (llvmpipe runs the kernels
-// on the same cores, with a fixed cost per dispatch that small counts do not amortise and a 128 MiB
-// storage block that stops the sparse field of a 10^6-particle body; docs/benchmarks.md, "sample
-// fixed costs"), or when there is no GL context; the GPU otherwise.
-enum class SampleBackend { Auto, Gpu, Cpu };
 
 struct SampleSettings {
   double radius = 0.0;         // particle radius r [m]; 0: from `count`, else about 8000 particles
@@ -62,8 +64,9 @@ struct SampleSettings {
   // docs/coverage-certificate.md, "The probe pass"). probes_per_particle 0: always `probes`.
   std::size_t probes = 1'000'000;
   std::size_t probes_per_particle = 256;
-  SdfBackend sdf_backend = SdfBackend::Auto;
-  SampleBackend backend = SampleBackend::Auto;
+  gpu::Backend sdf_backend = gpu::Backend::Auto;   // the field's device
+  CpuSdfMethod cpu_sdf = CpuSdfMethod::Exact;       // the field's method on the CPU
+  gpu::Backend backend = gpu::Backend::Auto;       // the relaxation's and the certificate's device
   // The coverage certificate that steers the rounds and is reported (floor: r / floor_divisor).
   CertificateSettings certificate;
   std::size_t max_particles = 20'000'000;
@@ -133,9 +136,9 @@ struct SampleResult {
   double certificate_seconds = 0.0;   // s, wall time of those
   double probe_seconds = 0.0;         // s, wall time of the statistical probe pass
   std::size_t probes = 0;             // surface points of that pass (probe_count)
-  SdfPath sdf_path = SdfPath::Scan;   // which path built the field (SdfBackend)
-  bool relax_on_cpu = false;          // the relaxation ran on the CPU (SampleBackend)
-  bool certificate_on_cpu = false;    // the coverage certificate ran on the CPU (SampleBackend)
+  SdfPath sdf_path = SdfPath::Scan;   // which path built the field (sdf_backend, cpu_sdf)
+  bool relax_on_cpu = false;          // the relaxation ran on the CPU (backend)
+  bool certificate_on_cpu = false;    // the coverage certificate ran on the CPU (backend)
   StageSeconds stages;
   std::vector<std::string> warnings;
   FieldStats field;
@@ -144,8 +147,13 @@ struct SampleResult {
   bool sdf_on_cpu() const { return sdf_path != SdfPath::Scan; }  // exact or OpenVDB's
 };
 
-// `context` may be null when no stage needs the GPU: SampleBackend Cpu or Auto (then the CPU), and
-// SdfBackend Cpu, OpenVdb or Auto (then a CPU field); a GPU stage without one is an internal error.
+// The path that builds the field under `settings` with `context` (null: none): gpu::resolve_backend of
+// sdf_backend, then cpu_sdf on the CPU. Throws InputError for OpenVDB with the winding-number sign.
+SdfPath choose_sdf_path(const gpu::Context* context, const SampleSettings& settings);
+
+// `context` may be null when no stage needs the GPU: backend Cpu or Auto (then the CPU), and
+// sdf_backend Cpu or Auto or cpu_sdf OpenVdb (then a CPU field); a GPU stage without one is an internal
+// error.
 SampleResult sample_mesh(gpu::Context* context, const TriangleMesh& mesh, const SampleSettings& settings,
                          const std::function<void(const SampleProgress&)>& progress = {});
 inline SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh,

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Checks that a change left behaviour alone: builds a base revision and the working tree (Release),
-# runs the same jobs with both on the bundled assets (sdf, sample, preview, info, sim on the CPU
-# reference and the GPU pipeline, export lammps) and compares every output file byte for byte.
+# runs the same jobs with both on the bundled assets (sdf by scan conversion and by the exact CPU path,
+# sample, preview, info, sim on the CPU reference and the GPU pipeline, export lammps) and compares every
+# output file byte for byte.
 #
 #   scripts/same-outputs.sh [--base REV] [--out DIR] [--no-build]
 #
@@ -60,12 +61,20 @@ run_jobs() {
   # A base built before it has no --backend, and its plain `sim` is the GPU pipeline.
   local gpu=()
   if "$bin" sim --help 2>/dev/null | grep -- --backend >/dev/null; then gpu=(--backend gpu); fi  # no -q: pipefail
+  # The same for `sdf`: since issue 42 plain `sdf` takes the exact CPU path on llvmpipe, so both binaries
+  # name the scan conversion, and the CPU path is a job of its own (a base before --backend has neither).
+  local scan=() exact=()
+  if "$bin" sdf --help 2>/dev/null | grep -- --backend >/dev/null; then scan=(--backend gpu); exact=(--backend cpu); fi
   {
     "$bin" info "$a/bunny.obj" --json >info_bunny.json
     "$bin" info "$a/torus.obj" --json >info_torus.json
-    "$bin" sdf "$a/bunny.obj" -o bunny.vdb --resolution 64
-    "$bin" sdf "$a/trefoil.obj" -o trefoil.vdb --resolution 48 --sign winding
-    "$bin" sdf "$a/cube.obj" -o cube.vdb --voxel 0.01 --band 2
+    "$bin" sdf "$a/bunny.obj" -o bunny.vdb --resolution 64 "${scan[@]}"
+    "$bin" sdf "$a/trefoil.obj" -o trefoil.vdb --resolution 48 --sign winding "${scan[@]}"
+    "$bin" sdf "$a/cube.obj" -o cube.vdb --voxel 0.01 --band 2 "${scan[@]}"
+    if [ ${#exact[@]} -gt 0 ]; then
+      "$bin" sdf "$a/bunny.obj" -o bunny_exact.vdb --resolution 64 "${exact[@]}"
+      "$bin" sdf "$a/trefoil.obj" -o trefoil_exact.vdb --resolution 48 --sign winding "${exact[@]}"
+    fi
     "$bin" sample "$a/sphere.obj" -o body --count 400 --preview
     "$bin" sample "$a/torus.obj" -o body --count 600 --fill
     "$bin" sample "$a/plate.obj" -o body --count 300 --sign winding --grain-radius 0.005

@@ -1,7 +1,8 @@
-// `--backend`: which engine `sim`, `sdf` and `sample` run, chosen the way issue 16 asks ("the fastest path
-// where there is no GPU"): on a software GL device `sim` takes the CPU reference unless told otherwise and
-// says so in one line; `--backend gpu` forces the GPU pipeline, `--cpu` stays an alias of
-// `--backend cpu`, and bad combinations are usage errors (exit 2).
+// `--backend`: which engine `sim`, `sdf`, `sample` and `preview` run, chosen by the one rule of gpu/backend.h
+// (issues 16 and 42: "the fastest path where there is no GPU"): on a software GL device auto takes the CPU
+// path (the preview, with no CPU path yet, the GPU) and every command says so in the same one line;
+// `--backend gpu` forces the GPU, `--cpu` stays an alias of `sim --backend cpu`, and bad combinations are
+// usage errors (exit 2).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -20,8 +21,8 @@ namespace {
 
 using test::quoted;
 
-// `--device N` of the first software EGL device (llvmpipe), so the choice is tested on a machine
-// with a GPU too; nullopt when EGL lists none.
+// `--device N` of the first software EGL device (llvmpipe), so the choice is tested on a machine with a GPU
+// too; nullopt when EGL lists none.
 std::optional<std::string> software_device() {
   for (const gpu::DeviceDescription& d : gpu::enumerate_devices(false))
     if (d.software) return "--device " + std::to_string(d.index) + " ";
@@ -44,8 +45,8 @@ std::string summary_engine(const std::string& out) {
 }
 
 constexpr const char* kAutoLine =
-    "backend: CPU reference (the GL device is llvmpipe, a software renderer; --backend "
-    "gpu forces the GPU pipeline)\n";
+    "backend: cpu, the CPU reference (auto: the GL device is llvmpipe, a software renderer; --backend gpu "
+    "forces the GPU)\n";
 
 TEST(SimBackend, AutoRunsTheCpuReferenceOnASoftwareDeviceAndSaysSoInOneLine) {
   const auto device = software_device();
@@ -64,7 +65,8 @@ TEST(SimBackend, BackendGpuForcesTheGpuPipelineOnASoftwareDevice) {
   for (const std::string flags : {"--backend gpu", "--backend gpu --precision double"}) {
     std::string out;
     ASSERT_EQ(run_sim(*device, flags, &out), 0) << flags << "\n" << out;
-    EXPECT_EQ(out.find("backend:"), std::string::npos) << flags << "\n" << out;
+    EXPECT_NE(out.find("backend: gpu, the GPU pipeline (asked for)\n"), std::string::npos) << flags << "\n"
+                                                                                           << out;
     EXPECT_TRUE(summary_engine(out).starts_with("llvmpipe")) << flags << "\n" << out;
     EXPECT_TRUE(summary_engine(out).ends_with(", software)")) << flags << "\n" << out;
   }
@@ -75,8 +77,8 @@ TEST(SimBackend, CpuFlagIsAnAliasOfBackendCpu) {
     std::string out;
     ASSERT_EQ(run_sim("", flags, &out), 0) << flags << "\n" << out;
     EXPECT_EQ(summary_engine(out), "CPU reference") << flags << "\n" << out;
-    EXPECT_EQ(out.find("backend:"), std::string::npos) << flags << "\n"
-                                                       << out;  // asked for: nothing to explain
+    EXPECT_NE(out.find("backend: cpu, the CPU reference (asked for)\n"), std::string::npos) << flags << "\n"
+                                                                                            << out;
   }
   std::string out;
   EXPECT_EQ(run_sim("", "--cpu --backend gpu", &out), 2) << out;
@@ -98,17 +100,17 @@ TEST(SimBackend, BadBackendAndPrecisionWithTheCpuReferenceAreRefused) {
   }
 }
 
-// auto on a software device with --precision: the CPU reference still runs, and the one line says
-// that --precision is the GPU pipeline's.
+// auto on a software device with --precision: the CPU reference still runs, and the one line says that
+// --precision is the GPU pipeline's.
 TEST(SimBackend, AutoOnASoftwareDeviceNotesThatPrecisionIsTheGpus) {
   const auto device = software_device();
   if (!device) GTEST_SKIP() << "EGL lists no software device";
   std::string out;
   ASSERT_EQ(run_sim(*device, "--precision double", &out), 0) << out;
-  EXPECT_NE(
-      out.find("backend: CPU reference (the GL device is llvmpipe, a software renderer; --backend gpu forces "
-               "the GPU pipeline; --precision applies to it only, the CPU reference computes in double)\n"),
-      std::string::npos)
+  EXPECT_NE(out.find("backend: cpu, the CPU reference (auto: the GL device is llvmpipe, a software renderer; "
+                     "--backend gpu forces the GPU; --precision applies to the GPU pipeline only, the CPU "
+                     "reference computes in double)\n"),
+            std::string::npos)
       << out;
   EXPECT_EQ(summary_engine(out), "CPU reference") << out;
 }
@@ -142,10 +144,9 @@ TEST(SimBackend, ResumeUnderAnotherBackendNamesTheFlagsOfTheRunThatWroteIt) {
             0)
       << out;
   EXPECT_EQ(test::run_tetrasand("sim " + scene + " --resume " + out_dir + " --backend gpu", &out), 1) << out;
-  EXPECT_NE(
-      out.find("written by the cpu reference engine, and this run uses the gpu float (resume with --backend "
-               "cpu, as the run that wrote it)"),
-      std::string::npos)
+  EXPECT_NE(out.find("written by the cpu reference engine, and this run uses the gpu float (resume with "
+                     "--backend cpu, as the run that wrote it)"),
+            std::string::npos)
       << out;
 }
 
@@ -160,9 +161,11 @@ TEST(SdfBackend, NamesTheDeviceAndTheTimeAndTheCpuPathGivesTheSameBand) {
   const auto dir = test::temp_dir();
   const std::string bunny = quoted(test::asset("bunny.obj"));
   std::string gpu, cpu;
-  ASSERT_EQ(test::run_tetrasand("sdf " + bunny + " -o " + quoted(dir / "gpu.vdb") + " --resolution 24", &gpu),
+  ASSERT_EQ(test::run_tetrasand(
+                "sdf " + bunny + " -o " + quoted(dir / "gpu.vdb") + " --resolution 24 --backend gpu", &gpu),
             0)
       << gpu;
+  EXPECT_NE(gpu.find("backend: gpu, scan conversion (asked for)\n"), std::string::npos) << gpu;
   EXPECT_TRUE(
       std::regex_search(gpu, std::regex(R"(\ndevice: .+ \(device \d+(, software)?\); scan conversion )"
                                         R"(\d+\.\d{3} s\n)")))
@@ -171,23 +174,54 @@ TEST(SdfBackend, NamesTheDeviceAndTheTimeAndTheCpuPathGivesTheSameBand) {
                 "sdf " + bunny + " -o " + quoted(dir / "cpu.vdb") + " --resolution 24 --backend cpu", &cpu),
             0)
       << cpu;
+  EXPECT_NE(cpu.find("backend: cpu, exact SDF (asked for)\n"), std::string::npos) << cpu;
   EXPECT_TRUE(
       std::regex_search(cpu, std::regex(R"(\ndevice: CPU exact SDF \(triangle sweep, double precision, \d+ )"
                                         R"(TBB threads\); exact SDF \d+\.\d{3} s\n)")))
       << cpu;
   EXPECT_TRUE(std::filesystem::exists(dir / "cpu.vdb"));
-  // The GPU field is within 1.2e-4 voxel of exact (docs/benchmarks.md): the same voxels lie in the band
-  // but for the few whose distance is within that of the band's edge.
+  // The GPU field is within 1.2e-4 voxel of exact (docs/benchmarks.md): the same voxels lie in the band but
+  // for the few whose distance is within that of the band's edge.
   const long g = band_voxels(gpu), c = band_voxels(cpu);
   ASSERT_GT(g, 1000) << gpu;
   EXPECT_NEAR(static_cast<double>(c), static_cast<double>(g), 0.001 * static_cast<double>(g)) << cpu;
+}
+
+// Issue 42: plain `sdf` follows the rule of every command, so on llvmpipe (where the exact CPU path is 4-7x
+// faster) it takes the CPU path and says why; --backend gpu still runs the scan conversion there.
+TEST(SdfBackend, AutoTakesTheExactCpuPathOnASoftwareDeviceAndSaysSo) {
+  const auto device = software_device();
+  if (!device) GTEST_SKIP() << "EGL lists no software device";
+  const auto dir = test::temp_dir();
+  const std::string bunny = quoted(test::asset("bunny.obj"));
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand(*device + "sdf " + bunny + " -o " + quoted(dir / "auto.vdb"), &out), 0)
+      << out;
+  EXPECT_NE(out.find("backend: cpu, exact SDF (auto: the GL device is llvmpipe, a software renderer; "
+                     "--backend gpu forces the GPU)\n"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("\ndevice: CPU exact SDF ("), std::string::npos) << out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "auto.vdb"));
+  ASSERT_EQ(
+      test::run_tetrasand(*device + "sdf " + bunny + " -o " + quoted(dir / "auto.vdb") + " --json", &out), 0)
+      << out;
+  EXPECT_EQ(nlohmann::json::parse(out.substr(out.find("{\n"))).at("backend"), "cpu") << out;
+
+  ASSERT_EQ(test::run_tetrasand(
+                *device + "sdf " + bunny + " -o " + quoted(dir / "gpu.vdb") + " --backend gpu", &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("backend: gpu, scan conversion (asked for)\n"), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(\ndevice: llvmpipe.*; scan conversion \d+\.\d{3} s\n)")))
+      << out;
 }
 
 TEST(SdfBackend, BadBackendAndCompareWithTheCpuPathAreRefused) {
   const auto dir = test::temp_dir();
   const std::string cube = quoted(test::asset("cube.obj"));
   std::string out;
-  EXPECT_EQ(test::run_tetrasand("sdf " + cube + " -o " + quoted(dir / "a.vdb") + " --backend auto", &out), 2)
+  EXPECT_EQ(test::run_tetrasand("sdf " + cube + " -o " + quoted(dir / "a.vdb") + " --backend tpu", &out), 2)
       << out;
   EXPECT_NE(out.find("--backend"), std::string::npos) << out;
   EXPECT_EQ(test::run_tetrasand(
@@ -217,10 +251,13 @@ TEST(CliSampleBackend, AutoRelaxesOnTheCpuOnASoftwareDeviceAndSaysSoOnTheDeviceL
   if (!device) GTEST_SKIP() << "EGL lists no software device";
   std::string out;
   ASSERT_EQ(run_sample(*device, "", &out), 0) << out;
-  EXPECT_EQ(
-      sample_backend(out),
-      "relaxation and certificate on the CPU (auto: the GL device is a software renderer; --backend gpu "
-      "forces the GPU)")
+  EXPECT_EQ(sample_backend(out),
+            "relaxation and certificate on the CPU (auto: the GL device is llvmpipe, a software renderer; "
+            "--backend gpu forces the GPU)")
+      << out;
+  EXPECT_NE(out.find("backend: cpu, relaxation and certificate (auto: the GL device is llvmpipe, a software "
+                     "renderer; --backend gpu forces the GPU; SDF: by exact distance on the CPU, auto)\n"),
+            std::string::npos)
       << out;
   ASSERT_EQ(run_sample(*device, "--backend auto --json", &out), 0) << out;
   const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
@@ -234,7 +271,7 @@ TEST(CliSampleBackend, BackendGpuForcesTheGpuRelaxationOnASoftwareDevice) {
   if (!device) GTEST_SKIP() << "EGL lists no software device";
   std::string out;
   ASSERT_EQ(run_sample(*device, "--backend gpu --timings", &out), 0) << out;
-  EXPECT_EQ(sample_backend(out), "relaxation and certificate on the GPU (--backend gpu)") << out;
+  EXPECT_EQ(sample_backend(out), "relaxation and certificate on the GPU (asked for)") << out;
   EXPECT_NE(out.find("sampler/relax.comp"), std::string::npos) << out;  // the kernels ran
   ASSERT_EQ(run_sample(*device, "--backend gpu --json", &out), 0) << out;
   const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
@@ -245,20 +282,25 @@ TEST(CliSampleBackend, BackendGpuForcesTheGpuRelaxationOnASoftwareDevice) {
 TEST(CliSampleBackend, BackendCpuRelaxesOnTheCpuWithNoRoundTrip) {
   std::string out;
   ASSERT_EQ(run_sample("", "--backend cpu --timings", &out), 0) << out;
-  EXPECT_EQ(sample_backend(out), "relaxation and certificate on the CPU (--backend cpu)") << out;
+  EXPECT_EQ(sample_backend(out), "relaxation and certificate on the CPU (asked for)") << out;
   EXPECT_EQ(out.find("sampler/relax.comp"), std::string::npos) << out;
   EXPECT_TRUE(std::regex_search(out, std::regex(R"(CPU relaxation \(\d+ threads\): \d+ iterations)"))) << out;
   EXPECT_TRUE(std::regex_search(out, std::regex(R"(relaxation iterations between checks \(\d+\) +0 )")))
       << out;
 }
 
-// --backend cpu opens no GL context: a device that does not exist stops auto and --backend gpu
-// (exit 3), not it; --preview still needs one.
+// --backend cpu opens no GL context: a device that does not exist stops auto and --backend gpu (exit 3), not
+// it; --preview still needs one.
 TEST(CliSampleBackend, BackendCpuRunsWithoutAGlContext) {
   std::string out;
   ASSERT_EQ(run_sample("--device 99 ", "--backend cpu", &out), 0) << out;
   EXPECT_NE(out.find("  device           the CPU (no GL context): SDF by exact distance on the CPU"),
             std::string::npos)
+      << out;
+  EXPECT_NE(
+      out.find(
+          "backend: cpu, relaxation and certificate (asked for; SDF: by exact distance on the CPU, auto)\n"),
+      std::string::npos)
       << out;
   EXPECT_NE(out.find("certificate      certified"), std::string::npos) << out;
   for (const std::string flags : {"--backend auto", "--backend gpu", "--backend cpu --preview"}) {
@@ -273,6 +315,28 @@ TEST(CliSampleBackend, BadBackendIsAUsageError) {
   EXPECT_NE(out.find("--backend"), std::string::npos) << out;
   EXPECT_NE(out.find("tpu"), std::string::npos) << out;
   EXPECT_EQ(out.find("certificate"), std::string::npos) << out;  // refused before any work
+}
+
+// The preview has no CPU renderer yet: auto takes the GPU on a software device too and names why; --backend
+// cpu is a usage error that says so, before any work.
+TEST(PreviewBackend, AutoTakesTheGpuForWantOfACpuPathAndCpuIsAUsageError) {
+  const auto device = software_device();
+  if (!device) GTEST_SKIP() << "EGL lists no software device";
+  const auto dir = test::temp_dir();
+  const std::string preview =
+      "preview " + quoted(test::asset("cube.obj")) + " --size 64x48 --resolution 24 -o ";
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand(*device + preview + quoted(dir / "auto.png"), &out), 0) << out;
+  EXPECT_NE(
+      out.find(
+          "backend: gpu (auto: there is no CPU path yet; the GL device is llvmpipe, a software renderer)\n"),
+      std::string::npos)
+      << out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "auto.png"));
+  EXPECT_EQ(test::run_tetrasand(*device + preview + quoted(dir / "cpu.png") + " --backend cpu", &out), 2)
+      << out;
+  EXPECT_NE(out.find("--backend cpu: the preview has only a GPU path for now"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "cpu.png"));
 }
 
 }  // namespace

@@ -45,7 +45,7 @@ TEST(CliSdf, WritesALevelSetOfTheCube) {
   const auto dir = test::temp_dir();
   std::string out;
   ASSERT_EQ(test::run_tetrasand("sdf '" + test::asset("cube.obj").string() + "' -o '" + (dir / "cube.vdb").string() +
-                                    "' --resolution 16 --timings",
+                                    "' --resolution 16 --timings --backend gpu",
                                 &out),
             0)
       << out;

@@ -12,12 +12,15 @@ unset TETRASAND_SHADER_DIR
 export MESA_SHADER_CACHE_DISABLE=true
 test -x "$prefix/bin/tetrasand"
 test -f "$prefix/share/tetrasand/shaders/sdf/scan_convert.geom"
-"$prefix/bin/tetrasand" sdf "$source/assets/cube.obj" -o "$prefix/cube.vdb" --resolution 16
+# --backend gpu: the scan conversion reads the kernels (plain sdf takes the exact CPU path on a software
+# renderer).
+"$prefix/bin/tetrasand" sdf "$source/assets/cube.obj" -o "$prefix/cube.vdb" --resolution 16 --backend gpu
 test -s "$prefix/cube.vdb"
 # Proof that it read the installed copy (the build tree is a fallback): break the installed kernel,
 # and the same run must now fail with a shader error naming that file.
 echo "this line is deliberately not GLSL (install_test);" >> "$prefix/share/tetrasand/shaders/sdf/scan_convert.geom"
-if "$prefix/bin/tetrasand" sdf "$source/assets/cube.obj" -o "$prefix/cube2.vdb" --resolution 16 > "$prefix/log" 2>&1; then
+if "$prefix/bin/tetrasand" sdf "$source/assets/cube.obj" -o "$prefix/cube2.vdb" --resolution 16 --backend gpu \
+    >"$prefix/log" 2>&1; then
   echo "the installed executable did not read its installed shaders" >&2; exit 1
 fi
 grep -q "scan_convert.geom" "$prefix/log" || { cat "$prefix/log" >&2; exit 1; }

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -365,19 +366,23 @@ TEST(SampleMesh, ProportionalProbesFindAKnownHoleWithinTheStatedBound) {
 }
 
 // Every SDF path gives a body that meets the targets: the exact CPU field (the default on a software
-// renderer for small grids, SdfBackend::Auto), OpenVDB's on the CPU and the GPU scan conversion; the
+// renderer for small grids, gpu::Backend::Auto), OpenVDB's on the CPU and the GPU scan conversion; the
 // result says which one ran.
 TEST(SampleMesh, CpuOpenVdbAndGpuSdfAllMeetTheTargets) {
   const TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));
-  for (const SdfBackend backend : {SdfBackend::Cpu, SdfBackend::OpenVdb, SdfBackend::Gpu, SdfBackend::Auto}) {
+  const std::pair<gpu::Backend, CpuSdfMethod> paths[] = {{gpu::Backend::Cpu, CpuSdfMethod::Exact},
+                                                         {gpu::Backend::Cpu, CpuSdfMethod::OpenVdb},
+                                                         {gpu::Backend::Gpu, CpuSdfMethod::Exact},
+                                                         {gpu::Backend::Auto, CpuSdfMethod::Exact}};
+  for (const auto& [backend, method] : paths) {
     SampleSettings settings;
     settings.count = 300;
     settings.sdf_backend = backend;
+    settings.cpu_sdf = method;
     const SampleResult result = sample_mesh(shared_context(), mesh, settings);
-    const bool cpu = backend == SdfBackend::Cpu || backend == SdfBackend::OpenVdb ||
-                     (backend == SdfBackend::Auto && shared_context().software());
+    const bool cpu = backend == gpu::Backend::Cpu || (backend == gpu::Backend::Auto && shared_context().software());
     EXPECT_EQ(result.sdf_on_cpu(), cpu);
-    EXPECT_EQ(result.sdf_path == SdfPath::OpenVdb, backend == SdfBackend::OpenVdb);  // auto: exact at this size
+    EXPECT_EQ(result.sdf_path == SdfPath::OpenVdb, method == CpuSdfMethod::OpenVdb);  // auto: exact at this size
     EXPECT_GT(result.field.band_voxels, 0u);
     EXPECT_GT(result.stages.sdf, 0.0);
     EXPECT_GT(result.stages.relaxation, 0.0);
@@ -404,7 +409,8 @@ TEST(SampleMesh, LargeGridsOnASoftwareRendererTakeTheExactField) {
 
   settings.sign = sdf::SignMethod::Winding;
   EXPECT_EQ(sample_mesh(shared_context(), mesh, settings).sdf_path, SdfPath::Exact);
-  settings.sdf_backend = SdfBackend::OpenVdb;
+  settings.sdf_backend = gpu::Backend::Cpu;
+  settings.cpu_sdf = CpuSdfMethod::OpenVdb;
   try {
     sample_mesh(shared_context(), mesh, settings);
     FAIL() << "--sdf-backend openvdb with the winding-number sign ran";
@@ -414,16 +420,16 @@ TEST(SampleMesh, LargeGridsOnASoftwareRendererTakeTheExactField) {
 }
 
 // Both relaxations give a body that meets the targets: the CPU one (the default on a software
-// renderer, SampleBackend::Auto) and the GPU kernels; the result says which one ran.
+// renderer, gpu::Backend::Auto) and the GPU kernels; the result says which one ran.
 TEST(SampleMesh, CpuAndGpuRelaxationBothMeetTheTargets) {
   const TriangleMesh mesh = load_mesh(test::asset("torus.obj"));
-  for (const SampleBackend backend : {SampleBackend::Cpu, SampleBackend::Gpu, SampleBackend::Auto}) {
+  for (const gpu::Backend backend : {gpu::Backend::Cpu, gpu::Backend::Gpu, gpu::Backend::Auto}) {
     SampleSettings settings;
     settings.count = 300;
     settings.backend = backend;
     const SampleResult result = sample_mesh(shared_context(), mesh, settings);
     const bool cpu =
-        backend == SampleBackend::Cpu || (backend == SampleBackend::Auto && shared_context().software());
+        backend == gpu::Backend::Cpu || (backend == gpu::Backend::Auto && shared_context().software());
     EXPECT_EQ(result.relax_on_cpu, cpu);
     EXPECT_EQ(result.certificate_on_cpu, cpu);
     EXPECT_EQ(result.field.gpu_bytes > 0, !cpu);  // the CPU path uploads no field
@@ -436,7 +442,7 @@ TEST(SampleMesh, CpuAndGpuRelaxationBothMeetTheTargets) {
 // a stage that needs the GPU says so.
 TEST(SampleMesh, CpuBackendNeedsNoGlContext) {
   const TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));
-  for (const SampleBackend backend : {SampleBackend::Cpu, SampleBackend::Auto}) {
+  for (const gpu::Backend backend : {gpu::Backend::Cpu, gpu::Backend::Auto}) {
     SampleSettings settings;
     settings.count = 300;
     settings.backend = backend;
@@ -448,7 +454,7 @@ TEST(SampleMesh, CpuBackendNeedsNoGlContext) {
   }
   SampleSettings settings;
   settings.count = 300;
-  settings.backend = SampleBackend::Gpu;
+  settings.backend = gpu::Backend::Gpu;
   EXPECT_THROW(sample_mesh(nullptr, mesh, settings), Error);
 }
 
