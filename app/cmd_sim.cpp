@@ -114,7 +114,7 @@ std::string requested_backend(const Options& o) {
 
 // The GL context a run needs (the GPU pipeline's, or only the frames' renderer's; null when neither)
 // and the engine that runs the steps: the GPU pipeline (sim/gpu_stepper.h) or the CPU reference
-// (sim/cpu_reference.h), by the rule of gpu/backend.h, named in its one line. A device that cannot
+// (sim/cpu_stepper.h), by the rule of gpu/backend.h, named in its one line. A device that cannot
 // make a context at all stays an error (exit 3) under auto, as under --backend gpu: a broken driver on
 // a GPU machine should say so, not turn into a much slower run.
 gpu::Backend choose_backend(const Options& o, const GlobalOptions& global, bool frames,

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <string>
 
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "scene/scene.h"
 #include "sim/world.h"
 

@@ -1,5 +1,5 @@
 // The coverage certificate against the probe pass on one body, side by side in one process: the
-// certificate (GPU, sampler/coverage_certificate.h), its CPU twin (sampler/cpu_coverage_certificate.h,
+// certificate (GPU, sampler/gpu_coverage_certificate.h), its CPU twin (sampler/cpu_coverage_certificate.h,
 // all cores) and the sampler's statistical pass (1M random surface probes, CPU on all cores) on the
 // particles as the body stores them, then an independent probe check (10M probes, another seed)
 // whose deepest point must never lie beyond the certified bound, nor beyond r when the body is
@@ -20,7 +20,7 @@
 #include "body/body_file.h"
 #include "core/mesh_io.h"
 #include "gpu/context.h"
-#include "sampler/coverage_certificate.h"
+#include "sampler/gpu_coverage_certificate.h"
 #include "sampler/cpu_coverage_certificate.h"
 #include "sampler/sampling_quality.h"
 
@@ -65,7 +65,7 @@ Options parse(int argc, char** argv) {
 nlohmann::json certificate_figures(ts::gpu::Context& context, const ts::TriangleMesh& mesh,
                                    const std::vector<Eigen::Vector3f>& centres, double r) {
   auto t = Clock::now();
-  ts::sampler::CoverageCertifier certifier(context, mesh);
+  ts::sampler::GpuCoverageCertifier certifier(context, mesh);
   const double setup = since(t);
   t = Clock::now();
   const ts::sampler::CoverageCertificate c = certifier.certify(centres, r);

@@ -58,7 +58,7 @@ struct ParticleBody {
     bool converged = false;
     int injection_rounds = 0;  // hole-closing rounds
 
-    // The coverage certificate of the surface particles at radius r (sampler/coverage_certificate.h,
+    // The coverage certificate of the surface particles at radius r (sampler/gpu_coverage_certificate.h,
     // docs/coverage-certificate.md): a proof, where covering_radius is a random sample's figure.
     struct Certificate {
       bool certified = false;                  // proven: every surface point lies within r of a centre

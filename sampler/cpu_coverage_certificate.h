@@ -1,5 +1,5 @@
 #pragma once
-// The coverage certificate of sampler/coverage_certificate.h, computed on the CPU in double
+// The coverage certificate of sampler/gpu_coverage_certificate.h, computed on the CPU in double
 // precision: the same midpoint subdivision, the same fate for each sub-triangle (covered when one
 // ball of the radius holds its three corners, split, or final at the floor), the same covering bound
 // and witnesses, in the same CoverageCertificate. Each triangle is refined depth first on its own
@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/mesh.h"
-#include "sampler/coverage_certificate.h"
+#include "sampler/gpu_coverage_certificate.h"
 
 namespace ts::sampler {
 

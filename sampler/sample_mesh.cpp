@@ -358,7 +358,7 @@ std::unique_ptr<Certifier> make_certifier(gpu::Context* context, const TriangleM
                                           const SampleSettings& settings, SampleResult& result) {
   result.certificate_on_cpu = result.relax_on_cpu;
   if (result.certificate_on_cpu) return std::make_unique<CertifierOf<CpuCoverageCertifier>>(mesh);
-  return std::make_unique<CertifierOf<CoverageCertifier>>(
+  return std::make_unique<CertifierOf<GpuCoverageCertifier>>(
       needed_context(context, "the GPU coverage certificate"), mesh, settings.timings);
 }
 

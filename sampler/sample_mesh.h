@@ -6,7 +6,7 @@
 //   3. relaxation (attraction to the zero level set + Gaussian repulsion) on the GPU or the CPU
 //      (SampleSettings::backend; sampler/relaxer.h);
 //   4. exact projection onto the mesh, crowded pairs (closer than 0.6 spacing) thinned, coverage
-//      certified (sampler/coverage_certificate.h), particles injected at the deepest
+//      certified (sampler/gpu_coverage_certificate.h), particles injected at the deepest
 //      uncovered points it proves; the first 3 rounds relax them with their neighbours (the rest
 //      frozen), later ones only place them, until the certificate holds or the round limit;
 //   5. quality figures: the certificate at radius r, and the covering radius over random surface
@@ -21,7 +21,7 @@
 #include "core/mesh.h"
 #include "gpu/backend.h"
 #include "gpu/context.h"
-#include "sampler/coverage_certificate.h"
+#include "sampler/gpu_coverage_certificate.h"
 #include "sampler/relaxer.h"
 #include "sampler/thin_features.h"
 #include "sdf/settings.h"
@@ -35,7 +35,7 @@ namespace ts::sampler {
 //   cores; the exact sweep is also faster than OpenVDB at every size measured, the 1M-particle bunny's
 //   band in 12 s (docs/benchmarks.md, "sample fixed costs").
 // - the relaxation and the coverage certificate (SampleSettings::backend): GL compute kernels
-//   (sampler/gpu_relaxer.h, sampler/coverage_certificate.h) or the same algorithms on the CPU with TBB
+//   (sampler/gpu_relaxer.h, sampler/gpu_coverage_certificate.h) or the same algorithms on the CPU with TBB
 //   (sampler/cpu_relaxer.h, sampler/cpu_coverage_certificate.h). llvmpipe runs the kernels on the same
 //   cores, with a fixed cost per dispatch that small counts do not amortise and a 128 MiB storage block
 //   that stops the sparse field of a 10^6-particle body (docs/benchmarks.md, "sample fixed costs").

@@ -18,7 +18,7 @@
 #include "scene/scene_checks.h"
 #include "scene/scene_world.h"
 #include "scene/servo.h"
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 
 namespace ts::scene {
 

@@ -2,7 +2,7 @@
 // The contact stage of the CPU reference, in double precision: particle positions from the body
 // poses, a hashed grid, and for each dynamic particle the forces of its touching partners (other
 // bodies' particles, then walls) gathered in a fixed order, TBB-parallel and deterministic. It is
-// apart from the stepper (sim/cpu_reference.h) because both engines need it: sim::CpuStepper gathers
+// apart from the stepper (sim/cpu_stepper.h) because both engines need it: sim::CpuStepper gathers
 // its forces here, and the GPU pipeline takes from it what only the reference computes (contact
 // dumps, the spring energy of a state it is given).
 #include <Eigen/Core>

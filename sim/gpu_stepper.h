@@ -1,5 +1,5 @@
 #pragma once
-// The GPU pipeline of the DEM, stage for stage the same as CpuStepper (sim/cpu_reference.h) on the same
+// The GPU pipeline of the DEM, stage for stage the same as CpuStepper (sim/cpu_stepper.h) on the same
 // World: poses -> particle positions and velocities -> hashed grid (counting sort) -> contact forces
 // gathered per particle (no float atomics) -> per-body sums and integration. Steps run with no CPU
 // round trip; statistics and state are read back only when asked. What only the CPU reference

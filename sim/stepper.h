@@ -1,7 +1,7 @@
 #pragma once
 // The one interface of the two DEM engines, and the data every engine takes and gives: the settings
 // of a step, the statistics of a step and one contact of a state. sim::CpuStepper
-// (sim/cpu_reference.h, double precision) and sim::GpuStepper (sim/gpu_stepper.h, GL compute) both
+// (sim/cpu_stepper.h, double precision) and sim::GpuStepper (sim/gpu_stepper.h, GL compute) both
 // implement Stepper; sim::run_scene (scene/scene_runner.h) drives either through it.
 #include <Eigen/Core>
 

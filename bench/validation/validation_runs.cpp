@@ -26,7 +26,7 @@
 #include "bench/bench_scenes.h"
 #include "core/atomic_file.h"
 #include "gpu/context.h"
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "export/lammps_deck.h"
 #include "sim/gpu_stepper.h"
 #include "scene/scene.h"

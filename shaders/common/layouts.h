@@ -43,7 +43,7 @@ TS_LAYOUT(SamplerGrid) {
   uvec4 dims;             // xyz: cells along each axis of the hashed grid; w: hash table size
 };
 
-// ---- sampler: one mesh triangle of the coverage certificate (sampler/coverage_certificate.h), relative
+// ---- sampler: one mesh triangle of the coverage certificate (sampler/gpu_coverage_certificate.h), relative
 // to the certificate's local origin: the point (a, b) of its parameter triangle (a, b >= 0, a + b <= 1)
 // is corner + a edge1 + b edge2.
 TS_LAYOUT(CertTriangle) {

@@ -33,7 +33,7 @@
 #define TS_SAMPLER_PARTIALS 7                      // vec4 per 256 particles: STEP_INFO summed
 #define TS_SAMPLER_POSITIONS 0                     // vec4 (project.comp): positions moved in place
 
-// The coverage certificate (sampler/coverage_certificate.cpp); the grid's slots 2, 4 and 5 stay bound.
+// The coverage certificate (sampler/gpu_coverage_certificate.cpp); the grid's slots 2, 4 and 5 stay bound.
 #define TS_CERT_CENTRES TS_GRID_POSITIONS  // vec4: xyz particle centre [m, local]
 #define TS_CERT_TRIANGLES 1                // CertTriangle per mesh triangle
 #define TS_CERT_QUEUE 3                    // uvec4 per sub-triangle of this level (CertLeaf.id)

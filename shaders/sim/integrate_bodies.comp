@@ -1,7 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Steps 4 and 5, per body: sum its particles' forces and torques in particle order (deterministic),
-// then integrate, mirroring CpuStepper::integrate (sim/cpu_reference.cpp). Rotation first (thesis eqs.
+// then integrate, mirroring CpuStepper::integrate (sim/cpu_stepper.cpp). Rotation first (thesis eqs.
 // 3.47-3.50) through the angular momentum L, omega = R I0^-1 R^T L; forward Euler moves with the old
 // velocities, semi-implicit Euler with the new ones. Static bodies are skipped; kinematic bodies
 // follow their prescribed velocities or

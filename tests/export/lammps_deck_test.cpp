@@ -21,7 +21,7 @@
 #include "scene/scene.h"
 #include "scene/scene_runner.h"
 #include "scene/scene_world.h"
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "sim/time_step.h"
 #include "sim/world.h"
 #include "tests/test_support.h"

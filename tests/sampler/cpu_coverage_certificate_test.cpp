@@ -2,7 +2,7 @@
 // inputs: the same verdict, bounds within the floor of each other (each lies within
 // max(r, c) / floor_divisor + its margin above c), and the same holes; then the cases only it must
 // answer for (zero-area and single triangles, the thread count). Its known-answer cases are those of
-// coverage_certificate_test.cpp, which run against both certifiers.
+// gpu_coverage_certificate_test.cpp, which run against both certifiers.
 #include "sampler/cpu_coverage_certificate.h"
 
 #include <gtest/gtest.h>
@@ -17,7 +17,7 @@
 
 #include "core/error.h"
 #include "core/mesh_io.h"
-#include "sampler/coverage_certificate.h"
+#include "sampler/gpu_coverage_certificate.h"
 #include "sampler/sampling_quality.h"
 #include "sampler/surface_points.h"
 #include "tests/test_meshes.h"
@@ -90,7 +90,7 @@ void expect_agreement(const CoverageCertificate& gpu, const CoverageCertificate&
 
 TEST(CpuCoverageCertificate, AgreesWithTheGpuOnIcosahedralSetsOnASphere) {
   const TriangleMesh sphere = test::icosphere(1.0, 4);
-  CoverageCertifier gpu(shared_context(), sphere);
+  GpuCoverageCertifier gpu(shared_context(), sphere);
   CpuCoverageCertifier cpu(sphere);
   for (const std::size_t n : {std::size_t{12}, std::size_t{42}}) {
     const std::vector<Eigen::Vector3f> centres =
@@ -121,7 +121,7 @@ TEST(CpuCoverageCertificate, AgreesWithTheGpuOnTheBunny) {
   CoverageSettings probes;
   probes.probes = 200'000;
   const double sampled = measure_coverage(bunny, centres, probes).covering_radius;
-  CoverageCertifier gpu(shared_context(), bunny);
+  GpuCoverageCertifier gpu(shared_context(), bunny);
   CpuCoverageCertifier cpu(bunny);
   for (const double r : {1.25 * sampled, 0.8 * sampled}) {
     const CoverageCertificate a = gpu.certify(centres, r), b = cpu.certify(centres, r);

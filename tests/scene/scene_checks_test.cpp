@@ -15,7 +15,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "gpu/context.h"
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "sim/gpu_stepper.h"
 #include "scene/scene_runner.h"
 #include "tests/test_support.h"

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <vector>
 
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "scene/scene.h"
 #include "scene/scene_runner.h"
 #include "scene/scene_world.h"

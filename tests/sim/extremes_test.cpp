@@ -9,7 +9,7 @@
 
 #include "core/error.h"
 #include "gpu/context.h"
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "sim/gpu_stepper.h"
 #include "sim/time_step.h"
 

@@ -9,7 +9,7 @@
 
 #include "core/atomic_file.h"
 #include "gpu/context.h"
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "sim/gpu_stepper.h"
 #include "scene/scene.h"
 #include "scene/scene_runner.h"

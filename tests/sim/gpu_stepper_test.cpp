@@ -10,7 +10,7 @@
 
 #include "core/error.h"
 
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "sim/grain.h"
 #include "sim/world.h"
 
@@ -205,7 +205,7 @@ TEST_F(GpuStepperTest, SlidingSpringContactTrajectoryAgrees) {
 
 // A grain standing on three spheres on a smooth plane tilted 20 degrees (tan 20 = 0.36 < mu = 0.5),
 // stepped on the GPU: 20 ms for the contacts to load, then how far it moves down the slope in the
-// next 0.05 s, in sphere radii (the CPU twin is in cpu_reference_test.cpp).
+// next 0.05 s, in sphere radii (the CPU twin is in cpu_stepper_test.cpp).
 double gpu_slide_on_incline(gpu::Context& context, TangentialModel tangential) {
   World w;
   w.materials = {Material{}};

@@ -14,7 +14,7 @@
 #include "core/atomic_file.h"
 #include "scene/scene.h"
 #include "scene/scene_runner.h"
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "scene/scene_world.h"
 #include "tests/test_support.h"
 

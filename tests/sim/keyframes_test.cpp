@@ -8,7 +8,7 @@
 
 #include "body/body_file.h"
 #include "core/error.h"
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "sim/gpu_stepper.h"
 #include "scene/scene.h"
 #include "scene/scene_world.h"

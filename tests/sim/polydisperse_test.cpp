@@ -12,7 +12,7 @@
 #include "core/error.h"
 #include "gpu/context.h"
 #include "scene/checkpoint.h"
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 #include "sim/gpu_stepper.h"
 #include "scene/grain_mix.h"
 #include "scene/scene.h"

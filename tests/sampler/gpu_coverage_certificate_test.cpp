@@ -1,11 +1,11 @@
-// The coverage certificate (sampler/coverage_certificate.h) on cases whose covering radius is known:
+// The coverage certificate (sampler/gpu_coverage_certificate.h) on cases whose covering radius is known:
 // analytically (a lattice with a particle removed, a plate covered from one side), from the geometry
 // (an icosahedral set on a sphere: the exact maximum of the nearest-centre distance over each
 // triangle, from its Voronoi vertices), and against dense random sampling. The bound must never be
 // below the exact value (nor below any sampled one) and must lie within the stated tolerance above
 // it: max(r, c) / 64 (the floor) plus the float margin. The known-answer cases run against both
 // certifiers, the GPU one and its CPU twin (sampler/cpu_coverage_certificate.h), so each proves both.
-#include "sampler/coverage_certificate.h"
+#include "sampler/gpu_coverage_certificate.h"
 
 #include <gtest/gtest.h>
 
@@ -39,7 +39,7 @@ class EitherCertifier {
  public:
   EitherCertifier(Backend backend, const TriangleMesh& mesh) {
     if (backend == Backend::Gpu) {
-      gpu_ = std::make_unique<CoverageCertifier>(shared_context(), mesh);
+      gpu_ = std::make_unique<GpuCoverageCertifier>(shared_context(), mesh);
     } else {
       cpu_ = std::make_unique<CpuCoverageCertifier>(mesh);
     }
@@ -50,7 +50,7 @@ class EitherCertifier {
   }
 
  private:
-  std::unique_ptr<CoverageCertifier> gpu_;
+  std::unique_ptr<GpuCoverageCertifier> gpu_;
   std::unique_ptr<CpuCoverageCertifier> cpu_;
 };
 
@@ -360,7 +360,7 @@ TEST(CoverageCertificate, SameInputGivesTheSameBitsAndABudgetCostsTilesNotRefine
   const TriangleMesh sphere = test::icosphere(1.0, 3);
   const std::vector<Eigen::Vector3d> centres(sphere.vertices.begin(), sphere.vertices.begin() + 42);
   const std::vector<Eigen::Vector3f> stored = to_float(centres);
-  CoverageCertifier certifier(shared_context(), sphere);
+  GpuCoverageCertifier certifier(shared_context(), sphere);
   const CoverageCertificate a = certifier.certify(stored, 0.3);
   const CoverageCertificate b = certifier.certify(stored, 0.3);
   EXPECT_EQ(a.covering_bound, b.covering_bound);
@@ -410,7 +410,7 @@ TEST(CoverageCertificate, LevelBudgetIsBoundedOnlyByItsThirtyTwoBitCounts) {
   const TriangleMesh sphere = test::icosphere(1.0, 2);
   const std::vector<Eigen::Vector3f> stored =
       to_float(std::vector<Eigen::Vector3d>(sphere.vertices.begin(), sphere.vertices.begin() + 42));
-  CoverageCertifier certifier(shared_context(), sphere);
+  GpuCoverageCertifier certifier(shared_context(), sphere);
   CertificateSettings large;
   large.max_subtriangles = std::size_t{1} << 28;
   const CoverageCertificate by_default = certifier.certify(stored, 0.3);

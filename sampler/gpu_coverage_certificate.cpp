@@ -1,4 +1,4 @@
-#include "sampler/coverage_certificate.h"
+#include "sampler/gpu_coverage_certificate.h"
 
 #include <fmt/format.h>
 
@@ -42,7 +42,7 @@ constexpr std::size_t kMaxLevelItems = (std::size_t{std::numeric_limits<std::uin
 }  // namespace
 
 // The certificate's local frame for one set of centres, and its float margins.
-struct CoverageCertifier::Frame {
+struct GpuCoverageCertifier::Frame {
   double radius = 0.0;       // m, tested
   double extent = 0.0;       // m, largest distance of a vertex or centre from the origin
   double margin = 0.0;       // m, absolute part of the float margin
@@ -91,7 +91,7 @@ std::vector<UncoveredPiece> deepest_holes(const CoverageCertificate& certificate
   return picked;
 }
 
-CoverageCertifier::CoverageCertifier(gpu::Context& context, const TriangleMesh& mesh, bool timings)
+GpuCoverageCertifier::GpuCoverageCertifier(gpu::Context& context, const TriangleMesh& mesh, bool timings)
     : mesh_(mesh),
       queue_(timings, context.debug()),
       evaluate_(gpu::Program::compute(library_, "sampler/certify_evaluate.comp")),
@@ -117,7 +117,7 @@ CoverageCertifier::CoverageCertifier(gpu::Context& context, const TriangleMesh& 
   totals_ = gpu::Buffer(sizeof(gpu::layout::uvec4));
 }
 
-CoverageCertifier::Frame CoverageCertifier::upload_centres(std::span<const Eigen::Vector3f> centres,
+GpuCoverageCertifier::Frame GpuCoverageCertifier::upload_centres(std::span<const Eigen::Vector3f> centres,
                                                            double radius) {
   Frame frame;
   frame.radius = radius;
@@ -144,14 +144,14 @@ CoverageCertifier::Frame CoverageCertifier::upload_centres(std::span<const Eigen
   return frame;
 }
 
-void CoverageCertifier::seed_queue(std::uint32_t begin, std::uint32_t end) {
+void GpuCoverageCertifier::seed_queue(std::uint32_t begin, std::uint32_t end) {
   std::vector<gpu::layout::uvec4> level0(end - begin);
   for (std::uint32_t t = begin; t < end; ++t) level0[t - begin] = {t, 0u, 0u, 0u};
   ensure(queue_buffers_[0], level0.size() * sizeof(gpu::layout::uvec4));
   if (!level0.empty()) queue_buffers_[0].upload(std::span<const gpu::layout::uvec4>(level0));
 }
 
-CoverageCertifier::LevelCounts CoverageCertifier::evaluate(std::uint32_t count, const Frame& frame,
+GpuCoverageCertifier::LevelCounts GpuCoverageCertifier::evaluate(std::uint32_t count, const Frame& frame,
                                                            const CertificateSettings& settings,
                                                            float witness_so_far, bool no_split) {
   ensure(splits_, (count + 1) * sizeof(std::uint32_t));
@@ -186,7 +186,7 @@ CoverageCertifier::LevelCounts CoverageCertifier::evaluate(std::uint32_t count, 
   return counts;
 }
 
-void CoverageCertifier::scatter(std::uint32_t count, const LevelCounts& counts) {
+void GpuCoverageCertifier::scatter(std::uint32_t count, const LevelCounts& counts) {
   ensure(queue_buffers_[1], counts.children * sizeof(gpu::layout::uvec4));
   ensure(holes_, counts.uncovered * sizeof(CertLeaf));
   queue_buffers_[0].bind(TS_CERT_QUEUE);
@@ -201,7 +201,7 @@ void CoverageCertifier::scatter(std::uint32_t count, const LevelCounts& counts) 
   std::swap(queue_buffers_[0], queue_buffers_[1]);
 }
 
-Eigen::Vector3d CoverageCertifier::piece_point(std::uint32_t triangle, int level, std::uint32_t a,
+Eigen::Vector3d GpuCoverageCertifier::piece_point(std::uint32_t triangle, int level, std::uint32_t a,
                                                std::uint32_t b) const {
   const auto& t = mesh_.triangles[triangle];
   const Eigen::Vector3d& v0 = mesh_.vertices[t[0]];
@@ -211,7 +211,7 @@ Eigen::Vector3d CoverageCertifier::piece_point(std::uint32_t triangle, int level
 
 // An uncovered sub-triangle in double precision, from its id and its GPU bounds (U and the witness,
 // not yet widened by the float margin: finish() does that).
-UncoveredPiece CoverageCertifier::make_piece(const Eigen::Vector4i& id, const Eigen::Vector3f& bounds) const {
+UncoveredPiece GpuCoverageCertifier::make_piece(const Eigen::Vector4i& id, const Eigen::Vector3f& bounds) const {
   const auto triangle = static_cast<std::uint32_t>(id.x());
   const int level = id.y() & 0xff;
   const bool down = (id.y() >> 8) != 0;
@@ -236,7 +236,7 @@ UncoveredPiece CoverageCertifier::make_piece(const Eigen::Vector4i& id, const Ei
   return p;
 }
 
-std::vector<UncoveredPiece> CoverageCertifier::read_pieces(std::uint32_t uncovered) const {
+std::vector<UncoveredPiece> GpuCoverageCertifier::read_pieces(std::uint32_t uncovered) const {
   const std::vector<CertLeaf> leaves = holes_.read<CertLeaf>(uncovered);
   std::vector<UncoveredPiece> pieces;
   pieces.reserve(leaves.size());
@@ -252,7 +252,7 @@ std::vector<UncoveredPiece> CoverageCertifier::read_pieces(std::uint32_t uncover
 // infinite): their depth is the exact distance from the centroid to the nearest centre (CPU, double),
 // their bound the smaller of the GPU's and that distance plus the longest edge (every corner lies
 // within an edge of the centroid).
-void CoverageCertifier::bound_unsearched(std::vector<UncoveredPiece>& pieces,
+void GpuCoverageCertifier::bound_unsearched(std::vector<UncoveredPiece>& pieces,
                                          std::span<const Eigen::Vector3f> centres, double radius) const {
   const auto unsearched = [](const UncoveredPiece& p) { return !p.searched; };
   if (std::none_of(pieces.begin(), pieces.end(), unsearched)) return;
@@ -267,7 +267,7 @@ void CoverageCertifier::bound_unsearched(std::vector<UncoveredPiece>& pieces,
   }
 }
 
-void CoverageCertifier::finish(CoverageCertificate& result, const Frame& frame, float witness) const {
+void GpuCoverageCertifier::finish(CoverageCertificate& result, const Frame& frame, float witness) const {
   const auto totals = totals_.read<std::uint32_t>(4);
   double bound = frame.upper(bits_to_float(totals[0]));
   for (UncoveredPiece& p : result.pieces) {
@@ -287,7 +287,7 @@ void CoverageCertifier::finish(CoverageCertificate& result, const Frame& frame, 
   result.margin = frame.margin;
 }
 
-CoverageCertifier::Tile CoverageCertifier::certify_tile(std::uint32_t begin, std::uint32_t end,
+GpuCoverageCertifier::Tile GpuCoverageCertifier::certify_tile(std::uint32_t begin, std::uint32_t end,
                                                         const Frame& frame,
                                                         const CertificateSettings& settings, float& witness) {
   Tile tile;
@@ -317,7 +317,7 @@ CoverageCertifier::Tile CoverageCertifier::certify_tile(std::uint32_t begin, std
   return tile;
 }
 
-CoverageCertificate CoverageCertifier::certify(std::span<const Eigen::Vector3f> centres, double radius,
+CoverageCertificate GpuCoverageCertifier::certify(std::span<const Eigen::Vector3f> centres, double radius,
                                                const CertificateSettings& settings) {
   if (centres.empty()) throw Error(ExitCode::Internal, "coverage certificate: no centres");
   if (!(radius > 0.0) || !(settings.floor_divisor >= 1.0) || !(settings.hole_divisor >= 1.0) ||

@@ -1,4 +1,4 @@
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>

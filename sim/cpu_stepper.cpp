@@ -1,4 +1,4 @@
-#include "sim/cpu_reference.h"
+#include "sim/cpu_stepper.h"
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>

@@ -78,13 +78,13 @@ std::vector<UncoveredPiece> deepest_holes(const CoverageCertificate& certificate
                                           std::span<const Eigen::Vector3f> centres, std::size_t count,
                                           double separation = 1.0);
 
-class CoverageCertifier {
+class GpuCoverageCertifier {
  public:
   // Uploads the mesh's triangles once, relative to the centre of its bounding box. `mesh` must
   // outlive the certifier.
-  CoverageCertifier(gpu::Context& context, const TriangleMesh& mesh, bool timings = false);
-  CoverageCertifier(const CoverageCertifier&) = delete;
-  CoverageCertifier& operator=(const CoverageCertifier&) = delete;
+  GpuCoverageCertifier(gpu::Context& context, const TriangleMesh& mesh, bool timings = false);
+  GpuCoverageCertifier(const GpuCoverageCertifier&) = delete;
+  GpuCoverageCertifier& operator=(const GpuCoverageCertifier&) = delete;
 
   // Certifies balls of `radius` [m] > 0 about `centres` (m, mesh coordinates, at least one): the
   // particles as a body stores them. Same input, same device: same result, bit for bit.
