@@ -14,6 +14,7 @@
 #include "app/commands.h"
 #include "app/numeric_options.h"
 #include "app/progress.h"
+#include "app/sdf_report.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -32,18 +33,8 @@ namespace ts::app {
 
 namespace {
 
-struct Options {
-  std::string mesh, output;
-  double voxel = 0;
-  int resolution = 128;
-  double band = 3.0;
-  int padding = -1;
-  std::string sign = "pseudonormal";
-  std::string backend = "auto";  // gpu: scan conversion; cpu: the exact SDF (sdf/exact_sdf.h); auto: the rule
-  double scale = 1.0;
-  double slab_mb = 1024;
-  bool timings = false, compare = false, json = false;
-};
+using Options = SdfOptions;
+using Figures = SdfFigures;
 
 // The suffix chooses the file format: OpenVDB (.vdb) or NanoVDB (.nvdb), case-insensitive.
 bool is_nanovdb_path(const std::string& path) {
@@ -55,15 +46,6 @@ bool is_nanovdb_path(const std::string& path) {
   return ext == ".nvdb";
 }
 
-// What the run cost: the band, memory per band voxel, host traffic (--timings, --json).
-struct Figures {
-  std::size_t band_voxels = 0;
-  std::size_t host_bytes = 0;       // the OpenVDB level set on the host
-  std::size_t nanovdb_bytes = 0;    // the same as a NanoVDB grid: what a GPU field of it takes
-  std::size_t scan_gpu_bytes = 0;   // scan conversion's slab target and buffers at their peak
-  std::size_t readback_bytes = 0;   // GPU -> host during scan conversion
-  double scan_seconds = 0.0, total_seconds = 0.0;
-};
 
 void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option("MESH", o.mesh, "Closed triangle mesh (any format assimp reads)")->required();
@@ -158,83 +140,6 @@ std::size_t write_level_set(const Options& o, const sdf::ScanConvertResult& resu
   return measure ? sdf::to_nanovdb(*result.grid).size() : 0;
 }
 
-void print_figures(const Options& o, const Figures& f) {
-  const double per = f.band_voxels ? 1.0 / static_cast<double>(f.band_voxels) : 0.0;
-  fmt::print(
-      "memory: {} band voxels; host level set {:.1f} MiB ({:.1f} bytes a band voxel), as NanoVDB {:.1f} MiB "
-      "({:.1f} bytes a band voxel)",
-      f.band_voxels, f.host_bytes / 1048576.0, static_cast<double>(f.host_bytes) * per,
-      f.nanovdb_bytes / 1048576.0, static_cast<double>(f.nanovdb_bytes) * per);
-  if (o.backend == "gpu") {
-    fmt::print("; scan conversion {:.1f} MiB on the GPU at its peak, {:.1f} MiB read back",
-               f.scan_gpu_bytes / 1048576.0, f.readback_bytes / 1048576.0);
-  }
-  fmt::print("\n");
-}
-
-void print_json(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
-                const sdf::ScanConvertStats& st, const Figures& f, const std::string& device) {
-  const nlohmann::ordered_json out = {
-      {"mesh", o.mesh},
-      {"output", o.output},
-      {"triangles", mesh.triangle_count()},
-      {"grid",
-       {{"dims", {spec.dims.x(), spec.dims.y(), spec.dims.z()}},
-        {"voxel_size", spec.voxel_size},
-        {"band", o.band}}},
-      {"band_voxels", f.band_voxels},
-      {"host_bytes", f.host_bytes},
-      {"host_bytes_per_band_voxel", f.band_voxels ? static_cast<double>(f.host_bytes) / f.band_voxels : 0.0},
-      {"nanovdb_bytes", f.nanovdb_bytes},
-      {"nanovdb_bytes_per_band_voxel",
-       f.band_voxels ? static_cast<double>(f.nanovdb_bytes) / f.band_voxels : 0.0},
-      {"scan_peak_gpu_bytes", f.scan_gpu_bytes},
-      {"readback_bytes", f.readback_bytes},
-      {"slabs", st.slabs},
-      {"draws", st.draws},
-      {"degenerate_triangles", st.degenerate_triangles},
-      {"needle_triangles", st.needle_triangles},
-      {"scan_seconds", f.scan_seconds},
-      {"total_seconds", f.total_seconds},
-      {"backend", o.backend},
-      {"renderer", device}};
-  fmt::print("{}\n", out.dump(2));
-}
-
-void print_summary(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
-                   const sdf::ScanConvertStats& st) {
-  fmt::print("{}: {} triangles -> {} ({} x {} x {} voxels of {:.6g}, band {} voxels, {} band voxels)\n", o.mesh,
-             mesh.triangle_count(), o.output, spec.dims.x(), spec.dims.y(), spec.dims.z(), spec.voxel_size, o.band,
-             st.band_voxels);
-  if (st.degenerate_triangles || st.needle_triangles) {
-    fmt::print("{} degenerate triangles skipped, {} needle triangles bounded by rectangles\n", st.degenerate_triangles,
-               st.needle_triangles);
-  }
-  if (o.timings && o.backend == "gpu") {
-    fmt::print("{} slabs of {} layers, {} draws, peak GPU memory {:.1f} MiB, {:.3f} s\n{}", st.slabs,
-               st.layers_per_slab, st.draws, st.peak_gpu_bytes / 1048576.0, st.seconds, st.timing_report);
-  }
-}
-
-// --compare-openvdb: the exact SDF and OpenVDB's meshToLevelSet on the same grid, timed, and all
-// three fields compared.
-void print_comparison(const Options& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
-                      const sdf::ScanConvertResult& result) {
-  auto lap = std::chrono::steady_clock::now();
-  const auto exact_grid = sdf::exact_sdf_grid(mesh, spec, o.band, o.sign == "winding" ? sdf::SignMethod::Winding
-                                                                                       : sdf::SignMethod::Pseudonormal);
-  const double exact_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lap).count();
-  lap = std::chrono::steady_clock::now();
-  const auto vdb = sdf::openvdb_level_set(mesh, spec.voxel_size, o.band);
-  const double vdb_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lap).count();
-  fmt::print("times: tetrasand GPU {:.3f} s, CPU exact {:.3f} s, OpenVDB meshToLevelSet {:.3f} s\n", result.stats.seconds,
-             exact_seconds, vdb_seconds);
-  const double band_world = o.band * spec.voxel_size;
-  fmt::print("{}", sdf::format_comparison(sdf::compare_grids(*result.grid, *exact_grid, spec.voxel_size, band_world),
-                                          sdf::compare_grids(*vdb, *exact_grid, spec.voxel_size, band_world),
-                                          sdf::compare_grids(*result.grid, *vdb, spec.voxel_size, band_world)));
-}
-
 // The GPU path: scan conversion on the GL device, signs by winding number afterwards where asked.
 // *device: the GL device's summary.
 sdf::ScanConvertResult gpu_level_set(const Options& o, gpu::Context& context, const TriangleMesh& mesh,
@@ -319,14 +224,14 @@ int run_sdf(const Options& options, const GlobalOptions& global) {
   figures.nanovdb_bytes = write_level_set(o, result, device, o.timings || o.json);
   figures.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (o.json) {
-    print_json(o, mesh, spec, result.stats, figures, device);
+    print_sdf_json(o, mesh, spec, result.stats, figures, device);
     return 0;
   }
-  print_summary(o, mesh, spec, result.stats);
+  print_sdf_summary(o, mesh, spec, result.stats);
   fmt::print("device: {}; {} {:.3f} s\n", device, o.backend == "cpu" ? "exact SDF" : "scan conversion",
              result.stats.seconds);
-  if (o.timings) print_figures(o, figures);
-  if (o.compare) print_comparison(o, mesh, spec, result);
+  if (o.timings) print_sdf_figures(o, figures);
+  if (o.compare) print_sdf_comparison(o, mesh, spec, result);
   fmt::print("total {:.2f} s\n",
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return 0;

@@ -1,0 +1,89 @@
+#include "app/sdf_report.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+
+#include <nlohmann/json.hpp>
+
+#include "sdf/exact_sdf.h"
+#include "sdf/openvdb_compare.h"
+
+namespace ts::app {
+
+void print_sdf_figures(const SdfOptions& o, const SdfFigures& f) {
+  const double per = f.band_voxels ? 1.0 / static_cast<double>(f.band_voxels) : 0.0;
+  fmt::print(
+      "memory: {} band voxels; host level set {:.1f} MiB ({:.1f} bytes a band voxel), as NanoVDB {:.1f} MiB "
+      "({:.1f} bytes a band voxel)",
+      f.band_voxels, f.host_bytes / 1048576.0, static_cast<double>(f.host_bytes) * per,
+      f.nanovdb_bytes / 1048576.0, static_cast<double>(f.nanovdb_bytes) * per);
+  if (o.backend == "gpu") {
+    fmt::print("; scan conversion {:.1f} MiB on the GPU at its peak, {:.1f} MiB read back",
+               f.scan_gpu_bytes / 1048576.0, f.readback_bytes / 1048576.0);
+  }
+  fmt::print("\n");
+}
+
+void print_sdf_json(const SdfOptions& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
+                const sdf::ScanConvertStats& st, const SdfFigures& f, const std::string& device) {
+  const nlohmann::ordered_json out = {
+      {"mesh", o.mesh},
+      {"output", o.output},
+      {"triangles", mesh.triangle_count()},
+      {"grid",
+       {{"dims", {spec.dims.x(), spec.dims.y(), spec.dims.z()}},
+        {"voxel_size", spec.voxel_size},
+        {"band", o.band}}},
+      {"band_voxels", f.band_voxels},
+      {"host_bytes", f.host_bytes},
+      {"host_bytes_per_band_voxel", f.band_voxels ? static_cast<double>(f.host_bytes) / f.band_voxels : 0.0},
+      {"nanovdb_bytes", f.nanovdb_bytes},
+      {"nanovdb_bytes_per_band_voxel",
+       f.band_voxels ? static_cast<double>(f.nanovdb_bytes) / f.band_voxels : 0.0},
+      {"scan_peak_gpu_bytes", f.scan_gpu_bytes},
+      {"readback_bytes", f.readback_bytes},
+      {"slabs", st.slabs},
+      {"draws", st.draws},
+      {"degenerate_triangles", st.degenerate_triangles},
+      {"needle_triangles", st.needle_triangles},
+      {"scan_seconds", f.scan_seconds},
+      {"total_seconds", f.total_seconds},
+      {"backend", o.backend},
+      {"renderer", device}};
+  fmt::print("{}\n", out.dump(2));
+}
+
+void print_sdf_summary(const SdfOptions& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
+                   const sdf::ScanConvertStats& st) {
+  fmt::print("{}: {} triangles -> {} ({} x {} x {} voxels of {:.6g}, band {} voxels, {} band voxels)\n", o.mesh,
+             mesh.triangle_count(), o.output, spec.dims.x(), spec.dims.y(), spec.dims.z(), spec.voxel_size, o.band,
+             st.band_voxels);
+  if (st.degenerate_triangles || st.needle_triangles) {
+    fmt::print("{} degenerate triangles skipped, {} needle triangles bounded by rectangles\n", st.degenerate_triangles,
+               st.needle_triangles);
+  }
+  if (o.timings && o.backend == "gpu") {
+    fmt::print("{} slabs of {} layers, {} draws, peak GPU memory {:.1f} MiB, {:.3f} s\n{}", st.slabs,
+               st.layers_per_slab, st.draws, st.peak_gpu_bytes / 1048576.0, st.seconds, st.timing_report);
+  }
+}
+
+void print_sdf_comparison(const SdfOptions& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
+                      const sdf::ScanConvertResult& result) {
+  auto lap = std::chrono::steady_clock::now();
+  const auto exact_grid = sdf::exact_sdf_grid(mesh, spec, o.band, o.sign == "winding" ? sdf::SignMethod::Winding
+                                                                                       : sdf::SignMethod::Pseudonormal);
+  const double exact_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lap).count();
+  lap = std::chrono::steady_clock::now();
+  const auto vdb = sdf::openvdb_level_set(mesh, spec.voxel_size, o.band);
+  const double vdb_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lap).count();
+  fmt::print("times: tetrasand GPU {:.3f} s, CPU exact {:.3f} s, OpenVDB meshToLevelSet {:.3f} s\n", result.stats.seconds,
+             exact_seconds, vdb_seconds);
+  const double band_world = o.band * spec.voxel_size;
+  fmt::print("{}", sdf::format_comparison(sdf::compare_grids(*result.grid, *exact_grid, spec.voxel_size, band_world),
+                                          sdf::compare_grids(*vdb, *exact_grid, spec.voxel_size, band_world),
+                                          sdf::compare_grids(*result.grid, *vdb, spec.voxel_size, band_world)));
+}
+
+}  // namespace ts::app
