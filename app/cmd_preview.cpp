@@ -8,6 +8,7 @@
 
 #include "app/commands.h"
 #include "app/numeric_options.h"
+#include "app/progress.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mesh_io.h"
@@ -285,7 +286,9 @@ Views render_views(const Options& o, preview::Renderer& renderer, preview::Rende
                    const preview::Camera& camera, const std::vector<std::filesystem::path>& inputs) {
   std::vector<preview::Image> sheet;
   Views views;
+  Progress progress;  // a turntable of many views on llvmpipe takes minutes: say which view is drawn
   for (int k = 0; k < o.turntable; ++k) {
+    if (o.turntable > 1) progress.update(fmt::format("view {} of {}", k + 1, o.turntable), static_cast<double>(k) / o.turntable);
     settings.camera = preview::orbit(camera, settings.up, 2.0 * std::numbers::pi * k / o.turntable);
     preview::RenderResult result = renderer.render(settings);
     views.seconds += result.seconds;
@@ -299,6 +302,7 @@ Views render_views(const Options& o, preview::Renderer& renderer, preview::Rende
       preview::write_png(out, result.image, inputs);
     }
   }
+  progress.end();
   if (o.contact_sheet) preview::write_png(o.output, preview::contact_sheet(sheet), inputs);
   return views;
 }
