@@ -83,6 +83,16 @@ void check_mass_properties(const Fields& f, const ParticleBody& b, const GivenMa
   if ((b.inertia - b.inertia.transpose()).norm() > 1e-9 * scale) f.fail("inertia", "must be symmetric");
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(b.inertia);
   if (!(eigen.eigenvalues().minCoeff() > 0.0)) f.fail("inertia", "must be positive definite (kg m^2)");
+  // The simulator inverts both (1/m, a 3x3 inverse whose determinant cubes the moments) and multiplies
+  // by squared speeds: beyond 1e+-100 that leaves double's range (a grain of density 1e200 wrote a NaN
+  // energy), so a body is refused there as a scene's grains are (scene/scene_limits.cpp).
+  const auto fits = [](double v) { return v >= 1e-100 && v <= 1e100; };
+  if (!fits(b.mass)) f.fail("mass", fmt::format("{:.3g} kg is beyond 1e-100..1e+100 kg, what the simulator can invert", b.mass));
+  if (!fits(eigen.eigenvalues().minCoeff()) || !fits(eigen.eigenvalues().maxCoeff())) {
+    f.fail("inertia", fmt::format("principal moments {:.3g}..{:.3g} kg m^2 are beyond 1e-100..1e+100, what the "
+                                  "simulator can invert",
+                                  eigen.eigenvalues().minCoeff(), eigen.eigenvalues().maxCoeff()));
+  }
   if (given.principal_axes &&
       (b.principal_axes.transpose() * b.principal_axes - Eigen::Matrix3d::Identity()).norm() > 1e-6) {
     f.fail("principal_axes", "must be three orthonormal unit vectors");
@@ -99,6 +109,21 @@ void check_mass_properties(const Fields& f, const ParticleBody& b, const GivenMa
 
 // At least one particle, a normal for each or none, and (when `interior_normals`) interior
 // particles exactly where the normals are zero.
+// Every particle within kMaxBodyReachInDiameters particle diameters of the centre of mass: the
+// simulator's grid reaches that far in cells of the largest diameter, so a body wider than that
+// cannot be placed in any scene (a particle 1e38 m out was read, and refused only by a scene).
+void check_particle_reach(const Fields& f, const ParticleBody& b) {
+  const double reach = kMaxBodyReachInDiameters * 2 * b.particle_radius;  // m
+  for (std::size_t i = 0; i < b.positions.size(); ++i) {
+    const double distance = (b.positions[i].cast<double>() - b.center_of_mass).cwiseAbs().maxCoeff();
+    if (distance <= reach) continue;
+    f.fail("particles", fmt::format("particle {} lies {:.3g} m from the centre of mass, {:.3g} particle "
+                                    "diameters; the simulator's grid reaches at most {:.0g} (within {:.3g} m)",
+                                    i, distance, distance / (2 * b.particle_radius), kMaxBodyReachInDiameters,
+                                    reach));
+  }
+}
+
 void check_particles(const Fields& f, const ParticleBody& b, bool interior_normals = true) {
   if (b.positions.empty()) f.fail("particles", "the body has no particles");
   if (!b.normals.empty() && b.normals.size() != b.positions.size()) {
@@ -108,6 +133,7 @@ void check_particles(const Fields& f, const ParticleBody& b, bool interior_norma
     f.fail("interior_particle_count",
            fmt::format("{} for {} particles", b.interior_count, b.positions.size()));
   }
+  check_particle_reach(f, b);
   if (!interior_normals) return;
   // Interior particles are the last ones and carry the zero normal, surface ones a non-zero one.
   for (std::size_t i = 0; i < b.normals.size(); ++i) {

@@ -8,6 +8,11 @@
 
 namespace ts::body {
 
+// How far from its centre of mass a body's particle may lie, in particle diameters: the simulator's
+// grid reaches 1e9 cells of the largest particle diameter (sim/world.h kMaxCellCoordinate,
+// which asserts the two agree), so a body any wider could never be placed. read_body refuses it.
+inline constexpr double kMaxBodyReachInDiameters = 1e9;
+
 // Which keys of body.json read_body requires.
 enum class BodyKeys {
   // Every key of the file's format_version: a body as `tetrasand sample` writes it.

@@ -153,7 +153,9 @@ int patch_library(dl_phdr_info* info, std::size_t, void* data) {
 }  // namespace
 
 const fs::path& scratch_dir() {
-  static const fs::path dir = [] {
+  // Never destroyed: the atexit handler that removes the folder runs after the destructors of
+  // statics constructed before it was registered, this one included.
+  static const fs::path& dir = *new fs::path([] {
     // In memory when the system has a tmpfs at /dev/shm: the targets write every input to a file
     // (two for fuzz_body), millions of writes that a disk-backed /tmp need not see.
     std::error_code ec;
@@ -164,7 +166,7 @@ const fs::path& scratch_dir() {
     fs::create_directories(d);
     std::atexit(remove_scratch);
     return d;
-  }();
+  }());
   return dir;
 }
 

@@ -84,12 +84,6 @@ std::vector<std::pair<std::int64_t, fs::path>> list_checkpoints(const fs::path& 
 
 }  // namespace
 
-void remove_stale_temporaries(const fs::path& dir) {
-  // Only names that are exactly a temporary name of core/temporary_name.h, of a writer that is gone:
-  // a user's look-alike file in the folder is never touched.
-  remove_dead_temporaries(dir);
-}
-
 namespace {
 
 std::string payload(const RunState& s) {
@@ -198,13 +192,13 @@ void write_checkpoint(const fs::path& dir, const RunState& state, std::size_t ke
   const auto all = list_checkpoints(dir);
   std::error_code ec;
   for (std::size_t i = 0; i + keep < all.size(); ++i) fs::remove(all[i].second, ec);
-  remove_stale_temporaries(dir);
+  remove_dead_temporaries(dir);
 }
 
 RunState read_latest_checkpoint(const fs::path& dir, fs::path* file) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw InputError(dir, "no such folder to resume from");
-  remove_stale_temporaries(dir);
+  remove_dead_temporaries(dir);
   const auto all = list_checkpoints(dir);
   if (all.empty()) {
     throw InputError(dir,
@@ -224,7 +218,7 @@ RunState read_latest_checkpoint(const fs::path& dir, fs::path* file) {
 void remove_checkpoints(const fs::path& dir) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return;
-  remove_stale_temporaries(dir);
+  remove_dead_temporaries(dir);
   for (const auto& [step, file] : list_checkpoints(dir)) {
     log::info("{}: removed (this run replaces the folder's outputs)", file.string());
     fs::remove(file, ec);

@@ -63,8 +63,4 @@ RunState read_latest_checkpoint(const std::filesystem::path& dir, std::filesyste
 // and the stale temporary files there.
 void remove_checkpoints(const std::filesystem::path& dir);
 
-// Removes the temporary files of atomic writes (core/temporary_name.h: names that are exactly ours) in an
-// output folder whose writer is no longer running: what a kill during a write leaves behind.
-void remove_stale_temporaries(const std::filesystem::path& dir);
-
 }  // namespace ts::scene

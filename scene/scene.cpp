@@ -614,6 +614,7 @@ void read_simulation(TableReader& root, const fs::path& file, Scene& scene) {
   s.step.check_energy = r.boolean("check_energy", true);
   s.step.check_penetration = r.boolean("check_penetration", true);
   s.check_clamps = r.boolean("check_clamps", true);
+  s.check_time_step = r.boolean("check_time_step", true);
   r.reject_unknown_keys();
 }
 

@@ -124,6 +124,8 @@ struct SimulationSettings {
   // Stop (exit 4) when velocity clamps do not die out: in two output intervals in a row at least one
   // clamp per step, the second interval with no fewer than the first (docs/reliability.md).
   bool check_clamps = true;
+  // Refuse a dt by hand above kHandTimeStepFactor x the bound (sim/time_step.h); false: warn and run.
+  bool check_time_step = true;
   // dt filled in by make_world. Scene files get symplectic Euler unless they ask for "euler": it meets
   // the 2 % restitution target at the automatic step, where forward Euler needs one about 20x smaller.
   StepSettings step{.integrator = Integrator::SemiImplicitEuler};

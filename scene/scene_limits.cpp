@@ -154,10 +154,29 @@ void check_emitter_cells(const Scene& scene, const Emitter& e, double cell) {
   }
 }
 
+// A grain's mass and inertia feed 1/m, a 3x3 inverse (the cube of its entries: the determinant) and
+// m v^2: beyond 1e+-100 those leave double's range, and density = 1e200 made a run write a NaN
+// rotational energy at exit 0 (found by fuzz_scene). Both must lie in [kLeastMass, kMostMass].
+constexpr double kLeastMass = 1e-100, kMostMass = 1e100;  // kg and kg m^2 alike
+
+void check_grain_mass(const Scene& scene, const GrainKind& kind) {
+  const GrainShape& g = kind.shape;
+  const auto fits = [](double v) { return v >= kLeastMass && v <= kMostMass; };
+  if (fits(g.mass) && fits(g.inertia)) return;
+  const GrainSpec& spec = scene.grains[kind.type];
+  fail(scene, spec.line, "grain",
+       fmt::format("{} weighs {:.3g} kg with a moment of inertia of {:.3g} kg m^2 (density {:.3g} kg/m^3, radius "
+                   "{:.3g} m); the rigid-body arithmetic needs both within {:.0e}..{:.0e} (use SI units and a "
+                   "density and radius of that order)",
+                   kind.name, g.mass, g.inertia, scene.materials[spec.material].density, g.particle_radius,
+                   kLeastMass, kMostMass));
+}
+
 }  // namespace
 
 void check_scene_sizes(const Scene& scene) {
   for (const Emitter& e : scene.emitters) check_emitter(scene, e, emitter_bound(scene, e));
+  for (const GrainKind& kind : scene_grain_kinds(scene)) check_grain_mass(scene, kind);
   double rough = 0;
   for (const Boundary& b : scene.boundaries) {
     if (!b.rough) continue;
@@ -170,6 +189,13 @@ void check_scene_sizes(const Scene& scene) {
     rough += particles;
   }
   check_total(scene, total_grains(scene), rough, "rough boundaries");
+}
+
+double implied_particles(const Scene& scene) {
+  double particles = 4 * total_grains(scene);
+  for (const Boundary& b : scene.boundaries)
+    if (b.rough) particles += rough_particles(b).first;
+  return particles;
 }
 
 void check_world_sizes(const Scene& scene, const World& world,

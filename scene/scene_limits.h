@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "body/body_file.h"
 #include "scene/lattice.h"
 #include "scene/scene.h"
 #include "sim/world.h"
@@ -15,14 +16,17 @@ namespace ts::scene {
 // Particles of a world: both engines' hashed grids have a table of the next power of two >= 2 N
 // entries, indexed with 32 bits.
 inline constexpr double kMaxParticles = 1073741824.0;  // 2^30
-// |coordinate| / cell of any place particles start at: grid cells have 32-bit integer coordinates
-// (the CPU grid clamps them at +-1e9, the GPU converts float to int).
-inline constexpr double kMaxCellCoordinate = 1e9;
+// sim::kMaxCellCoordinate (sim/world.h) bounds every place particles start at.
+static_assert(kMaxCellCoordinate == body::kMaxBodyReachInDiameters, "a body readable is a body placeable");
 
 // The sizes the scene's keys alone imply: each emitter's lattice and grain count, each rough
 // boundary's particles, and their sum. Throws ts::InputError "file:line: key: ..." with the size asked
 // for and the largest that fits.
 void check_scene_sizes(const Scene& scene);
+
+// Particles the emitters' grains and the rough boundaries imply (props apart), in double, before any
+// is made: what a caller that wants only small runs (the fuzz targets) bounds a scene by.
+double implied_particles(const Scene& scene);
 
 // Once the boundaries and props are in `world` (and no grain yet): the whole world's particles with
 // every emitter's grains, and the grid cell coordinates of every place particles start at (the cell

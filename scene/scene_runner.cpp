@@ -2,18 +2,22 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <optional>
+#include <string_view>
 #include <utility>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/checked_values.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/text_tokens.h"
 #include "scene/checkpoint.h"
 #include "scene/scene_checks.h"
 #include "scene/scene_world.h"
@@ -51,6 +55,14 @@ double resolve_time_step(const Scene& scene, const World& world, std::string* wa
   }
   if (scene.simulation.dt <= 0) return bound.recommended;
   const std::string message = check_time_step(scene.simulation.dt, bound);
+  if (scene.simulation.check_time_step && scene.simulation.dt > kHandTimeStepFactor * bound.recommended) {
+    throw InputError(fmt::format(
+        "{}: {}: {:.3g} times the bound, where a time step by hand may exceed it by at most {:g}x "
+        "(docs/reliability.md); use dt <= {:.3g} s or dt = \"auto\", or check_time_step = false in "
+        "[simulation] to run it anyway with a warning",
+        scene_location(scene, "simulation.dt"), message, scene.simulation.dt / bound.recommended,
+        kHandTimeStepFactor, kHandTimeStepFactor * bound.recommended));
+  }
   if (warning) *warning = message;
   return scene.simulation.dt;
 }
@@ -129,13 +141,47 @@ std::size_t grains_of(const Scene& scene, const World& world) {
   return bodies_moving(world, MotionType::Dynamic) - props_moving(scene, MotionType::Dynamic);
 }
 
+constexpr std::string_view kMetricsHeader =
+    "step,time_s,grains,kinetic_translational_J,kinetic_rotational_J,potential_J,elastic_J,contacts,"
+    "wall_contacts,max_overlap_ratio,velocity_clamps,angular_velocity_clamps,overlap_clamps,spring_overflows\n";
+
+std::vector<std::string_view> split_fields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  for (std::size_t start = 0;;) {
+    const std::size_t comma = line.find(',', start);
+    fields.push_back(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    if (comma == std::string_view::npos) return fields;
+    start = comma + 1;
+  }
+}
+
+bool is_finite_number(std::string_view field) {
+  const std::optional<double> v = detail::parse_number(field);
+  return v && std::isfinite(*v);
+}
+
+void check_metrics_csv(std::string_view csv, std::int64_t rows) {
+  if (!csv.starts_with(kMetricsHeader)) throw InputError("metrics_csv: its header is not metrics.csv's");
+  const std::size_t columns = static_cast<std::size_t>(std::count(kMetricsHeader.begin(), kMetricsHeader.end(), ',')) + 1;
+  std::int64_t row = 0;
+  for (std::size_t at = kMetricsHeader.size(); at < csv.size(); ++row) {
+    const std::size_t end = csv.find('\n', at);
+    if (end == std::string_view::npos) throw InputError(fmt::format("metrics_csv: row {} has no line end", row + 1));
+    const std::vector<std::string_view> fields = split_fields(csv.substr(at, end - at));
+    const bool finite = std::all_of(fields.begin(), fields.end(), [](std::string_view f) { return is_finite_number(f); });
+    if (fields.size() != columns || !finite)
+      throw InputError(fmt::format("metrics_csv: row {} is not {} finite numbers", row + 1, columns));
+    at = end + 1;
+  }
+  if (row != rows) throw InputError(fmt::format("metrics_csv: {} rows for {} outputs", row, rows));
+}
+
 class OutputWriter {
  public:
   OutputWriter(const Scene& scene, const std::filesystem::path& dir, const RunHooks& hooks)
       : scene_(scene), dir_(dir), hooks_(hooks) {
     std::filesystem::create_directories(dir_);
-    csv_ = "step,time_s,grains,kinetic_translational_J,kinetic_rotational_J,potential_J,elastic_J,contacts,"
-           "wall_contacts,max_overlap_ratio,velocity_clamps,angular_velocity_clamps,overlap_clamps,spring_overflows\n";
+    csv_ = kMetricsHeader;
   }
 
   void write(const World& world, const StepStats& stats, std::int64_t step, Stepper& stepper) {
@@ -176,8 +222,12 @@ class OutputWriter {
     if (scene_.output.frames && hooks_.write_frame) files.push_back({"frame_NNNNNN.png", frame_, "files"});
     return files;
   }
-  // Goes on after `frames` outputs whose metrics.csv was `csv` (a resumed run).
+  // Goes on after `frames` outputs whose metrics.csv was `csv` (a resumed run). The text comes from
+  // a checkpoint, so it is checked as this writer would have written it: the header, one row per
+  // output (none without [output] csv), each of finite numbers; a crafted checkpoint put text into
+  // metrics.csv that the run then reported at exit 0 (found by fuzz_checkpoint).
   void restore(std::string csv, std::int64_t frames) {
+    check_metrics_csv(csv, scene_.output.csv ? frames : 0);
     csv_ = std::move(csv);
     frame_ = frames;
   }
@@ -299,6 +349,21 @@ void SceneRun::start_fresh() {
   output_->write(world_, stats_, 0, *stepper_);
 }
 
+// What the scene fixes for the whole run (gravity, smooth walls, materials) must come back as the
+// scene gives it: the checkpoint's own copy is only checked for finite values, and a crafted one
+// with gravity of 1e231 resumed to exit 0 with particles 1e227 cells out (found by fuzz_checkpoint).
+void check_scene_constants(const World& resumed, const World& initial, const std::filesystem::path& file) {
+  const auto differs = [&](std::string_view what) {
+    throw InputError(file, fmt::format("its {} differ from the scene's (the checkpoint was changed after "
+                                       "writing, or belongs to another scene)",
+                                       what));
+  };
+  if (resumed.gravity != initial.gravity) differs("gravity");
+  if (resumed.walls.planes != initial.walls.planes || resumed.walls.cylinders != initial.walls.cylinders)
+    differs("smooth walls");
+  if (resumed.materials != initial.materials) differs("materials");
+}
+
 void SceneRun::resume() {
   World initial = make_world(scene_, &sources_);
   if (hooks_.edit_initial_world) hooks_.edit_initial_world(initial);
@@ -321,6 +386,7 @@ void SceneRun::resume() {
     throw InputError(file, fmt::format("written with dt = {:.17g} s, but the scene now gives {:.17g} s",
                                        state.dt, result_.dt));
   }
+  check_scene_constants(state.world, initial, file);
   restore(state, file);
   log::info("{}: resuming at step {} (t = {:.6g} s)", file.string(), step_, world_.time);
 }
@@ -337,7 +403,11 @@ void SceneRun::restore(const RunState& s, const std::filesystem::path& file) {
   }
   duration_ = control_.duration > 0 ? control_.duration : s.duration;
   output_.emplace(scene_, dir_, hooks_);
-  output_->restore(s.metrics_csv, s.frames);
+  try {
+    output_->restore(s.metrics_csv, s.frames);
+  } catch (const InputError& e) {
+    throw InputError(file, e.what());
+  }
   step_ = s.step;
   stretch_end_ = s.stretch_end;
   stretch_output_ = s.stretch_output;

@@ -6,7 +6,7 @@
 #     --seconds N   run time of each target (default 60)
 #     --runs R      stop a target after R executions instead, if that comes first (default: no limit)
 #     --jobs J      libFuzzer worker processes per target (default 1)
-#     TARGET        fuzz_mesh fuzz_body fuzz_scene fuzz_vdb fuzz_cli (default: all)
+#     TARGET        fuzz_mesh fuzz_body fuzz_scene fuzz_checkpoint fuzz_vdb fuzz_cli (default: all)
 # Prints one line per target and writes them to build-fuzz/fuzz-summary.txt. A crash leaves its input
 # in build-fuzz/crashes/TARGET/ (make it a regression test: tests/core/bad_meshes/ for meshes) and
 # makes the script exit 1; an input slower than 10 s is kept there too (slow-unit-*), counted apart.
@@ -23,7 +23,7 @@ while [ $# -gt 0 ]; do
     *) echo "fuzz.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_mesh fuzz_body fuzz_scene fuzz_vdb fuzz_cli)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_mesh fuzz_body fuzz_scene fuzz_checkpoint fuzz_vdb fuzz_cli)
 dir="$root/build-fuzz"
 if ! command -v clang++-14 >/dev/null || [ ! -e /usr/lib/llvm-14/lib/clang/14.0.6/lib/linux/libclang_rt.fuzzer-x86_64.a ]; then
   echo "fuzz.sh: needs clang-14 and libFuzzer: apt-get install clang-14 libclang-rt-14-dev" >&2; exit 1
@@ -63,7 +63,9 @@ seed_fuzz_body() {
       | sed "s/$name.particles.ply/cube.particles.ply/" >"$out/$name"
   done
 }
-seed_fuzz_scene() { cp "$root"/assets/scenes/*.toml "$1/"; }
+seed_fuzz_scene() { cp "$root"/assets/scenes/*.toml "$root"/fuzz/regressions/fuzz_scene/* "$1/"; }
+# Edits of the base checkpoint fuzz_checkpoint.cpp makes (12-byte records); the empty input resumes it as is.
+seed_fuzz_checkpoint() { cp "$root"/fuzz/regressions/fuzz_checkpoint/* "$1/"; }
 seed_fuzz_vdb() {
   # TETRASAND_BIN: a tetrasand binary to write the seed .vdb files with (default: build-test's).
   local out=$1 bin="${TETRASAND_BIN:-$root/build-test/bin/tetrasand}"

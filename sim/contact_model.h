@@ -28,6 +28,8 @@ struct Material {
   // gamma_s = 10 would push under a microsecond.
   double tangential_damping = 0.1;
   double density = 2600.0;          // kg/m^3 (quartz)
+
+  bool operator==(const Material&) const = default;
 };
 
 // Returns an empty string when the material is usable, else the first problem ("E: must be > 0").

@@ -50,6 +50,13 @@ struct ParticleKind {
 TimeStepBound time_step_bound(const std::vector<ContactCase>& cases, const std::vector<ParticleKind>& particles,
                               double max_impact_speed);
 
+// How far a time step given by hand may exceed TimeStepBound::recommended before a run refuses it
+// (scene key simulation.check_time_step = false turns the refusal into the warning below). Why 2: the
+// tightest part of the bound, m_t/gamma_s, is half of explicit damping's stability limit 2 m_t/gamma_s,
+// so 2x is where the tangential force starts to flip sign every step; t_c/20 and 0.2 t_R have more
+// margin (symplectic Euler on the stiffest Hertz contact diverges near t_c/2). docs/reliability.md.
+inline constexpr double kHandTimeStepFactor = 2.0;
+
 // Empty when dt (s) respects the bound, else a warning naming dt and the bound, e.g.
 // "dt = 1e-4 s exceeds the stable bound 2.3e-6 s (t_c/20 = ... at 10 m/s, 0.2 t_R = ...)".
 std::string check_time_step(double dt, const TimeStepBound& bound);

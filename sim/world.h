@@ -27,6 +27,12 @@ enum class MotionType : std::uint8_t {
   Static,     // never moves (floors, rough walls)
 };
 
+// |coordinate| / cell of any particle the engines can hold, the cell being the largest particle
+// diameter: grid cells have 32-bit integer coordinates (the CPU grid clamps them at +-1e9, the GPU
+// converts float to int). Scenes check it before their world is built (scene/scene_limits.h), bodies
+// when read (body/body_file.h), checkpoints when read back (sim/world_bytes.h).
+inline constexpr double kMaxCellCoordinate = 1e9;
+
 struct Bodies {
   std::vector<Eigen::Vector3d> position;          // m, centre of mass
   std::vector<Eigen::Quaterniond> orientation;    // body -> world, unit
@@ -57,6 +63,8 @@ struct PlaneWall {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();   // m, a point on the plane
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, into the free side
   std::uint16_t material = 0;
+
+  bool operator==(const PlaneWall&) const = default;
 };
 
 // The inside of a vertical (z-axis) cylinder wall between z_min and z_max; outside that range of
@@ -66,6 +74,8 @@ struct CylinderWall {
   double radius = 1;                               // m
   double z_min = -1e30, z_max = 1e30;              // m
   std::uint16_t material = 0;
+
+  bool operator==(const CylinderWall&) const = default;
 };
 
 struct Walls {

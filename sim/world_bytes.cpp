@@ -5,8 +5,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <type_traits>
+#include <vector>
 
 #include "core/checked_values.h"
 #include "sim/contact_model.h"
@@ -171,7 +173,15 @@ void check_body_values(const Bodies& b, const ValueCheck& check, ByteReader& r) 
     check.finite(b.position[k], "body position", k);
     check.unit(b.orientation[k], "body orientation", k);
     check.finite(b.linear_velocity[k], "body linear_velocity", k);
+    // No faster than light, as a scene's velocities (core/checked_values.h): 1e300 m/s is finite, but
+    // its kinetic energy is not.
+    if (b.linear_velocity[k].norm() > kMaxSpeed)
+      r.fail(fmt::format("body linear_velocity of entry {} is {:.3g} m/s, faster than light", k,
+                         b.linear_velocity[k].norm()));
     check.finite(b.angular_velocity[k], "body angular_velocity", k);
+    if (b.angular_velocity[k].norm() * b.bounding_radius[k] > kMaxSpeed)
+      r.fail(fmt::format("body angular_velocity of entry {} is {:.3g} rad/s: its particles move faster than light",
+                         k, b.angular_velocity[k].norm()));
     check.finite(b.inverse_inertia[k], "body inverse_inertia", k);
     check.finite(b.bounding_radius[k], "body bounding_radius", k);
     // A dynamic body moves by its forces times its inverse mass: 0 would freeze it, inf fling it.
@@ -181,6 +191,22 @@ void check_body_values(const Bodies& b, const ValueCheck& check, ByteReader& r) 
       r.fail(fmt::format("body inverse_mass of entry {} is {} (must be 0 for a kinematic or static body)", k,
                          b.inverse_mass[k]));
     }
+  }
+}
+
+// Every particle within the grid's reach, as a fresh scene's are (kMaxCellCoordinate cells of the
+// largest diameter): a crafted checkpoint resumed a particle 8.6e143 cells out to exit 0 (found by
+// fuzz_checkpoint). Positions, offsets and orientations are checked finite before.
+void check_particle_reach(const World& w, ByteReader& r) {
+  double cell = 0;  // m
+  for (double radius : w.particles.radius) cell = std::max(cell, 2 * radius);
+  const std::vector<Eigen::Vector3d> positions = particle_positions(w);
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const double cells = positions[i].cwiseAbs().maxCoeff() / cell;
+    if (cells <= kMaxCellCoordinate) continue;
+    r.fail(fmt::format("particle position of entry {} lies {:.3g} grid cells of {:.3g} m from the origin; at "
+                       "most {:.0g} fit",
+                       i, cells, cell, kMaxCellCoordinate));
   }
 }
 
@@ -215,6 +241,7 @@ void check_world_values(const World& w, ByteReader& r) {
   }
   check.finite(w.gravity, "gravity");
   check.finite(w.time, "time");
+  check_particle_reach(w, r);
 }
 
 }  // namespace

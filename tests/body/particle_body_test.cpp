@@ -368,6 +368,27 @@ TEST(ParticleBody, InvalidBodiesAreNotWritten) {
   EXPECT_TRUE(fs::is_empty(dir)) << "neither the PLY nor the JSON of a refused body is written";
 }
 
+// The grid reaches 1e9 diameters (kMaxBodyReachInDiameters): a particle beyond it from the centre
+// of mass is refused by the reader (naming file, key, particle and reach) and never written; one
+// just inside is read.
+TEST(ParticleBody, ParticleBeyondTheGridsReachIsRefusedWhenReadAndWhenWritten) {
+  const fs::path dir = test::temp_dir();
+  ParticleBody body = box_body();
+  const fs::path json = write_body(dir, "box", body);
+  const float reach = static_cast<float>(kMaxBodyReachInDiameters * 2 * body.particle_radius);
+  body.positions.at(7) = body.center_of_mass.cast<float>() + Eigen::Vector3f(0, 0.5f * reach, 0);
+  write_text(dir / "box.particles.ply", particles_ply_bytes(body.positions, body.normals));
+  EXPECT_NO_THROW(read_body(json));
+  body.positions.at(7) = Eigen::Vector3f(0, -1e38f, 0);
+  write_text(dir / "box.particles.ply", particles_ply_bytes(body.positions, body.normals));
+  const std::string error = input_error([&] { read_body(json); });
+  EXPECT_EQ(error.rfind(json.string() + ": particles: particle 7 lies 1e+38 m from the centre of mass", 0), 0u)
+      << error;
+  EXPECT_NE(error.find("reaches at most 1e+09"), std::string::npos) << error;
+  EXPECT_NE(input_error([&] { write_body(dir / "other", "box", body); }).find("particle 7 lies"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "other" / "box.body.json"));
+}
+
 TEST(ParticleBody, SimulatorLoadsWhatTheSamplerWrites) {
   const ParticleBody body = box_body();
   const ParticleBody loaded = read_body(write_body(test::temp_dir(), "box", body), BodyKeys::Physical);

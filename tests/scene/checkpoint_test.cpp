@@ -272,6 +272,12 @@ TEST(Checkpoint, CraftedCheckpointsWithNonFiniteOrMeaninglessValuesAreRefusedNam
        [&](RunState& s) { s.world.bodies.orientation[0].coeffs().setConstant(1e200); }},
       {"dt must be finite and > 0 (got inf)", [&](RunState& s) { s.dt = inf; }},
       {"the duration must be finite and > 0", [&](RunState& s) { s.duration = nan; }},
+      // Found by fuzz_checkpoint: finite, but beyond what a scene could give.
+      {"particle position of entry 0 lies 1e+38 grid cells",
+       [&](RunState& s) {
+         s.world.bodies.position[s.world.particles.body[0]].x() = 1e38 * 2 * s.world.particles.radius[0];
+       }},
+      {"faster than light", [&](RunState& s) { s.world.bodies.linear_velocity[dynamic].x() = 1e300; }},
   };
   int n = 0;
   for (const auto& [field, craft] : crafted) {
@@ -291,6 +297,38 @@ TEST(Checkpoint, CraftedCheckpointsWithNonFiniteOrMeaninglessValuesAreRefusedNam
   }
   write_checkpoint(dir / "untouched", good);
   EXPECT_EQ(read_latest_checkpoint(dir / "untouched").step, good.step);  // the good state still reads
+}
+
+// What the scene fixes (gravity, smooth walls, materials) and the metrics written so far come back
+// only as the scene and the writer would give them: crafted checkpoints with gravity of 1e231 or
+// text in metrics.csv resumed to exit 0 (found by fuzz_checkpoint). Refused at resume, naming the
+// file and what differs.
+TEST(Checkpoint, CraftedSceneConstantsOrMetricsAreRefusedAtResume) {
+  const fs::path dir = test::temp_dir();
+  Scene scene = write_scene(dir);
+  scene.simulation.duration = 0.01;
+  run_scene(scene, dir / "out");
+  const RunState good = read_latest_checkpoint(dir / "out");
+  const std::vector<std::pair<std::string, std::function<void(RunState&)>>> crafted{
+      {"its gravity differ from the scene's", [](RunState& s) { s.world.gravity.z() = -1e231; }},
+      {"its materials differ from the scene's", [](RunState& s) { s.world.materials.at(0).friction = 5; }},
+      {"its smooth walls differ from the scene's", [](RunState& s) { s.world.walls.planes.at(0).point.z() = 1; }},
+      {"metrics_csv: row 1 is not 14 finite numbers",
+       [](RunState& s) { s.metrics_csv.replace(s.metrics_csv.find('\n') + 1, 1, "x"); }},
+      {"metrics_csv: its header is not metrics.csv's", [](RunState& s) { s.metrics_csv[0] = 'S'; }},
+  };
+  int n = 0;
+  for (const auto& [problem, craft] : crafted) {
+    RunState state = good;
+    craft(state);
+    const fs::path out = dir / fmt::format("crafted_{}", n++);
+    write_checkpoint(out, state);
+    const std::string message = resume_error(scene, out);
+    EXPECT_EQ(message.rfind(checkpoint_path(out, state.step).string() + ": ", 0), 0u) << problem << ": " << message;
+    EXPECT_NE(message.find(problem), std::string::npos) << problem << ": " << message;
+  }
+  write_checkpoint(dir / "untouched", good);
+  EXPECT_EQ(resume_error(scene, dir / "untouched"), "");  // the good state still resumes
 }
 
 }  // namespace

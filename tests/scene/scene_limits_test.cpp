@@ -8,6 +8,7 @@
 #include <string>
 
 #include "body/body_file.h"
+#include "body/particles_ply.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "export/lammps_deck.h"
@@ -124,13 +125,21 @@ TEST(SceneLimits, ParticlesFartherThanTheGridCellsReachAreRefused) {
 
 // A body whose particle file puts one particle 1e38 m out (a float the file can hold) reaches as far as
 // a prop placed there: refused naming the prop's body, before a grid coordinate overflows.
+// A body whose particle lies beyond the grid's reach from its centre of mass is refused when the
+// scene reads it (body/body_file.h kMaxBodyReachInDiameters), naming the body file, before any
+// world is built around it.
 TEST(SceneLimits, PropBodyWithAParticleFarBeyondTheGridIsRefused) {
   const fs::path dir = test::temp_dir();
   body::ParticleBody far = body::read_body(test::asset("bodies/cube.body.json"));
-  far.positions.at(0) = Eigen::Vector3f(1e38f, 0, 0);
   const fs::path body = body::write_body(dir, "far", far);
+  far.positions.at(0) = Eigen::Vector3f(1e38f, 0, 0);
+  write_file_atomically(dir / "far.particles.ply", body::particles_ply_bytes(far.positions, far.normals));
   const std::string prop = fmt::format("[[prop]]\nbody = \"{}\"\nmaterial = \"sand\"\n", body.string());
-  expect_names(world_error(dir, prop), dir, kFirstTable, "prop.body", "at most 1e+09 cells fit");
+  const std::string message = world_error(dir, prop);
+  EXPECT_NE(message.find(body.string()), std::string::npos) << message;
+  EXPECT_NE(message.find("particles: particle 0 lies 1e+38 m from the centre of mass"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("the simulator's grid reaches at most 1e+09"), std::string::npos) << message;
 }
 
 }  // namespace

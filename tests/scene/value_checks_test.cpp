@@ -95,6 +95,46 @@ TEST(ValueChecks, VelocityWhoseEnergyOverflowsIsRefusedNamingFileLineAndKey) {
       << error;
 }
 
+// A dt by hand may exceed the stability bound by at most kHandTimeStepFactor: beyond it the run is
+// refused before the first step, naming the key, the factor and the largest dt that would run; within
+// it (and with check_time_step = false) it warns and runs.
+TEST(ValueChecks, HandTimeStepFarAboveTheStabilityBoundIsRefusedNamingTheKeyAndWhatWouldRun) {
+  const std::string base = std::string(test::kCoarseSand) +
+                           test::smooth_plane("[0.0, 0.0, 0.0]", "[0.0, 0.0, 1.0]") +
+                           test::box_emitter("fill", "[-0.03, -0.03, 0.01]", "[0.03, 0.03, 0.05]", 1) +
+                           "[simulation]\nduration = 0.001\n";
+  const Scene automatic = parse_scene(base, "scene.toml");
+  const World world = make_world(automatic);
+  const double bound = resolve_time_step(automatic, world, nullptr);
+  const auto with_dt = [&](double dt, const std::string& extra = "") {
+    return parse_scene(base + fmt::format("dt = {:.17g}\n", dt) + extra, "scene.toml");
+  };
+  std::string warning;
+  EXPECT_EQ(resolve_time_step(with_dt(1.5 * bound), world, &warning), 1.5 * bound);
+  EXPECT_TRUE(contains(warning, "exceeds the stable bound")) << warning;
+  const std::string refused = test::input_error([&] { resolve_time_step(with_dt(3 * bound), world, nullptr); });
+  EXPECT_TRUE(refused.starts_with("scene.toml:") && contains(refused, ": simulation.dt: dt = ")) << refused;
+  EXPECT_TRUE(contains(refused, "3 times the bound, where a time step by hand may exceed it by at most 2x"))
+      << refused;
+  EXPECT_TRUE(contains(refused, fmt::format("use dt <= {:.3g} s", 2 * bound))) << refused;
+  warning.clear();
+  EXPECT_EQ(resolve_time_step(with_dt(3 * bound, "check_time_step = false\n"), world, &warning), 3 * bound);
+  EXPECT_TRUE(contains(warning, "exceeds the stable bound")) << warning;
+}
+
+// A grain's mass and inertia feed 1/m, a 3x3 inverse and m v^2: density = 1e200 wrote a NaN
+// rotational energy at exit 0 (found by fuzz_scene). Refused before the world is built, naming the
+// [grain] table's line and what would fit.
+TEST(ValueChecks, GrainWhoseMassLeavesDoubleArithmeticIsRefusedNamingTheGrainTable) {
+  std::string text = std::string(test::kCoarseSand) +
+                     test::box_emitter("fill", "[-0.03, -0.03, 0.01]", "[0.03, 0.03, 0.05]", 1);
+  text.replace(text.find("density = 2600.0"), 16, "density = 1.0e200");
+  const Scene scene = parse_scene(text, "scene.toml");
+  const std::string error = test::input_error([&] { make_world(scene); });
+  EXPECT_TRUE(contains(error, "scene.toml:9: grain: a grain weighs")) << error;
+  EXPECT_TRUE(contains(error, "needs both within 1e-100..1e+100")) << error;
+}
+
 // One grain thrown at the floor so fast that the run's single step carries it wholly through: the
 // engines see a step's result only when the next step starts, and there is none.
 TEST(ValueChecks, GrainThroughTheFloorOnTheLastStepStopsTheRunWithExit4) {
@@ -104,7 +144,7 @@ TEST(ValueChecks, GrainThroughTheFloorOnTheLastStepStopsTheRunWithExit4) {
                             test::smooth_plane("[0.0, 0.0, 0.0]", "[0.0, 0.0, 1.0]") +
                             test::box_emitter("fill", "[-0.03, -0.03, 0.01]", "[0.03, 0.03, 0.05]", 1,
                                               "velocity = [0.0, 0.0, -20.0]\n") +
-                            "[simulation]\nduration = 0.01\ndt = 0.01\n");
+                            "[simulation]\nduration = 0.01\ndt = 0.01\ncheck_time_step = false\n");
   const Scene scene = load_scene(dir / "scene.toml");
   try {
     run_scene(scene, dir / "out");
