@@ -24,6 +24,15 @@ inline constexpr std::size_t kReadbackChunkBytes = std::size_t{64} << 20;
 // current, before it is destroyed. A no-op when none was made.
 void release_readback_staging();
 
+// Programs are linked once per context and kept: Program::compute and Program::graphics look their
+// stages' full source up in the current context's program cache and link only what it lacks, so a
+// second scan conversion (or batch item, or bench repeat) in the same process compiles nothing.
+// Frees `egl_context`'s cached programs (deleted if it is current, else left to go with it); called
+// by Context before the context is destroyed.
+void release_program_cache(void* egl_context);
+// Programs linked in this process so far, every context together (tests check the cache with it).
+std::size_t program_links();
+
 // A shader storage / general-purpose GL buffer. Move-only.
 class Buffer {
  public:
@@ -65,7 +74,8 @@ class Buffer {
   std::size_t bytes_ = 0;
 };
 
-// A linked program: one compute kernel, or a vertex[/geometry]/fragment pipeline. Move-only.
+// A linked program: one compute kernel, or a vertex[/geometry]/fragment pipeline. A handle to the
+// context's cached program (see release_program_cache): valid while the context lives. Move-only.
 class Program {
  public:
   Program() = default;
