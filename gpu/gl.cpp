@@ -284,6 +284,22 @@ Queue::~Queue() {
   if (!spare_queries_.empty()) glDeleteQueries(static_cast<GLsizei>(spare_queries_.size()), spare_queries_.data());
 }
 
+void Queue::add_host_seconds(const std::string& name, double seconds) {
+  for (auto& [known, total] : host_seconds_) {
+    if (known == name) {
+      total += seconds;
+      return;
+    }
+  }
+  host_seconds_.emplace_back(name, seconds);
+}
+
+double Queue::host_seconds(const std::string& name) const {
+  for (const auto& [known, total] : host_seconds_)
+    if (known == name) return total;
+  return 0.0;
+}
+
 void Queue::dispatch(const Program& program, std::uint32_t gx, std::uint32_t gy, std::uint32_t gz, GLbitfield barrier) {
   if (gx == 0 || gy == 0 || gz == 0) return;
   begin(program.name());

@@ -5,6 +5,7 @@
 #include <GL/glew.h>
 
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -131,12 +132,17 @@ class Queue {
   // The (x, y) grid dispatch_groups uses for `groups` when at most `max_x` fit along x.
   static std::pair<std::uint32_t, std::uint32_t> group_grid(std::size_t groups, std::size_t max_x);
   // Times arbitrary GL work (draw calls, copies) under `name`.
+  // The host's wall time in each name's sections is kept whether or not timings are on.
   template <typename F>
   void timed(const std::string& name, F&& work) {
+    const auto start = std::chrono::steady_clock::now();
     begin(name);
     work();
     end(name);
+    add_host_seconds(name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
+  // Host wall time spent in timed(name, ...) sections so far [s] (0 for a name never timed).
+  double host_seconds(const std::string& name) const;
   // Blocks until the GPU has run everything issued (a host round trip, counted in gpu/host_sync.h).
   void finish() const;
   bool timings_enabled() const { return timings_; }
@@ -153,6 +159,7 @@ class Queue {
   void begin(const std::string& name);
   void end(const std::string& name);
   void check(const std::string& what) const;
+  void add_host_seconds(const std::string& name, double seconds);
   // Reads the pending queries, all of them (waiting for the GPU: a host round trip), or with
   // wait = false those already done. Returns how many were read.
   std::size_t resolve(bool wait);
@@ -166,6 +173,7 @@ class Queue {
   std::vector<Pending> pending_;
   std::vector<GLuint> spare_queries_;
   std::vector<KernelTiming> totals_;
+  std::vector<std::pair<std::string, double>> host_seconds_;  // per timed() name, in first-use order
   GLint max_groups_[2] = {0, 0};  // GL_MAX_COMPUTE_WORK_GROUP_COUNT along x and y, 0 until first needed
 };
 
