@@ -128,7 +128,9 @@ sdf::GridSpec grid_of(const Options& o, const TriangleMesh& mesh) {
 std::size_t write_level_set(const Options& o, const sdf::ScanConvertResult& result, const std::string& device,
                             bool measure, double* seconds) {
   const auto start = std::chrono::steady_clock::now();
-  auto lap = [&] { *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  auto lap = [&] {
+    *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   if (is_nanovdb_path(o.output)) {
     const sdf::NanoGrid nano = sdf::to_nanovdb(*result.grid);
     sdf::write_nvdb(o.output, nano, {o.mesh});

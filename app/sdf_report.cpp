@@ -28,8 +28,8 @@ void print_sdf_figures(const SdfOptions& o, const SdfFigures& f) {
 void print_sdf_times(const SdfOptions& o, const sdf::ScanConvertStats& st, const SdfFigures& f) {
   if (o.backend == "gpu") {
     fmt::print(
-        "times: scan conversion {:.3f} s (GPU {:.3f} s, read-back {:.3f} s, host build {:.3f} s on this thread; "
-        "leaves built {:.3f} s beside the GPU), write {:.3f} s\n",
+        "times: scan conversion {:.3f} s (GPU {:.3f} s, read-back {:.3f} s, host build {:.3f} s on this "
+        "thread; leaves built {:.3f} s beside the GPU), write {:.3f} s\n",
         st.seconds, st.gpu_seconds, st.readback_seconds, st.host_build_seconds, st.leaf_build_seconds,
         f.write_seconds);
   } else {

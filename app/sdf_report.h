@@ -33,7 +33,7 @@ struct SdfFigures {
   std::size_t scan_gpu_bytes = 0;   // scan conversion's slab target and buffers at their peak
   std::size_t readback_bytes = 0;   // GPU -> host during scan conversion
   double scan_seconds = 0.0, total_seconds = 0.0;
-  double write_seconds = 0.0;       // the output file (for .nvdb the conversion to NanoVDB with it)
+  double write_seconds = 0.0;  // the output file (for .nvdb the conversion to NanoVDB with it)
 };
 
 // One line a run: mesh, triangles, output, grid, band voxels (and degenerate and needle triangles,

@@ -40,7 +40,8 @@ struct Case {
 
 Case parse_case(const std::string& text) {
   const auto at = text.rfind('@');
-  if (at == std::string::npos) throw std::runtime_error("case '" + text + "' needs @resolutions, e.g. knot1.off@256");
+  if (at == std::string::npos)
+    throw std::runtime_error("case '" + text + "' needs @resolutions, e.g. knot1.off@256");
   Case c;
   c.mesh = text.substr(0, at);
   std::stringstream list(text.substr(at + 1));
@@ -69,18 +70,22 @@ struct Band {
 
 Band band_of(const openvdb::FloatGrid& grid, const ts::sdf::GridSpec& spec, int layers) {
   Band b{spec, layers, {}, {}, {}};
-  const std::size_t nx = static_cast<std::size_t>(spec.dims.x()), layer = nx * static_cast<std::size_t>(spec.dims.y());
+  const std::size_t nx = static_cast<std::size_t>(spec.dims.x()),
+                    layer = nx * static_cast<std::size_t>(spec.dims.y());
   std::vector<std::pair<std::size_t, float>> all;
   all.reserve(grid.activeVoxelCount());
   for (auto it = grid.cbeginValueOn(); it; ++it) {
-    const openvdb::Coord c = it.getCoord() - openvdb::Coord(spec.index_offset.x(), spec.index_offset.y(), spec.index_offset.z());
-    all.emplace_back(static_cast<std::size_t>(c.z()) * layer + static_cast<std::size_t>(c.y()) * nx + static_cast<std::size_t>(c.x()),
+    const openvdb::Coord c =
+        it.getCoord() - openvdb::Coord(spec.index_offset.x(), spec.index_offset.y(), spec.index_offset.z());
+    all.emplace_back(static_cast<std::size_t>(c.z()) * layer + static_cast<std::size_t>(c.y()) * nx +
+                         static_cast<std::size_t>(c.x()),
                      static_cast<float>(*it / spec.voxel_size));
   }
   std::sort(all.begin(), all.end());
   std::size_t next = 0;
   for (int z0 = 0; z0 < spec.dims.z(); z0 += layers) {
-    const std::size_t base = static_cast<std::size_t>(z0) * layer, end = base + static_cast<std::size_t>(layers) * layer;
+    const std::size_t base = static_cast<std::size_t>(z0) * layer,
+                      end = base + static_cast<std::size_t>(layers) * layer;
     b.z0.push_back(z0);
     b.voxels.emplace_back();
     b.values.emplace_back();
@@ -93,7 +98,8 @@ Band band_of(const openvdb::FloatGrid& grid, const ts::sdf::GridSpec& spec, int 
 }
 
 template <typename Add>
-std::pair<double, openvdb::FloatTree::Ptr> timed_build(const Band& band, float background, int repeats, Add&& add) {
+std::pair<double, openvdb::FloatTree::Ptr> timed_build(const Band& band, float background, int repeats,
+                                                       Add&& add) {
   double best = 1e300;
   openvdb::FloatTree::Ptr tree;
   for (int r = 0; r < repeats; ++r) {
@@ -126,19 +132,23 @@ void run_case(ts::gpu::Context& context, const Case& c, int repeats) {
     const auto scan = ts::sdf::scan_convert(context, mesh, normals, spec, {});
     const Band band = band_of(*scan.grid, spec, scan.stats.layers_per_slab);
     const float h = static_cast<float>(spec.voxel_size), background = scan.grid->background();
-    const auto [serial_s, serial] = timed_build(band, background, repeats, [&](openvdb::FloatTree& tree, const Band& b) {
-      for (std::size_t s = 0; s < b.z0.size(); ++s) ts::sdf::insert_band_serial(tree, b.spec, h, {b.z0[s], b.voxels[s], b.values[s]});
-    });
-    const auto [parallel_s, parallel] = timed_build(band, background, repeats, [&](openvdb::FloatTree& tree, const Band& b) {
-      ts::sdf::LevelSetBuilder builder(tree, b.spec, h, /*overlapped=*/false);
-      for (std::size_t s = 0; s < b.z0.size(); ++s) builder.add({b.z0[s], b.voxels[s], b.values[s]});
-      builder.finish();
-    });
+    const auto [serial_s, serial] =
+        timed_build(band, background, repeats, [&](openvdb::FloatTree& tree, const Band& b) {
+          for (std::size_t s = 0; s < b.z0.size(); ++s)
+            ts::sdf::insert_band_serial(tree, b.spec, h, {b.z0[s], b.voxels[s], b.values[s]});
+        });
+    const auto [parallel_s, parallel] =
+        timed_build(band, background, repeats, [&](openvdb::FloatTree& tree, const Band& b) {
+          ts::sdf::LevelSetBuilder builder(tree, b.spec, h, /*overlapped=*/false);
+          for (std::size_t s = 0; s < b.z0.size(); ++s) builder.add({b.z0[s], b.voxels[s], b.values[s]});
+          builder.finish();
+        });
     const double voxels = static_cast<double>(scan.stats.band_voxels);
-    fmt::print("| {} | {}x{}x{} ({}) | {} | {} | {:.3f} | {:.3f} | {:.1f} | {:.1f} | {:.1f} | {:.3f} | {} |\n", short_name(c.mesh),
-               spec.dims.x(), spec.dims.y(), spec.dims.z(), resolution, scan.stats.band_voxels, scan.stats.slabs, serial_s,
-               parallel_s, 1e9 * serial_s / voxels, 1e9 * parallel_s / voxels, serial_s / parallel_s,
-               scan.stats.seconds, same_leaves(*serial, *parallel) ? "yes" : "NO");
+    fmt::print(
+        "| {} | {}x{}x{} ({}) | {} | {} | {:.3f} | {:.3f} | {:.1f} | {:.1f} | {:.1f} | {:.3f} | {} |\n",
+        short_name(c.mesh), spec.dims.x(), spec.dims.y(), spec.dims.z(), resolution, scan.stats.band_voxels,
+        scan.stats.slabs, serial_s, parallel_s, 1e9 * serial_s / voxels, 1e9 * parallel_s / voxels,
+        serial_s / parallel_s, scan.stats.seconds, same_leaves(*serial, *parallel) ? "yes" : "NO");
     std::fflush(stdout);
   }
 }
@@ -163,11 +173,15 @@ int main(int argc, char** argv) {
     }
   }
   std::unique_ptr<tbb::global_control> limit;
-  if (threads) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+  if (threads)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
   ts::gpu::Context context;
-  fmt::print(stderr, "renderer: {}; TBB threads: {}\n", context.summary(), tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  fmt::print("| mesh | grid | band voxels | slabs | serial s | parallel s | serial ns/voxel | parallel ns/voxel | "
-             "serial / parallel | scan s (whole call) | same tree |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+  fmt::print(stderr, "renderer: {}; TBB threads: {}\n", context.summary(),
+             tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  fmt::print(
+      "| mesh | grid | band voxels | slabs | serial s | parallel s | serial ns/voxel | parallel ns/voxel | "
+      "serial / parallel | scan s (whole call) | same tree "
+      "|\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Case& c : cases) run_case(context, c, repeats);
   return 0;
 }

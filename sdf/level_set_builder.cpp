@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <exception>
+#include <memory>
+#include <span>
+#include <vector>
 
 namespace ts::sdf {
 namespace {
@@ -32,9 +34,11 @@ struct LeafRows {
 // One row of leaves (leaf block bz along z, by along y) filled from the slab's band. Leaves a slab
 // before this one began (the row's z block starts below the slab) are in the tree already and are
 // filled in place; the others are made here and returned in `created` for linking.
-void fill_row(const LeafRows& r, int bz, int by, std::span<const std::size_t> voxels, std::span<const float> distances,
-              openvdb::FloatTree& tree, std::vector<Leaf*>& row, std::vector<std::unique_ptr<Leaf>>& created) {
-  const int z0 = std::max(bz << kLeafLog2, r.z_lo), z1 = std::min((bz << kLeafLog2) + static_cast<int>(Leaf::DIM) - 1, r.z_hi);
+void fill_row(const LeafRows& r, int bz, int by, std::span<const std::size_t> voxels,
+              std::span<const float> distances, openvdb::FloatTree& tree, std::vector<Leaf*>& row,
+              std::vector<std::unique_ptr<Leaf>>& created) {
+  const int z0 = std::max(bz << kLeafLog2, r.z_lo),
+            z1 = std::min((bz << kLeafLog2) + static_cast<int>(Leaf::DIM) - 1, r.z_hi);
   const int j0 = std::max((by << kLeafLog2) - r.offset.y(), 0);
   const int j1 = std::min((by << kLeafLog2) + static_cast<int>(Leaf::DIM) - r.offset.y(), r.ny);
   const bool continued = (bz << kLeafLog2) < r.z_lo;
@@ -43,7 +47,8 @@ void fill_row(const LeafRows& r, int bz, int by, std::span<const std::size_t> vo
   for (int z = z0; z <= z1; ++z) {
     const std::size_t layer_start = static_cast<std::size_t>(z - r.z_lo) * layer;
     // Rows j0..j1-1 of one layer are one run of the ascending band list.
-    const auto begin = std::lower_bound(voxels.begin(), voxels.end(), layer_start + static_cast<std::size_t>(j0) * nx);
+    const auto begin =
+        std::lower_bound(voxels.begin(), voxels.end(), layer_start + static_cast<std::size_t>(j0) * nx);
     const auto end = std::lower_bound(begin, voxels.end(), layer_start + static_cast<std::size_t>(j1) * nx);
     // The run ascends, so rows are stepped through, not divided out.
     int j = j0;
@@ -73,13 +78,15 @@ openvdb::Coord band_voxel_coord(const GridSpec& spec, int z0, std::size_t voxel)
   return {spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k};
 }
 
-void insert_band_serial(openvdb::FloatTree& tree, const GridSpec& spec, float voxel_size, const BandSlab& slab) {
+void insert_band_serial(openvdb::FloatTree& tree, const GridSpec& spec, float voxel_size,
+                        const BandSlab& slab) {
   openvdb::tree::ValueAccessor<openvdb::FloatTree> accessor(tree);
   for (std::size_t k = 0; k < slab.voxels.size(); ++k)
     accessor.setValue(band_voxel_coord(spec, slab.z0, slab.voxels[k]), slab.values[4 * k + 3] * voxel_size);
 }
 
-LevelSetBuilder::LevelSetBuilder(openvdb::FloatTree& tree, const GridSpec& spec, float voxel_size, bool overlapped)
+LevelSetBuilder::LevelSetBuilder(openvdb::FloatTree& tree, const GridSpec& spec, float voxel_size,
+                                 bool overlapped)
     : tree_(tree), spec_(spec), voxel_size_(voxel_size), overlapped_(overlapped) {}
 
 LevelSetBuilder::~LevelSetBuilder() noexcept {

@@ -9,7 +9,6 @@
 #include <tbb/task_group.h>
 
 #include <cstddef>
-#include <memory>
 #include <span>
 #include <vector>
 
@@ -30,7 +29,8 @@ struct BandSlab {
 openvdb::Coord band_voxel_coord(const GridSpec& spec, int z0, std::size_t voxel);
 
 // The reference: every voxel through one accessor on one thread, distance times voxel_size.
-void insert_band_serial(openvdb::FloatTree& tree, const GridSpec& spec, float voxel_size, const BandSlab& slab);
+void insert_band_serial(openvdb::FloatTree& tree, const GridSpec& spec, float voxel_size,
+                        const BandSlab& slab);
 
 class LevelSetBuilder {
  public:

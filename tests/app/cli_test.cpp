@@ -64,14 +64,19 @@ TEST(CliSdf, TimingsSplitTheScanIntoGpuReadbackHostBuildAndWrite) {
   const std::string bunny = "'" + test::asset("bunny.obj").string() + "'";
   const std::string common = " --resolution 48 --max-slab-mb 1 --backend gpu";
   std::string out;
-  ASSERT_EQ(test::run_tetrasand("sdf " + bunny + " -o '" + (dir / "b.vdb").string() + "'" + common + " --timings", &out),
+  ASSERT_EQ(test::run_tetrasand(
+                "sdf " + bunny + " -o '" + (dir / "b.vdb").string() + "'" + common + " --timings", &out),
             0)
       << out;
   EXPECT_TRUE(std::regex_search(
-      out, std::regex(R"(\ntimes: scan conversion \d+\.\d{3} s \(GPU \d+\.\d{3} s, read-back \d+\.\d{3} s, host build )"
-                      R"(\d+\.\d{3} s on this thread; leaves built \d+\.\d{3} s beside the GPU\), write \d+\.\d{3} s\n)")))
+      out,
+      std::regex(
+          R"(\ntimes: scan conversion \d+\.\d{3} s \(GPU \d+\.\d{3} s, read-back \d+\.\d{3} s, host build )"
+          R"(\d+\.\d{3} s on this thread; leaves built \d+\.\d{3} s beside the GPU\), write \d+\.\d{3} s\n)")))
       << out;
-  ASSERT_EQ(test::run_tetrasand("sdf " + bunny + " -o '" + (dir / "b.nvdb").string() + "'" + common + " --json", &out), 0)
+  ASSERT_EQ(test::run_tetrasand(
+                "sdf " + bunny + " -o '" + (dir / "b.nvdb").string() + "'" + common + " --json", &out),
+            0)
       << out;
   const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
   double parts = 0.0;

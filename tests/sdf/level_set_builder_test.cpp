@@ -67,7 +67,8 @@ SyntheticBand sphere_band(const Eigen::Vector3i& dims, const Eigen::Vector3i& of
         const double d = (Eigen::Vector3d(i, j, k) - centre).norm() - r;
         if (std::abs(d) >= 3.0) continue;
         b.voxels.push_back(b.spec.linear_index(i, j, k));
-        b.values.insert(b.values.end(), {jitter(random), jitter(random), jitter(random), static_cast<float>(d)});
+        b.values.insert(b.values.end(),
+                        {jitter(random), jitter(random), jitter(random), static_cast<float>(d)});
       }
   return b;
 }
@@ -76,7 +77,8 @@ SyntheticBand sphere_band(const Eigen::Vector3i& dims, const Eigen::Vector3i& of
 // at each slab's first layer, as the scanner reads them back.
 template <typename F>
 void for_each_slab(const SyntheticBand& band, int layers, F&& consume) {
-  const std::size_t layer = static_cast<std::size_t>(band.spec.dims.x()) * static_cast<std::size_t>(band.spec.dims.y());
+  const std::size_t layer =
+      static_cast<std::size_t>(band.spec.dims.x()) * static_cast<std::size_t>(band.spec.dims.y());
   std::size_t next = 0;
   for (int z0 = 0; z0 < band.spec.dims.z(); z0 += layers) {
     const std::size_t end_index = static_cast<std::size_t>(std::min(z0 + layers, band.spec.dims.z())) * layer;
@@ -96,7 +98,8 @@ openvdb::FloatTree::Ptr serial_tree(const SyntheticBand& band, int layers, float
   return tree;
 }
 
-openvdb::FloatTree::Ptr parallel_tree(const SyntheticBand& band, int layers, float background, bool overlapped) {
+openvdb::FloatTree::Ptr parallel_tree(const SyntheticBand& band, int layers, float background,
+                                      bool overlapped) {
   auto tree = std::make_shared<openvdb::FloatTree>(background);
   LevelSetBuilder builder(*tree, band.spec, static_cast<float>(band.spec.voxel_size), overlapped);
   for_each_slab(band, layers, [&](const BandSlab& slab) { builder.add(slab); });
@@ -142,8 +145,9 @@ openvdb::FloatTree::Ptr serial_from_dense(const ScanConvertResult& result, float
       for (int i = 0; i < spec.dims.x(); ++i) {
         const Eigen::Vector4f& v = result.dense.values[spec.linear_index(i, j, k)];
         if (v.head<3>().isZero() && std::abs(v.w()) == background) continue;
-        accessor.setValue(openvdb::Coord(spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k),
-                          v.w());
+        accessor.setValue(
+            openvdb::Coord(spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k),
+            v.w());
       }
   openvdb::tools::signedFloodFill(*tree);
   return tree;
