@@ -123,12 +123,18 @@ sdf::GridSpec grid_of(const Options& o, const TriangleMesh& mesh) {
 }
 
 // Writes the level set in the format the suffix asks for; returns the size of its NanoVDB form (the
-// GPU field's) when it was made or `measure` asks for it, else 0.
+// GPU field's) when it was made or `measure` asks for it, else 0. *seconds: the write's time (for
+// .nvdb the conversion to NanoVDB with it; the measurement for .vdb not).
 std::size_t write_level_set(const Options& o, const sdf::ScanConvertResult& result, const std::string& device,
-                            bool measure) {
+                            bool measure, double* seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  auto lap = [&] {
+    *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   if (is_nanovdb_path(o.output)) {
     const sdf::NanoGrid nano = sdf::to_nanovdb(*result.grid);
     sdf::write_nvdb(o.output, nano, {o.mesh});
+    lap();
     return nano.size();
   }
   const std::map<std::string, std::string> metadata{{"tetrasand:source", o.mesh},
@@ -137,6 +143,7 @@ std::size_t write_level_set(const Options& o, const sdf::ScanConvertResult& resu
                                                     {"tetrasand:sign", o.sign},
                                                     {"tetrasand:renderer", device}};
   sdf::write_vdb(o.output, result.grid, metadata, {o.mesh});
+  lap();
   return measure ? sdf::to_nanovdb(*result.grid).size() : 0;
 }
 
@@ -220,8 +227,8 @@ int run_sdf(const Options& options, const GlobalOptions& global) {
   sdf::ScanConvertResult result = o.backend == "cpu" ? cpu_level_set(o, mesh, spec, &device)
                                                      : gpu_level_set(o, *context, mesh, spec, &device);
   Figures figures{result.stats.band_voxels, result.grid->memUsage(), 0, result.stats.peak_gpu_bytes,
-                  result.stats.readback_bytes, result.stats.seconds, 0.0};
-  figures.nanovdb_bytes = write_level_set(o, result, device, o.timings || o.json);
+                  result.stats.readback_bytes, result.stats.seconds, 0.0, 0.0};
+  figures.nanovdb_bytes = write_level_set(o, result, device, o.timings || o.json, &figures.write_seconds);
   figures.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (o.json) {
     print_sdf_json(o, mesh, spec, result.stats, figures, device);
@@ -230,7 +237,10 @@ int run_sdf(const Options& options, const GlobalOptions& global) {
   print_sdf_summary(o, mesh, spec, result.stats);
   fmt::print("device: {}; {} {:.3f} s\n", device, o.backend == "cpu" ? "exact SDF" : "scan conversion",
              result.stats.seconds);
-  if (o.timings) print_sdf_figures(o, figures);
+  if (o.timings) {
+    print_sdf_times(o, result.stats, figures);
+    print_sdf_figures(o, figures);
+  }
   if (o.compare) print_sdf_comparison(o, mesh, spec, result);
   fmt::print("total {:.2f} s\n",
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());

@@ -25,6 +25,18 @@ void print_sdf_figures(const SdfOptions& o, const SdfFigures& f) {
   fmt::print("\n");
 }
 
+void print_sdf_times(const SdfOptions& o, const sdf::ScanConvertStats& st, const SdfFigures& f) {
+  if (o.backend == "gpu") {
+    fmt::print(
+        "times: scan conversion {:.3f} s (GPU {:.3f} s, read-back {:.3f} s, host build {:.3f} s on this "
+        "thread; leaves built {:.3f} s beside the GPU), write {:.3f} s\n",
+        st.seconds, st.gpu_seconds, st.readback_seconds, st.host_build_seconds, st.leaf_build_seconds,
+        f.write_seconds);
+  } else {
+    fmt::print("times: exact SDF {:.3f} s, write {:.3f} s\n", st.seconds, f.write_seconds);
+  }
+}
+
 void print_sdf_json(const SdfOptions& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
                 const sdf::ScanConvertStats& st, const SdfFigures& f, const std::string& device) {
   const nlohmann::ordered_json out = {
@@ -48,6 +60,11 @@ void print_sdf_json(const SdfOptions& o, const TriangleMesh& mesh, const sdf::Gr
       {"degenerate_triangles", st.degenerate_triangles},
       {"needle_triangles", st.needle_triangles},
       {"scan_seconds", f.scan_seconds},
+      {"gpu_seconds", st.gpu_seconds},
+      {"readback_seconds", st.readback_seconds},
+      {"host_build_seconds", st.host_build_seconds},
+      {"leaf_build_seconds", st.leaf_build_seconds},
+      {"write_seconds", f.write_seconds},
       {"total_seconds", f.total_seconds},
       {"backend", o.backend},
       {"renderer", device}};

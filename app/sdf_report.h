@@ -33,12 +33,16 @@ struct SdfFigures {
   std::size_t scan_gpu_bytes = 0;   // scan conversion's slab target and buffers at their peak
   std::size_t readback_bytes = 0;   // GPU -> host during scan conversion
   double scan_seconds = 0.0, total_seconds = 0.0;
+  double write_seconds = 0.0;  // the output file (for .nvdb the conversion to NanoVDB with it)
 };
 
 // One line a run: mesh, triangles, output, grid, band voxels (and degenerate and needle triangles,
 // and the slab table with --timings on the GPU path).
 void print_sdf_summary(const SdfOptions& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
                        const sdf::ScanConvertStats& st);
+// The times line of --timings: the scan conversion split into GPU, read-back and host build (GPU
+// path), and the write.
+void print_sdf_times(const SdfOptions& o, const sdf::ScanConvertStats& st, const SdfFigures& f);
 // The memory line of --timings.
 void print_sdf_figures(const SdfOptions& o, const SdfFigures& f);
 // The --json report on standard output.

@@ -86,6 +86,7 @@ struct RawContext {
 void destroy(RawContext& raw) {
   if (raw.display == EGL_NO_DISPLAY) return;
   if (raw.context != EGL_NO_CONTEXT && eglGetCurrentContext() == raw.context) release_readback_staging();
+  if (raw.context != EGL_NO_CONTEXT) release_program_cache(raw.context);
   eglMakeCurrent(raw.display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   if (raw.context != EGL_NO_CONTEXT) eglDestroyContext(raw.display, raw.context);
   eglTerminate(raw.display);

@@ -4,6 +4,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
+#include <map>
+#include <mutex>
 #include <utility>
 
 #include "core/error.h"
@@ -25,8 +28,7 @@ std::string gl_error_name(GLenum code) {
 }
 
 GLuint compile_stage(const ShaderLibrary& library, GLenum stage, const std::string& relative,
-                     const std::vector<std::string>& defines) {
-  const ShaderSource source = library.load(relative, defines);
+                     const ShaderSource& source) {
   const GLuint shader = glCreateShader(stage);
   const char* text = source.text.c_str();
   glShaderSource(shader, 1, &text, nullptr);
@@ -66,6 +68,37 @@ GLuint link(const std::vector<GLuint>& shaders, const std::string& name) {
   return program;
 }
 
+// The programs each context has linked, by the full source of their stages (includes and defines
+// resolved, so a shader file edited on disk is a new key): Program::compute/graphics link each once
+// per context. Global, not per thread, so a context destroyed on any thread drops its entry and a
+// later context that reuses its handle never sees its program names.
+struct ProgramCache {
+  std::mutex mutex;
+  std::map<EGLContext, std::map<std::string, GLuint>> programs;
+  std::atomic<std::size_t> links{0};
+};
+ProgramCache& program_cache() {
+  static ProgramCache cache;
+  return cache;
+}
+
+// The current context's program for `key`, linked by `make` the first time.
+template <typename Make>
+GLuint cached_program(const std::string& key, Make&& make) {
+  ProgramCache& cache = program_cache();
+  const EGLContext current = eglGetCurrentContext();
+  {
+    const std::lock_guard lock(cache.mutex);
+    const auto& programs = cache.programs[current];
+    if (const auto it = programs.find(key); it != programs.end()) return it->second;
+  }
+  const GLuint program = make();  // GL calls outside the lock: contexts on other threads go on
+  ++cache.links;
+  const std::lock_guard lock(cache.mutex);
+  cache.programs[current].emplace(key, program);
+  return program;
+}
+
 // The staging buffer of the context current on this thread (GL contexts are current per thread):
 // host memory by hint (client storage, map-read), the only buffer the host reads directly.
 struct ReadbackStaging {
@@ -97,6 +130,19 @@ GLuint readback_staging(std::size_t bytes) {
 }
 
 }  // namespace
+
+void release_program_cache(void* egl_context) {
+  ProgramCache& cache = program_cache();
+  const std::lock_guard lock(cache.mutex);
+  const auto it = cache.programs.find(static_cast<EGLContext>(egl_context));
+  if (it == cache.programs.end()) return;
+  // Not current: the names cannot be deleted here, but go with the context itself.
+  if (eglGetCurrentContext() == it->first)
+    for (const auto& [key, program] : it->second) glDeleteProgram(program);
+  cache.programs.erase(it);
+}
+
+std::size_t program_links() { return program_cache().links.load(); }
 
 void release_readback_staging() {
   if (staging.context != eglGetCurrentContext()) return;  // another context's: not ours to free
@@ -175,33 +221,45 @@ void Buffer::bind(GLuint binding, GLenum target) const { glBindBufferBase(target
 
 Program Program::compute(const ShaderLibrary& library, const std::string& relative,
                          const std::vector<std::string>& defines) {
+  const ShaderSource source = library.load(relative, defines);
   Program p;
   p.name_ = relative;
-  p.id_ = link({compile_stage(library, GL_COMPUTE_SHADER, relative, defines)}, relative);
+  p.id_ = cached_program("comp\n" + source.text, [&] {
+    return link({compile_stage(library, GL_COMPUTE_SHADER, relative, source)}, relative);
+  });
   return p;
 }
 
 Program Program::graphics(const ShaderLibrary& library, const std::string& vertex, const std::string& geometry,
                           const std::string& fragment, const std::vector<std::string>& defines) {
+  std::vector<std::pair<GLenum, std::string>> stages{{GL_VERTEX_SHADER, vertex}};
+  if (!geometry.empty()) stages.emplace_back(GL_GEOMETRY_SHADER, geometry);
+  stages.emplace_back(GL_FRAGMENT_SHADER, fragment);
+  std::vector<ShaderSource> sources;
+  std::string key;
+  for (const auto& [stage, relative] : stages) {
+    sources.push_back(library.load(relative, defines));
+    key += fmt::format("stage {:x} {}\n", stage, sources.back().text.size()) + sources.back().text;
+  }
   Program p;
   p.name_ = vertex + "+" + (geometry.empty() ? "" : geometry + "+") + fragment;
-  std::vector<GLuint> shaders{compile_stage(library, GL_VERTEX_SHADER, vertex, defines)};
-  if (!geometry.empty()) shaders.push_back(compile_stage(library, GL_GEOMETRY_SHADER, geometry, defines));
-  shaders.push_back(compile_stage(library, GL_FRAGMENT_SHADER, fragment, defines));
-  p.id_ = link(shaders, p.name_);
+  p.id_ = cached_program(key, [&] {
+    std::vector<GLuint> shaders;
+    for (std::size_t s = 0; s < stages.size(); ++s)
+      shaders.push_back(compile_stage(library, stages[s].first, stages[s].second, sources[s]));
+    return link(shaders, p.name_);
+  });
   return p;
 }
 
-Program::~Program() {
-  if (id_) glDeleteProgram(id_);
-}
+// The cache owns the program (released with its context): a handle only forgets it.
+Program::~Program() = default;
 
 Program::Program(Program&& other) noexcept
     : id_(std::exchange(other.id_, 0)), name_(std::move(other.name_)) {}
 
 Program& Program::operator=(Program&& other) noexcept {
   if (this != &other) {
-    if (id_) glDeleteProgram(id_);
     id_ = std::exchange(other.id_, 0);
     name_ = std::move(other.name_);
   }
@@ -224,6 +282,22 @@ Queue::~Queue() {
     glDeleteQueries(1, &p.stop);
   }
   if (!spare_queries_.empty()) glDeleteQueries(static_cast<GLsizei>(spare_queries_.size()), spare_queries_.data());
+}
+
+void Queue::add_host_seconds(const std::string& name, double seconds) {
+  for (auto& [known, total] : host_seconds_) {
+    if (known == name) {
+      total += seconds;
+      return;
+    }
+  }
+  host_seconds_.emplace_back(name, seconds);
+}
+
+double Queue::host_seconds(const std::string& name) const {
+  for (const auto& [known, total] : host_seconds_)
+    if (known == name) return total;
+  return 0.0;
 }
 
 void Queue::dispatch(const Program& program, std::uint32_t gx, std::uint32_t gy, std::uint32_t gz, GLbitfield barrier) {

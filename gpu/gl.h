@@ -5,6 +5,7 @@
 #include <GL/glew.h>
 
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -23,6 +24,15 @@ inline constexpr std::size_t kReadbackChunkBytes = std::size_t{64} << 20;
 // Frees the current context's staging buffer; called by Context while its GL context is still
 // current, before it is destroyed. A no-op when none was made.
 void release_readback_staging();
+
+// Programs are linked once per context and kept: Program::compute and Program::graphics look their
+// stages' full source up in the current context's program cache and link only what it lacks, so a
+// second scan conversion (or batch item, or bench repeat) in the same process compiles nothing.
+// Frees `egl_context`'s cached programs (deleted if it is current, else left to go with it); called
+// by Context before the context is destroyed.
+void release_program_cache(void* egl_context);
+// Programs linked in this process so far, every context together (tests check the cache with it).
+std::size_t program_links();
 
 // A shader storage / general-purpose GL buffer. Move-only.
 class Buffer {
@@ -65,7 +75,8 @@ class Buffer {
   std::size_t bytes_ = 0;
 };
 
-// A linked program: one compute kernel, or a vertex[/geometry]/fragment pipeline. Move-only.
+// A linked program: one compute kernel, or a vertex[/geometry]/fragment pipeline. A handle to the
+// context's cached program (see release_program_cache): valid while the context lives. Move-only.
 class Program {
  public:
   Program() = default;
@@ -121,12 +132,17 @@ class Queue {
   // The (x, y) grid dispatch_groups uses for `groups` when at most `max_x` fit along x.
   static std::pair<std::uint32_t, std::uint32_t> group_grid(std::size_t groups, std::size_t max_x);
   // Times arbitrary GL work (draw calls, copies) under `name`.
+  // The host's wall time in each name's sections is kept whether or not timings are on.
   template <typename F>
   void timed(const std::string& name, F&& work) {
+    const auto start = std::chrono::steady_clock::now();
     begin(name);
     work();
     end(name);
+    add_host_seconds(name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
+  // Host wall time spent in timed(name, ...) sections so far [s] (0 for a name never timed).
+  double host_seconds(const std::string& name) const;
   // Blocks until the GPU has run everything issued (a host round trip, counted in gpu/host_sync.h).
   void finish() const;
   bool timings_enabled() const { return timings_; }
@@ -143,6 +159,7 @@ class Queue {
   void begin(const std::string& name);
   void end(const std::string& name);
   void check(const std::string& what) const;
+  void add_host_seconds(const std::string& name, double seconds);
   // Reads the pending queries, all of them (waiting for the GPU: a host round trip), or with
   // wait = false those already done. Returns how many were read.
   std::size_t resolve(bool wait);
@@ -156,6 +173,7 @@ class Queue {
   std::vector<Pending> pending_;
   std::vector<GLuint> spare_queries_;
   std::vector<KernelTiming> totals_;
+  std::vector<std::pair<std::string, double>> host_seconds_;  // per timed() name, in first-use order
   GLint max_groups_[2] = {0, 0};  // GL_MAX_COMPUTE_WORK_GROUP_COUNT along x and y, 0 until first needed
 };
 

@@ -17,6 +17,7 @@
 #include "gpu/graphics.h"
 #include "gpu/hash_grid.h"
 #include "gpu/layouts.h"
+#include "sdf/level_set_builder.h"
 #include "shaders/sdf/bindings.h"
 
 namespace ts::sdf {
@@ -443,13 +444,6 @@ struct Slab {
   std::size_t grid_index(std::size_t voxel) const {
     return static_cast<std::size_t>(z0) * layer_voxels() + voxel;
   }
-  openvdb::Coord vdb_coord(std::size_t voxel) const {
-    const std::size_t nx = static_cast<std::size_t>(spec.dims.x());
-    const int i = static_cast<int>(voxel % nx);
-    const int j = static_cast<int>((voxel / nx) % static_cast<std::size_t>(spec.dims.y()));
-    const int k = z0 + static_cast<int>(voxel / layer_voxels());
-    return {spec.index_offset.x() + i, spec.index_offset.y() + j, spec.index_offset.z() + k};
-  }
 };
 
 // One output of scan conversion: fed every finished slab in z order, then finished once.
@@ -458,25 +452,27 @@ class SlabConsumer {
   virtual ~SlabConsumer() = default;
   virtual void consume(const Slab& slab) = 0;
   virtual void finish() = 0;
+  // Work done on other threads (beside the GPU's) [s].
+  virtual double background_seconds() const { return 0.0; }
 };
 
-// The OpenVDB level set: band voxels in world units, then a signed flood fill for the rest.
+// The OpenVDB level set: band voxels in world units, then a signed flood fill for the rest. Leaves
+// are built in parallel, each slab's while the GPU scans the next (sdf/level_set_builder.h).
 class LevelSetOutput final : public SlabConsumer {
  public:
   LevelSetOutput(const GridSpec& spec, float band, bool index_space, openvdb::FloatGrid::Ptr& grid)
-      : voxel_size_(static_cast<float>(spec.voxel_size)),
-        grid_(grid = make_level_set(spec, band, index_space)),
-        accessor_(grid_->getAccessor()) {}
-  void consume(const Slab& slab) override {
-    for (std::size_t k = 0; k < slab.band.size(); ++k)
-      accessor_.setValue(slab.vdb_coord(slab.band[k]), slab.values[4 * k + 3] * voxel_size_);
+      : grid_(grid = make_level_set(spec, band, index_space)),
+        builder_(grid_->tree(), spec, static_cast<float>(spec.voxel_size)) {}
+  void consume(const Slab& slab) override { builder_.add({slab.z0, slab.band, slab.values}); }
+  void finish() override {
+    builder_.finish();
+    openvdb::tools::signedFloodFill(grid_->tree());
   }
-  void finish() override { openvdb::tools::signedFloodFill(grid_->tree()); }
+  double background_seconds() const override { return builder_.build_seconds(); }
 
  private:
-  float voxel_size_;
   openvdb::FloatGrid::Ptr grid_;
-  openvdb::FloatGrid::Accessor accessor_;
+  LevelSetBuilder builder_;
 };
 
 // Which voxels the band holds and, after the last slab, which of the others lie outside: the signs
@@ -534,17 +530,28 @@ std::vector<std::unique_ptr<SlabConsumer>> make_outputs(const GridSpec& spec, co
   return outputs;
 }
 
-// Draws, reads back and hands on each slab in z order.
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Draws, reads back and hands on each slab in z order. stats.gpu_seconds gets the time spent
+// drawing and reading back (the read-back is split off by the caller), stats.host_build_seconds the
+// time spent handing slabs on.
 void scan_slabs(SlabScanner& scanner, const std::vector<std::unique_ptr<SlabConsumer>>& outputs,
                 const GridSpec& spec, const ScanConvertOptions& options, bool check_errors,
                 ScanConvertStats& stats) {
   const float band = static_cast<float>(options.band);
   for (int z0 = 0; z0 < spec.dims.z(); z0 += stats.layers_per_slab) {
     const int layers = std::min(stats.layers_per_slab, spec.dims.z() - z0);
+    auto lap = Clock::now();
     stats.draws += scanner.draw(z0, layers);
     const SlabScanner::Band voxels = scanner.read_band(layers, band);
+    stats.gpu_seconds += seconds_since(lap);
+    lap = Clock::now();
     const Slab slab{spec, z0, layers, voxels.indices, voxels.values};
     for (const auto& output : outputs) output->consume(slab);
+    stats.host_build_seconds += seconds_since(lap);
     if (check_errors) gpu::check_gl("SDF scan conversion (shaders sdf/scan_convert.*, sdf/band_*.comp)");
     stats.band_voxels += voxels.indices.size();
     ++stats.slabs;
@@ -609,7 +616,14 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
   // Voxels outside the band take +-band: a closed band separates the inside from the outside, so a
   // flood fill classifies the whole grid (OpenVDB's signedFloodFill for the level set; a fill from
   // the grid border for the dense copy).
+  const auto finishing = Clock::now();
   for (const auto& output : outputs) output->finish();
+  stats.host_build_seconds += seconds_since(finishing);
+  // The band's download, timed by the host inside read_band, is the read-back; the rest of the time
+  // the scanner took is the GPU's (draws and compaction, the host waiting on them).
+  stats.readback_seconds = std::min(queue.host_seconds("sdf/readback"), stats.gpu_seconds);
+  stats.gpu_seconds -= stats.readback_seconds;
+  for (const auto& output : outputs) stats.leaf_build_seconds += output->background_seconds();
   if (options.timings) stats.timing_report = queue.timing_report();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -41,7 +41,13 @@ struct ScanConvertStats {
   std::size_t readback_bytes = 0;      // GPU -> host traffic: the compacted band (20 bytes a voxel) and counts
   std::size_t degenerate_triangles = 0;  // zero area: skipped, their edges belong to their neighbours
   std::size_t needle_triangles = 0;      // slivers bounded by an in-plane rectangle instead of a miter
-  double seconds = 0.0;
+  double seconds = 0.0;                  // the whole call
+  // Where the time went (seconds, host wall clock; planning and setup make up the rest of `seconds`):
+  double gpu_seconds = 0.0;         // draws and band compaction, the host issuing them and waiting for them
+  double readback_seconds = 0.0;    // the band's download (from the wait for the last compaction kernel on)
+  double host_build_seconds = 0.0;  // the outputs on the caller's thread: copying each band, waiting for
+                                    // the level set's leaves, the signed flood fill
+  double leaf_build_seconds = 0.0;  // the level set's leaves built and linked, mostly beside the GPU's work
   std::string timing_report;           // filled when options.timings
 };
 

@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <regex>
+
+#include <nlohmann/json.hpp>
 
 #include "core/mesh_io.h"
 #include "core/primitives.h"
@@ -52,6 +55,41 @@ TEST(CliSdf, WritesALevelSetOfTheCube) {
   EXPECT_TRUE(std::filesystem::exists(dir / "cube.vdb"));
   EXPECT_NE(out.find("band voxels"), std::string::npos) << out;
   EXPECT_NE(out.find("peak GPU memory"), std::string::npos) << out;
+}
+
+// --timings splits the scan conversion into GPU, read-back and host build, and times the write; --json
+// carries the same figures, each non-negative, the parts of the scan within its whole.
+TEST(CliSdf, TimingsSplitTheScanIntoGpuReadbackHostBuildAndWrite) {
+  const auto dir = test::temp_dir();
+  const std::string bunny = "'" + test::asset("bunny.obj").string() + "'";
+  const std::string common = " --resolution 48 --max-slab-mb 1 --backend gpu";
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand(
+                "sdf " + bunny + " -o '" + (dir / "b.vdb").string() + "'" + common + " --timings", &out),
+            0)
+      << out;
+  EXPECT_TRUE(std::regex_search(
+      out,
+      std::regex(
+          R"(\ntimes: scan conversion \d+\.\d{3} s \(GPU \d+\.\d{3} s, read-back \d+\.\d{3} s, host build )"
+          R"(\d+\.\d{3} s on this thread; leaves built \d+\.\d{3} s beside the GPU\), write \d+\.\d{3} s\n)")))
+      << out;
+  ASSERT_EQ(test::run_tetrasand(
+                "sdf " + bunny + " -o '" + (dir / "b.nvdb").string() + "'" + common + " --json", &out),
+            0)
+      << out;
+  const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
+  double parts = 0.0;
+  for (const char* key : {"gpu_seconds", "readback_seconds", "host_build_seconds"}) {
+    ASSERT_TRUE(json.contains(key)) << key << "\n" << out;
+    EXPECT_GT(json.at(key).get<double>(), 0.0) << key;
+    parts += json.at(key).get<double>();
+  }
+  EXPECT_LE(parts, json.at("scan_seconds").get<double>());
+  EXPECT_GT(json.at("leaf_build_seconds").get<double>(), 0.0);
+  EXPECT_GT(json.at("write_seconds").get<double>(), 0.0);
+  EXPECT_LE(json.at("scan_seconds").get<double>() + json.at("write_seconds").get<double>(),
+            json.at("total_seconds").get<double>());
 }
 
 TEST(CliSdf, BadParametersAndFilesExitNonZeroWithAMessage) {

@@ -173,6 +173,48 @@ TEST(ShaderLibrary, CompileErrorNamesFileAndLine) {
   }
 }
 
+// Programs are linked once per context: asking again (another stage, batch item or bench repeat)
+// links nothing and hands out the same program; other defines are another program.
+TEST(GpuProgramCache, TheSameSourceAskedTwiceInOneContextIsLinkedOnce) {
+  Context context;
+  ShaderLibrary library;
+  const std::size_t before = program_links();
+  const Program first = Program::compute(library, "test/saxpy.comp");
+  EXPECT_EQ(program_links(), before + 1);
+  const Program again = Program::compute(library, "test/saxpy.comp");
+  EXPECT_EQ(program_links(), before + 1);
+  EXPECT_EQ(again.id(), first.id());
+  const Program defined = Program::compute(library, "test/saxpy.comp", {"UNUSED_BY_SAXPY 1"});
+  EXPECT_EQ(program_links(), before + 2);
+  EXPECT_NE(defined.id(), first.id());
+}
+
+// The key is the source itself, so an edited file is a new program, and a new context links its own.
+TEST(GpuProgramCache, AnEditedShaderFileAndANewContextAreLinkedAnew) {
+  const auto dir = std::filesystem::temp_directory_path() / "tetrasand-program-cache-test";
+  std::filesystem::create_directories(dir / "cache");
+  auto write = [&](const char* body) {
+    std::ofstream f(dir / "cache" / "k.comp");
+    f << "#version 450\nlayout(local_size_x = 1) in;\nlayout(std430, binding = 0) buffer B { float v[]; };\n"
+      << "void main() { " << body << " }\n";
+  };
+  write("v[0] = 1.0;");
+  ShaderLibrary library(dir);
+  const std::size_t before = program_links();
+  {
+    Context context;
+    Program::compute(library, "cache/k.comp");
+    Program::compute(library, "cache/k.comp");
+    EXPECT_EQ(program_links(), before + 1);
+    write("v[0] = 2.0;");
+    Program::compute(library, "cache/k.comp");
+    EXPECT_EQ(program_links(), before + 2);
+  }
+  Context fresh;
+  Program::compute(library, "cache/k.comp");
+  EXPECT_EQ(program_links(), before + 3);
+}
+
 TEST(ShaderLibrary, MissingShaderDirectoryIsAClearError) {
   EXPECT_THROW(ShaderLibrary("/nonexistent/tetrasand/shaders"), GpuError);
 }

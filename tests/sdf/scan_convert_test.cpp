@@ -394,5 +394,24 @@ TEST_F(ScanConvert, NeedleTriangleIsCoveredByItsRectanglePrism) {
   EXPECT_LE(worst, 1e-3);
 }
 
+// The programs are linked once per context: a second scan in the same process (sample --batch, the
+// benches) links none, and its field is the first one's, bit for bit.
+TEST_F(ScanConvert, ASecondScanInTheSameContextLinksNoProgramAndGivesTheSameField) {
+  const TriangleMesh sphere = icosphere(1.0, 2);
+  const GridSpec spec = grid_around(sphere, 2.0 / 24.0, 4);
+  const std::size_t before = gpu::program_links();
+  const auto first = run(sphere, spec);
+  EXPECT_GT(gpu::program_links(), before);
+  const std::size_t after_first = gpu::program_links();
+  const auto second = run(sphere, spec);
+  EXPECT_EQ(gpu::program_links(), after_first);
+  ASSERT_EQ(first.grid->activeVoxelCount(), second.grid->activeVoxelCount());
+  auto b = second.grid->getConstAccessor();
+  for (auto it = first.grid->cbeginValueAll(); it; ++it) {
+    ASSERT_EQ(*it, b.getValue(it.getCoord())) << it.getCoord();
+    ASSERT_EQ(it.isValueOn(), b.isValueOn(it.getCoord())) << it.getCoord();
+  }
+}
+
 }  // namespace
 }  // namespace ts::sdf
