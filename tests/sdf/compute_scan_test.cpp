@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <set>
+#include <tuple>
 
 #include "core/mesh_io.h"
 #include "core/mesh_report.h"
@@ -198,9 +200,10 @@ TEST_F(ComputeScan, NeedleTriangleHasItsWholeBandAtExactDistance) {
   EXPECT_LE(worst, 1e-3);
 }
 
-TEST(BrickPairs, EveryBrickWithinTheMarginOfATriangleIsPairedAndRowsAreSorted) {
-  const TriangleMesh sphere = test::icosphere(0.5, 2);
-  const GridSpec spec = grid_around(sphere, 1.0 / 24.0, 4);
+TEST(BrickPairs, EveryBrickWithAVoxelInATrianglesBandIsPairedWithItAndRowsAreSorted) {
+  const TriangleMesh sphere = test::icosphere(0.5, 1);
+  const GridSpec spec = grid_around(sphere, 1.0 / 12.0, 4);
+  const double band = 3.0;
   std::vector<gpu::layout::SdfTriangle> triangles(sphere.triangle_count());
   std::vector<std::uint32_t> usable;
   for (std::uint32_t t = 0; t < sphere.triangle_count(); ++t) {
@@ -215,24 +218,33 @@ TEST(BrickPairs, EveryBrickWithinTheMarginOfATriangleIsPairedAndRowsAreSorted) {
                                 static_cast<float>(n.z()), 1.0f};
     usable.push_back(t);
   }
-  const BrickPairs pairs = build_brick_pairs(triangles, usable, spec, 3.25);
-  const int rows = (spec.dims.z() + TS_SDF_BRICK - 1) / TS_SDF_BRICK;
-  ASSERT_EQ(pairs.row_begin.size(), static_cast<std::size_t>(rows) + 1);
+  const BrickPairs pairs = build_brick_pairs(triangles, usable, spec, band + 0.25);
+  const Eigen::Vector3i bricks = (spec.dims.array() + TS_SDF_BRICK - 1) / TS_SDF_BRICK;
+  ASSERT_EQ(pairs.row_begin.size(), static_cast<std::size_t>(bricks.z()) + 1);
   EXPECT_EQ(pairs.row_begin.back(), pairs.count());
-  // Within a row, triangles ascend; every triangle's own vertices' bricks are among its pairs.
-  for (int r = 0; r < rows; ++r)
-    for (std::uint32_t p = pairs.row_begin[r] + 1; p < pairs.row_begin[r + 1]; ++p)
-      ASSERT_LE(pairs.words[2 * (p - 1)], pairs.words[2 * p]);
-  for (std::uint32_t t : usable) {
-    const Eigen::Vector3i b =
-        (spec.to_voxel(sphere.vertices[sphere.triangles[t][0]]).array().round().cast<int>()) / TS_SDF_BRICK;
-    bool found = false;
-    for (std::uint32_t p = pairs.row_begin[b.z()]; p < pairs.row_begin[b.z() + 1] && !found; ++p)
-      found = pairs.words[2 * p] == t &&
-              pairs.words[2 * p + 1] ==
-                  (static_cast<std::uint32_t>(b.x()) | (static_cast<std::uint32_t>(b.y()) << 16));
-    EXPECT_TRUE(found) << "triangle " << t;
-  }
+  std::set<std::tuple<std::uint32_t, int, int, int>> paired;  // triangle, brick x, y, z
+  for (int r = 0; r < bricks.z(); ++r)
+    for (std::uint32_t p = pairs.row_begin[r]; p < pairs.row_begin[r + 1]; ++p) {
+      if (p > pairs.row_begin[r]) {
+        ASSERT_LE(pairs.words[2 * (p - 1)], pairs.words[2 * p]);
+      }
+      const std::uint32_t key = pairs.words[2 * p + 1];
+      paired.insert({pairs.words[2 * p], static_cast<int>(key & 0xFFFF), static_cast<int>(key >> 16), r});
+    }
+  // Brute force: every voxel centre of the grid against every triangle.
+  const ExactDistance exact(sphere);
+  std::size_t needed = 0, missing = 0;
+  for (int k = 0; k < spec.dims.z(); ++k)
+    for (int j = 0; j < spec.dims.y(); ++j)
+      for (int i = 0; i < spec.dims.x(); ++i)
+        for (std::uint32_t t : usable) {
+          if (!(exact.closest_on(spec.voxel_center(i, j, k), t).distance / spec.voxel_size < band)) continue;
+          ++needed;
+          const int b = TS_SDF_BRICK;
+          missing += paired.count({t, i / b, j / b, k / b}) ? 0 : 1;
+        }
+  EXPECT_GT(needed, 10000u);
+  EXPECT_EQ(missing, 0u);
 }
 
 }  // namespace
