@@ -6,14 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "core/error.h"
 #include "shaders/sdf/bindings.h"
 
 namespace ts::sdf {
 namespace {
-
-constexpr int kBrick = TS_SDF_BRICK;
 
 struct PairEntry {
   std::uint32_t row, triangle, key;
@@ -43,12 +42,12 @@ double triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, con
   return (p - (a + ab * (vb / denominator) + ac * (vc / denominator))).norm();
 }
 
-// Appends triangle t's bricks to `out`. A brick's voxel centres fill a cube of side kBrick - 1 around
-// its centre c, all within (kBrick - 1) / 2 * sqrt(3) of c; one lies within `margin` of the triangle
-// only if the cube meets the slab |n.(x - v0)| <= margin, i.e. |n.(c - v0)| <= margin + (kBrick - 1) /
-// 2 * |n|_1 (a cheap first test), and c lies within margin + (kBrick - 1) / 2 * sqrt(3) of it.
+// Appends triangle t's bricks (side `brick`) to `out`. A brick's voxel centres fill a cube of side
+// brick - 1 around its centre c, all within (brick - 1) / 2 * sqrt(3) of c; one lies within `margin` of
+// the triangle only if the cube meets the slab |n.(x - v0)| <= margin, i.e. |n.(c - v0)| <= margin +
+// (brick - 1) / 2 * |n|_1 (a cheap first test), and c lies within margin + (brick - 1) / 2 * sqrt(3) of it.
 void pair_triangle(const gpu::layout::SdfTriangle& t, std::uint32_t index, const Eigen::Vector3i& bricks,
-                   const Eigen::Vector3i& dims, double margin, std::vector<PairEntry>& out) {
+                   const Eigen::Vector3i& dims, double margin, int kBrick, std::vector<PairEntry>& out) {
   const Eigen::Vector3d v[3] = {vertex_of(t, 0), vertex_of(t, 1), vertex_of(t, 2)};
   const Eigen::Vector3d lo = v[0].cwiseMin(v[1]).cwiseMin(v[2]).array() - margin;
   const Eigen::Vector3d hi = v[0].cwiseMax(v[1]).cwiseMax(v[2]).array() + margin;
@@ -75,8 +74,12 @@ void pair_triangle(const gpu::layout::SdfTriangle& t, std::uint32_t index, const
 
 }  // namespace
 
+int compute_brick_side(bool software_renderer) { return software_renderer ? 2 : 4; }
+
 BrickPairs build_brick_pairs(std::span<const gpu::layout::SdfTriangle> triangles,
-                             std::span<const std::uint32_t> usable, const GridSpec& spec, double margin) {
+                             std::span<const std::uint32_t> usable, const GridSpec& spec, double margin,
+                             int brick) {
+  const int kBrick = brick;
   const Eigen::Vector3i bricks = (spec.dims.array() + (kBrick - 1)) / kBrick;
   if (bricks.x() > 0xFFFF || bricks.y() > 0xFFFF) {
     throw GpuError(
@@ -85,7 +88,7 @@ BrickPairs build_brick_pairs(std::span<const gpu::layout::SdfTriangle> triangles
                     spec.dims.x(), spec.dims.y()));
   }
   std::vector<PairEntry> entries;
-  for (std::uint32_t t : usable) pair_triangle(triangles[t], t, bricks, spec.dims, margin, entries);
+  for (std::uint32_t t : usable) pair_triangle(triangles[t], t, bricks, spec.dims, margin, kBrick, entries);
   if (entries.size() > std::numeric_limits<std::uint32_t>::max()) {
     throw GpuError(
         fmt::format("{} triangle/brick pairs exceed the 2^32 the compute scan conversion numbers; use "
@@ -94,6 +97,7 @@ BrickPairs build_brick_pairs(std::span<const gpu::layout::SdfTriangle> triangles
   }
   // A counting sort by row keeps the triangles ascending within each row.
   BrickPairs pairs;
+  pairs.brick = brick;
   pairs.row_begin.assign(static_cast<std::size_t>(bricks.z()) + 1, 0);
   for (const PairEntry& e : entries) ++pairs.row_begin[e.row + 1];
   for (std::size_t r = 1; r < pairs.row_begin.size(); ++r) pairs.row_begin[r] += pairs.row_begin[r - 1];
@@ -111,9 +115,12 @@ ComputeScan::ComputeScan(const gpu::ShaderLibrary& library, const BrickPairs& pa
                          int slab_layers, double band)
     : spec_(spec),
       band_(static_cast<float>(band)),
+      brick_(pairs.brick),
       row_begin_(pairs.row_begin),
-      nearest_distance_pass_(gpu::Program::compute(library, "sdf/scan_pairs.comp")),
-      nearest_triangle_pass_(gpu::Program::compute(library, "sdf/scan_pairs.comp", {"NEAREST_TRIANGLE 1"})),
+      nearest_distance_pass_(
+          gpu::Program::compute(library, "sdf/scan_pairs.comp", {"BRICK " + std::to_string(pairs.brick)})),
+      nearest_triangle_pass_(gpu::Program::compute(
+          library, "sdf/scan_pairs.comp", {"BRICK " + std::to_string(pairs.brick), "NEAREST_TRIANGLE 1"})),
       write_pass_(gpu::Program::compute(library, "sdf/scan_write.comp")),
       pairs_(gpu::Buffer::from<std::uint32_t>(pairs.words)),
       rows_(gpu::Buffer::from<std::uint32_t>(pairs.row_begin)),
@@ -122,8 +129,8 @@ ComputeScan::ComputeScan(const gpu::ShaderLibrary& library, const BrickPairs& pa
       nearest_triangle_(nearest_distance_.bytes()) {}
 
 std::size_t ComputeScan::fill(gpu::Queue& queue, const gpu::Texture& target, int z0, int layers) {
-  const std::size_t first_row = static_cast<std::size_t>(z0 / kBrick);
-  const std::size_t last_row = static_cast<std::size_t>((z0 + layers - 1) / kBrick);
+  const std::size_t first_row = static_cast<std::size_t>(z0 / brick_);
+  const std::size_t last_row = static_cast<std::size_t>((z0 + layers - 1) / brick_);
   const std::uint32_t first = row_begin_[first_row], count = row_begin_[last_row + 1] - first;
   const std::uint32_t voxels = static_cast<std::uint32_t>(spec_.dims.x()) *
                                static_cast<std::uint32_t>(spec_.dims.y()) *

@@ -1,7 +1,7 @@
 #pragma once
 // The compute-shader scan conversion of one z-slab (ScanMethod::Compute in sdf/scan_convert.h), after
 // the triangle/leaf pairs of NanoVDB's CUDA mesh-to-grid: every usable triangle is paired with the
-// TS_SDF_BRICK^3 voxel bricks its band can reach (host side, sorted by brick row); per slab one work
+// brick^3 voxel bricks its band can reach (host side, sorted by brick row); per slab one work
 // group per pair finds, per voxel, the least distance to any triangle (atomic minimum on the distance
 // bits), a second pass the least triangle index at that distance (ties never depend on arrival order),
 // and a per-voxel pass stores that triangle's value into the same slab target the geometry path draws
@@ -21,10 +21,17 @@
 
 namespace ts::sdf {
 
+// The side of a brick [voxels]: 2 on a software renderer, where a work group of 8 is one SIMD batch
+// and a 4^3 brick spent most of its invocations on voxels beyond the band (fandisk at 40 on llvmpipe:
+// 1.7x the geometry path's time with 4^3, about 1.0x with 2^3); 4 on a GPU, whose SIMD groups are
+// 32 or 64 invocations wide (not measured on one yet).
+int compute_brick_side(bool software_renderer);
+
 // Every usable triangle with each voxel brick whose voxel centres may lie within `margin` of it: the
 // bricks of its bounding box grown by the margin whose centre box meets the slab of its plane grown by
 // the margin. Sorted by brick row (brick z), triangles ascending within a row.
 struct BrickPairs {
+  int brick = 4;                         // the side of a brick [voxels]
   std::vector<std::uint32_t> words;      // 2 per pair: triangle index, brick x | brick y << 16
   std::vector<std::uint32_t> row_begin;  // per brick row, its first pair; one more entry: the pair count
   std::size_t count() const { return words.size() / 2; }
@@ -34,7 +41,8 @@ struct BrickPairs {
 // pair (the non-degenerate ones). GpuError when the grid has more bricks along x or y than 16 bits
 // number or more pairs than 32 bits do.
 BrickPairs build_brick_pairs(std::span<const gpu::layout::SdfTriangle> triangles,
-                             std::span<const std::uint32_t> usable, const GridSpec& spec, double margin);
+                             std::span<const std::uint32_t> usable, const GridSpec& spec, double margin,
+                             int brick);
 
 // GPU memory the compute path adds per slab voxel: the nearest distance and nearest triangle words.
 inline constexpr std::size_t kComputeScanBytesPerVoxel = 2 * sizeof(std::uint32_t);
@@ -55,6 +63,7 @@ class ComputeScan {
  private:
   GridSpec spec_;
   float band_;
+  int brick_;
   std::vector<std::uint32_t> row_begin_;
   gpu::Program nearest_distance_pass_, nearest_triangle_pass_, write_pass_;
   gpu::Buffer pairs_, rows_, nearest_distance_, nearest_triangle_;

@@ -277,8 +277,9 @@ struct ScanPlan {
   BrickPairs pairs;  // compute path
 };
 
-ScanPlan plan_scan(std::size_t max_items, int max_layers, const TriangleMesh& mesh, const Pseudonormals& normals,
-                   const GridSpec& spec, const ScanConvertOptions& options) {
+// `brick`: the compute path's brick side (compute_brick_side).
+ScanPlan plan_scan(std::size_t max_items, int max_layers, int brick, const TriangleMesh& mesh,
+                   const Pseudonormals& normals, const GridSpec& spec, const ScanConvertOptions& options) {
   ScanPlan plan;
   // Every voxel with |d| < band lies inside the triangle's prism grown by the band; a quarter voxel
   // more keeps rounding of the cross-sections (~1e-6 voxel) from losing one, and costs far fewer
@@ -297,7 +298,7 @@ ScanPlan plan_scan(std::size_t max_items, int max_layers, const TriangleMesh& me
   plan.block = std::min(kLayersPerDraw, plan.slab_layers);
   // The same margin as the prisms: the pairs reach every voxel a prism would.
   if (compute) {
-    plan.pairs = build_brick_pairs(plan.geometry.triangles, plan.geometry.drawn, spec, plan.margin);
+    plan.pairs = build_brick_pairs(plan.geometry.triangles, plan.geometry.drawn, spec, plan.margin, brick);
   } else {
     plan.lists = bucket_by_block(plan.geometry, spec.dims.z(), plan.block);
   }
@@ -620,7 +621,10 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
                                const GridSpec& spec, const ScanConvertOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   check_request(context, spec, options);
-  const ScanPlan plan = plan_scan(max_slab_items(context), max_slab_layers(context), mesh, normals, spec, options);
+  const ScanPlan plan = plan_scan(max_slab_items(context), max_slab_layers(context),
+                                  options.compute_brick > 0 ? options.compute_brick
+                                                            : compute_brick_side(context.software()),
+                                  mesh, normals, spec, options);
   gpu::ShaderLibrary library;
   gpu::Queue queue(options.timings, context.debug());
   SlabScanner scanner(library, queue, spec, plan);

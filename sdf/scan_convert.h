@@ -22,6 +22,7 @@ namespace ts::sdf {
 
 struct ScanConvertOptions {
   ScanMethod method = ScanMethod::Geometry;
+  int compute_brick = 0;  // compute path: brick side [voxels], 2 or 4; 0: compute_brick_side for the device
   double band = 3.0;                         // half-width of the narrow band [voxels]
   std::size_t max_slab_bytes = 1ull << 30;   // GPU render-target budget per slab [bytes]
   bool timings = false;                      // per-kernel GPU timer queries

@@ -28,8 +28,8 @@
 #define TS_SDF_TRIANGLES 0     // SdfTriangle[]: the triangles in grid-local voxel units
 #define TS_SDF_PRISMS 1        // SdfPrism[]: each triangle's bounding prism
 
-// The compute path: a voxel brick is TS_SDF_BRICK^3 voxels, one work group of scan_pairs.comp.
-#define TS_SDF_BRICK 4
+// The compute path: a voxel brick is BRICK^3 voxels, one work group of scan_pairs.comp; the host
+// compiles it with BRICK 2 or 4 (sdf::compute_brick_side) and pairs the triangles with the same bricks.
 #define TS_SDF_PAIRS 1             // uvec2 per triangle/brick pair: triangle, brick x | brick y << 16
 #define TS_SDF_PAIR_ROWS 2         // uint per brick row (brick z) + 1: its first pair (pairs sorted by row)
 #define TS_SDF_NEAREST_DISTANCE 3  // uint per slab voxel: ~ the bits of the least distance (0: none)

@@ -10,7 +10,10 @@
 #include "common/dispatch.glsl"
 #include "common/layouts.h"
 #include "sdf/bindings.h"
-layout(local_size_x = TS_SDF_BRICK, local_size_y = TS_SDF_BRICK, local_size_z = TS_SDF_BRICK) in;
+#ifndef BRICK
+#define BRICK 4
+#endif
+layout(local_size_x = BRICK, local_size_y = BRICK, local_size_z = BRICK) in;
 layout(std430, binding = TS_SDF_TRIANGLES) readonly buffer Triangles { SdfTriangle triangles[]; };
 layout(std430, binding = TS_SDF_PAIRS) readonly buffer Pairs { uvec2 pairs[]; };
 layout(std430, binding = TS_SDF_PAIR_ROWS) readonly buffer PairRows { uint pair_rows[]; };
@@ -40,7 +43,7 @@ void main() {
   uint pair = params.pairs.x + group;
   uvec2 record = pairs[pair];
   ivec3 brick = ivec3(int(record.y & 0xFFFFu), int(record.y >> 16), brick_row(pair));
-  ivec3 voxel = brick * TS_SDF_BRICK + ivec3(gl_LocalInvocationID);
+  ivec3 voxel = brick * BRICK + ivec3(gl_LocalInvocationID);
   int layer = voxel.z - params.slab.x;
   if (any(greaterThanEqual(voxel, params.grid.xyz)) || layer < 0 || layer >= params.slab.y) return;
   SdfTriangle t = triangles[record.x];

@@ -19,7 +19,6 @@
 #include "sdf/grid.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
-#include "shaders/sdf/bindings.h"
 #include "tests/test_meshes.h"
 #include "tests/test_support.h"
 
@@ -69,9 +68,10 @@ class ComputeScan : public ::testing::Test {
  protected:
   gpu::Context context;
   ScanConvertResult run(const TriangleMesh& mesh, const GridSpec& spec, ScanMethod method,
-                        std::size_t max_slab_bytes = std::size_t{1} << 30) {
+                        std::size_t max_slab_bytes = std::size_t{1} << 30, int brick = 0) {
     ScanConvertOptions options;
     options.method = method;
+    options.compute_brick = brick;
     options.keep_dense = true;
     options.build_grid = false;
     options.max_slab_bytes = max_slab_bytes;
@@ -127,7 +127,7 @@ TEST_F(ComputeScan, BandVoxelsDistancesAndSignsAreTheGeometryPaths) {
   EXPECT_LE(worst, 1e-6);
 }
 
-TEST_F(ComputeScan, TwoRunsAndAnySlabSplitGiveTheSameBytes) {
+TEST_F(ComputeScan, TwoRunsAnySlabSplitAndEitherBrickSizeGiveTheSameBytes) {
   const TriangleMesh mesh = load_mesh(test::cgal_mesh("knot1"));
   SdfSettings settings;
   settings.resolution = 24;
@@ -136,9 +136,13 @@ TEST_F(ComputeScan, TwoRunsAndAnySlabSplitGiveTheSameBytes) {
   const auto second = run(mesh, spec, ScanMethod::Compute);
   // Slabs of a few layers: different pair ranges per dispatch, bricks cut by slab boundaries.
   const auto sliced = run(mesh, spec, ScanMethod::Compute, bytes_per_layer(spec) * 5);
+  // 4^3 bricks (a hardware GPU's choice; 2^3 on llvmpipe): other pairs, other groups, the same field.
+  const auto large_bricks = run(mesh, spec, ScanMethod::Compute, std::size_t{1} << 30, 4);
   ASSERT_GT(sliced.stats.slabs, first.stats.slabs);
+  ASSERT_NE(large_bricks.stats.brick_pairs, first.stats.brick_pairs);
   EXPECT_TRUE(same_bytes(first.dense, second.dense));
   EXPECT_TRUE(same_bytes(first.dense, sliced.dense));
+  EXPECT_TRUE(same_bytes(first.dense, large_bricks.dense));
 }
 
 TEST_F(ComputeScan, CubeWithVoxelsEquidistantToTwoFacesIsDeterministicAndExact) {
@@ -200,26 +204,14 @@ TEST_F(ComputeScan, NeedleTriangleHasItsWholeBandAtExactDistance) {
   EXPECT_LE(worst, 1e-3);
 }
 
-TEST(BrickPairs, EveryBrickWithAVoxelInATrianglesBandIsPairedWithItAndRowsAreSorted) {
-  const TriangleMesh sphere = test::icosphere(0.5, 1);
-  const GridSpec spec = grid_around(sphere, 1.0 / 12.0, 4);
-  const double band = 3.0;
-  std::vector<gpu::layout::SdfTriangle> triangles(sphere.triangle_count());
-  std::vector<std::uint32_t> usable;
-  for (std::uint32_t t = 0; t < sphere.triangle_count(); ++t) {
-    Eigen::Vector3d v[3];
-    for (int k = 0; k < 3; ++k) {
-      v[k] = spec.to_voxel(sphere.vertices[sphere.triangles[t][k]]);
-      triangles[t].vertex[k] = {static_cast<float>(v[k].x()), static_cast<float>(v[k].y()),
-                                static_cast<float>(v[k].z()), 0.0f};
-    }
-    const Eigen::Vector3d n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
-    triangles[t].face_normal = {static_cast<float>(n.x()), static_cast<float>(n.y()),
-                                static_cast<float>(n.z()), 1.0f};
-    usable.push_back(t);
-  }
-  const BrickPairs pairs = build_brick_pairs(triangles, usable, spec, band + 0.25);
-  const Eigen::Vector3i bricks = (spec.dims.array() + TS_SDF_BRICK - 1) / TS_SDF_BRICK;
+// Every (triangle, brick) with a voxel centre of the brick within `band` of the triangle (brute force
+// over the whole grid) is among the pairs, and each row lists its triangles in ascending order.
+void expect_every_band_brick_paired(const TriangleMesh& sphere, const GridSpec& spec,
+                                    const std::vector<gpu::layout::SdfTriangle>& triangles,
+                                    const std::vector<std::uint32_t>& usable, double band, int side) {
+  const BrickPairs pairs = build_brick_pairs(triangles, usable, spec, band + 0.25, side);
+  EXPECT_EQ(pairs.brick, side);
+  const Eigen::Vector3i bricks = (spec.dims.array() + side - 1) / side;
   ASSERT_EQ(pairs.row_begin.size(), static_cast<std::size_t>(bricks.z()) + 1);
   EXPECT_EQ(pairs.row_begin.back(), pairs.count());
   std::set<std::tuple<std::uint32_t, int, int, int>> paired;  // triangle, brick x, y, z
@@ -240,11 +232,35 @@ TEST(BrickPairs, EveryBrickWithAVoxelInATrianglesBandIsPairedWithItAndRowsAreSor
         for (std::uint32_t t : usable) {
           if (!(exact.closest_on(spec.voxel_center(i, j, k), t).distance / spec.voxel_size < band)) continue;
           ++needed;
-          const int b = TS_SDF_BRICK;
+          const int b = side;
           missing += paired.count({t, i / b, j / b, k / b}) ? 0 : 1;
         }
   EXPECT_GT(needed, 10000u);
   EXPECT_EQ(missing, 0u);
+}
+
+TEST(BrickPairs, EveryBrickWithAVoxelInATrianglesBandIsPairedWithItAndRowsAreSorted) {
+  const TriangleMesh sphere = test::icosphere(0.5, 1);
+  const GridSpec spec = grid_around(sphere, 1.0 / 12.0, 4);
+  const double band = 3.0;
+  std::vector<gpu::layout::SdfTriangle> triangles(sphere.triangle_count());
+  std::vector<std::uint32_t> usable;
+  for (std::uint32_t t = 0; t < sphere.triangle_count(); ++t) {
+    Eigen::Vector3d v[3];
+    for (int k = 0; k < 3; ++k) {
+      v[k] = spec.to_voxel(sphere.vertices[sphere.triangles[t][k]]);
+      triangles[t].vertex[k] = {static_cast<float>(v[k].x()), static_cast<float>(v[k].y()),
+                                static_cast<float>(v[k].z()), 0.0f};
+    }
+    const Eigen::Vector3d n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+    triangles[t].face_normal = {static_cast<float>(n.x()), static_cast<float>(n.y()),
+                                static_cast<float>(n.z()), 1.0f};
+    usable.push_back(t);
+  }
+  for (int side : {2, 4}) {
+    SCOPED_TRACE(side);
+    expect_every_band_brick_paired(sphere, spec, triangles, usable, band, side);
+  }
 }
 
 }  // namespace
