@@ -41,6 +41,7 @@ struct Options {
   std::vector<double> up{0.0, 0.0, 1.0};  // --preview's world up
   bool strict = false;                    // a body short of OK exits 1 (it is still written)
   std::string backend = "auto", sdf_backend = "auto";
+  std::string scan = "auto";     // sdf::parse_scan_method
   double context_seconds = 0.0;  // s, the GPU context's creation (once for a batch)
 };
 
@@ -110,6 +111,12 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
                   "(the CPU by OpenVDB's meshToVolume, all cores: approximate, closed meshes) or auto (as "
                   "--backend auto: on a software renderer or without GL cpu, else gpu)")
       ->check(CLI::IsMember({"auto", "gpu", "cpu", "openvdb"}))
+      ->capture_default_str();
+  cmd->add_option(
+         "--scan", o.scan,
+         "How the GPU scan conversion reaches the voxels (SDF on the GPU): compute (compute shaders), "
+         "geometry (geometry shader and rasteriser) or auto (compute)")
+      ->check(CLI::IsMember({"auto", "compute", "geometry"}))
       ->capture_default_str();
   cmd->add_option("--sdf-budget-mib", o.sdf_budget_mib,
                   "Most memory the sparse SDF may take [MiB] (GPU memory; host memory with the CPU "
@@ -191,6 +198,7 @@ sampler::SampleSettings settings_of(const Options& o) {
   const bool openvdb = o.sdf_backend == "openvdb";
   settings.sdf_backend = openvdb ? gpu::Backend::Cpu : gpu::parse_backend(o.sdf_backend).value();
   settings.cpu_sdf = openvdb ? sampler::CpuSdfMethod::OpenVdb : sampler::CpuSdfMethod::Exact;
+  settings.scan = sdf::parse_scan_method(o.scan).value();  // CLI::IsMember checked the spelling
   return settings;
 }
 
@@ -256,10 +264,11 @@ void print_backend_line(const Options& o, const gpu::Context* context) {
   const sampler::SampleSettings settings = settings_of(o);
   const gpu::Backend relax = gpu::resolve_backend(settings.backend, context);
   const gpu::Backend sdf = gpu::resolve_backend(settings.sdf_backend, context);
-  const std::string field = settings.cpu_sdf == sampler::CpuSdfMethod::OpenVdb
-                                ? "by OpenVDB's meshToVolume on the CPU"
-                            : sdf == gpu::Backend::Gpu ? "by GPU scan conversion"
-                                                       : "by exact distance on the CPU";
+  const std::string field =
+      settings.cpu_sdf == sampler::CpuSdfMethod::OpenVdb ? "by OpenVDB's meshToVolume on the CPU"
+      : sdf == gpu::Backend::Gpu ? fmt::format("by GPU scan conversion ({}, --scan {})",
+                                               sdf::scan_method_name(settings.scan), o.scan)
+                                 : "by exact distance on the CPU";
   const std::string note = fmt::format("SDF: {}, {}", field, o.sdf_backend == "auto" ? "auto" : "asked for");
   const std::string line = gpu::backend_line(settings.backend, relax, gpu::describe(context), true,
                                              "relaxation and certificate", note);

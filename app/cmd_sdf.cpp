@@ -70,6 +70,12 @@ void add_options(CLI::App* cmd, Options& o) {
          "4-7x faster, docs/benchmarks.md SDF), gpu on a hardware GPU")
       ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
       ->capture_default_str();
+  cmd->add_option("--scan", o.scan,
+                  "How the GPU scan conversion reaches the voxels: compute (triangle/brick pairs in compute "
+                  "shaders, every core of the GPU), geometry (prisms sliced by a geometry shader and "
+                  "rasterised: the thesis's method) or auto (compute; --backend gpu)")
+      ->check(CLI::IsMember({"auto", "compute", "geometry"}))
+      ->capture_default_str();
   cmd->add_option("--sign", o.sign, "Sign method: pseudonormal (closed meshes) or winding (robust to holes)")
       ->check(CLI::IsMember({"pseudonormal", "winding"}))
       ->capture_default_str();
@@ -153,6 +159,7 @@ sdf::ScanConvertResult gpu_level_set(const Options& o, gpu::Context& context, co
                                      const sdf::GridSpec& spec, std::string* device) {
   *device = context.summary();
   sdf::ScanConvertOptions scan;
+  scan.method = sdf::parse_scan_method(o.scan).value();  // CLI::IsMember checked the spelling
   scan.band = o.band;
   scan.timings = o.timings;
   scan.max_slab_bytes = static_cast<std::size_t>(o.slab_mb * 1048576.0);
@@ -186,6 +193,21 @@ sdf::ScanConvertResult cpu_level_set(const Options& o, const TriangleMesh& mesh,
   return result;
 }
 
+// The scan conversion as the backend line names it: "scan conversion by compute shaders".
+std::string scan_words(const std::string& scan) {
+  return sdf::parse_scan_method(scan).value() == sdf::ScanMethod::Compute
+             ? "scan conversion by compute shaders"
+             : "scan conversion by geometry shader";
+}
+
+// The backend line's note on the GPU path: why this scan method, and --compare-openvdb's reason.
+std::string scan_note(const Options& o) {
+  std::string note = o.scan == "auto" ? "--scan auto takes compute, no per-driver calibration yet"
+                                      : "--scan " + o.scan + " asked for";
+  if (o.compare && o.backend == "auto") note += "; --compare-openvdb compares the GPU field";
+  return note;
+}
+
 // Where the field is built (gpu/backend.h): the options with `backend` set to the path that runs, and
 // the GL context when that is the GPU. --compare-openvdb asks for the scan conversion (it compares the
 // GPU field with the exact one). Prints the backend line (a log line under --json: standard output
@@ -201,10 +223,9 @@ Options choose_backend(const Options& o, const GlobalOptions& global, std::uniqu
   if (o.compare) requested = gpu::Backend::Gpu;
   if (requested != gpu::Backend::Cpu) context = std::make_unique<gpu::Context>(context_options(global));
   const gpu::Backend chosen = gpu::resolve_backend(requested, context.get());
-  const std::string line =
-      gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
-                        chosen == gpu::Backend::Cpu ? "exact SDF" : "scan conversion",
-                        o.compare && o.backend == "auto" ? "--compare-openvdb compares the GPU field" : "");
+  const std::string line = gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
+                                             chosen == gpu::Backend::Cpu ? "exact SDF" : scan_words(o.scan),
+                                             chosen == gpu::Backend::Cpu ? "" : scan_note(o));
   if (o.json) {
     log::info("{}", line);
   } else {
@@ -235,7 +256,10 @@ int run_sdf(const Options& options, const GlobalOptions& global) {
     return 0;
   }
   print_sdf_summary(o, mesh, spec, result.stats);
-  fmt::print("device: {}; {} {:.3f} s\n", device, o.backend == "cpu" ? "exact SDF" : "scan conversion",
+  fmt::print("device: {}; {} {:.3f} s\n", device,
+             o.backend == "cpu"
+                 ? "exact SDF"
+                 : fmt::format("scan conversion ({})", sdf::scan_method_name(result.stats.method)),
              result.stats.seconds);
   if (o.timings) {
     print_sdf_times(o, result.stats, figures);

@@ -161,6 +161,9 @@ nlohmann::json run_json(const sampler::SampleResult& result, const CommandSecond
   return {{"device", device_name(context)},
           {"software_device", context ? nlohmann::json(context->software()) : nlohmann::json(nullptr)},
           {"sdf_backend", sampler::sdf_path_name(result.sdf_path)},
+          {"scan", result.sdf_path == sampler::SdfPath::Scan
+                       ? nlohmann::json(sdf::scan_method_name(result.field.scan))
+                       : nlohmann::json(nullptr)},
           {"relax_backend", result.relax_on_cpu ? "cpu" : "gpu"},
           {"certificate_backend", result.certificate_on_cpu ? "cpu" : "gpu"},
           {"probes", result.probes},

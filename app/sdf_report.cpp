@@ -67,6 +67,9 @@ void print_sdf_json(const SdfOptions& o, const TriangleMesh& mesh, const sdf::Gr
       {"write_seconds", f.write_seconds},
       {"total_seconds", f.total_seconds},
       {"backend", o.backend},
+      {"scan", o.backend == "cpu" ? nlohmann::ordered_json(nullptr)
+                                  : nlohmann::ordered_json(sdf::scan_method_name(st.method))},
+      {"brick_pairs", st.brick_pairs},
       {"renderer", device}};
   fmt::print("{}\n", out.dump(2));
 }

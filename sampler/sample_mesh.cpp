@@ -284,12 +284,14 @@ openvdb::FloatGrid::Ptr band_level_set(gpu::Context* context, const TriangleMesh
   }
   const sdf::Pseudonormals normals = sdf::compute_pseudonormals(mesh);
   sdf::ScanConvertOptions scan;
+  scan.method = settings.scan;
   scan.band = kBandVoxels;
   scan.index_space_grid = true;
   scan.timings = settings.timings;
   const sdf::ScanConvertResult converted =
       sdf::scan_convert(needed_context(context, "the GPU scan conversion"), mesh, normals, spec, scan);
   f.band_voxels = converted.stats.band_voxels;
+  f.scan = converted.stats.method;
   f.readback_bytes = converted.stats.readback_bytes;
   f.scan_peak_gpu_bytes = converted.stats.peak_gpu_bytes;
   result.timing_report = converted.stats.timing_report;

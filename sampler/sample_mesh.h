@@ -65,6 +65,7 @@ struct SampleSettings {
   std::size_t probes = 1'000'000;
   std::size_t probes_per_particle = 256;
   gpu::Backend sdf_backend = gpu::Backend::Auto;   // the field's device
+  sdf::ScanMethod scan = sdf::ScanMethod::Geometry;  // the GPU scan conversion's method (sample --scan)
   CpuSdfMethod cpu_sdf = CpuSdfMethod::Exact;       // the field's method on the CPU
   gpu::Backend backend = gpu::Backend::Auto;       // the relaxation's and the certificate's device
   // The coverage certificate that steers the rounds and is reported (floor: r / floor_divisor).
@@ -119,6 +120,7 @@ inline constexpr std::size_t kReportedHoles = 20;
 // What the sparse SDF cost (docs/benchmarks.md reports it per band voxel).
 struct FieldStats {
   std::size_t band_voxels = 0;          // voxels with |d| < band
+  sdf::ScanMethod scan = sdf::ScanMethod::Geometry;  // the scan conversion's method (SdfPath::Scan)
   std::size_t gpu_bytes = 0;            // the NanoVDB grid on the GPU
   std::size_t host_bytes = 0;           // the OpenVDB level set and the NanoVDB grid on the host, at their peak
   std::size_t readback_bytes = 0;       // GPU -> host during scan conversion (the compacted band)

@@ -17,6 +17,7 @@
 #include "gpu/graphics.h"
 #include "gpu/hash_grid.h"
 #include "gpu/layouts.h"
+#include "sdf/compute_scan.h"
 #include "sdf/level_set_builder.h"
 #include "shaders/sdf/bindings.h"
 
@@ -244,8 +245,9 @@ void fill_dense_off_band(DenseSdf& dense, const std::vector<std::uint8_t>& state
 // `max_items`: the most voxels one slab's band compaction (and its scan) takes: slab voxels are
 // numbered in 32 bits, and one dispatch covers 256 per work group times the device's work-group
 // count limits along x and y (gpu::Queue::dispatch_groups lays the groups out in rows).
-int choose_slab_layers(const GridSpec& spec, std::size_t budget, std::size_t max_items, int max_layers) {
-  const std::size_t per_layer = bytes_per_layer(spec);
+// `per_layer`: the GPU bytes one layer of the slab costs.
+int choose_slab_layers(const GridSpec& spec, std::size_t per_layer, std::size_t budget, std::size_t max_items,
+                       int max_layers) {
   const std::size_t layer_voxels = static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y());
   if (layer_voxels > max_items) {
     throw GpuError(fmt::format("one z-layer of the SDF grid ({} x {} voxels) exceeds the {} voxels one slab's band "
@@ -266,25 +268,41 @@ int choose_slab_layers(const GridSpec& spec, std::size_t budget, std::size_t max
 
 // Everything the slab loop needs that the CPU decides before the GPU is touched.
 struct ScanPlan {
+  ScanMethod method = ScanMethod::Geometry;
+  double band = 0.0;    // half-width [voxels]
   double margin = 0.0;  // prism growth beyond the triangle [voxels]
   int slab_layers = 0;  // z-layers per slab (render-target layers)
   int block = 0;        // z-layers per draw
   GpuGeometry geometry;
-  DrawLists lists;
+  DrawLists lists;   // geometry path
+  BrickPairs pairs;  // compute path
 };
 
-ScanPlan plan_scan(std::size_t max_items, int max_layers, const TriangleMesh& mesh, const Pseudonormals& normals,
-                   const GridSpec& spec, const ScanConvertOptions& options) {
+// `brick`: the compute path's brick side (compute_brick_side).
+ScanPlan plan_scan(std::size_t max_items, int max_layers, int brick, const TriangleMesh& mesh,
+                   const Pseudonormals& normals, const GridSpec& spec, const ScanConvertOptions& options) {
   ScanPlan plan;
   // Every voxel with |d| < band lies inside the triangle's prism grown by the band; a quarter voxel
   // more keeps rounding of the cross-sections (~1e-6 voxel) from losing one, and costs far fewer
   // fragments than a whole voxel ((4.25/5)^3 for tiny triangles). The fragment shader drops what
   // lies beyond depth_range.
+  plan.method = options.method;
+  plan.band = options.band;
   plan.margin = options.band + 0.25;
   plan.geometry = build_geometry(mesh, normals, spec, plan.margin);
-  plan.slab_layers = choose_slab_layers(spec, options.max_slab_bytes, max_items, max_layers);
+  const bool compute = options.method == ScanMethod::Compute;
+  const std::size_t per_layer =
+      bytes_per_layer(spec) + (compute ? kComputeScanBytesPerVoxel * static_cast<std::size_t>(spec.dims.x()) *
+                                             static_cast<std::size_t>(spec.dims.y())
+                                       : 0);
+  plan.slab_layers = choose_slab_layers(spec, per_layer, options.max_slab_bytes, max_items, max_layers);
   plan.block = std::min(kLayersPerDraw, plan.slab_layers);
-  plan.lists = bucket_by_block(plan.geometry, spec.dims.z(), plan.block);
+  // The same margin as the prisms: the pairs reach every voxel a prism would.
+  if (compute) {
+    plan.pairs = build_brick_pairs(plan.geometry.triangles, plan.geometry.drawn, spec, plan.margin, brick);
+  } else {
+    plan.lists = bucket_by_block(plan.geometry, spec.dims.z(), plan.block);
+  }
   return plan;
 }
 
@@ -295,8 +313,8 @@ class SlabScanner {
  public:
   SlabScanner(const gpu::ShaderLibrary& library, gpu::Queue& queue, const GridSpec& spec,
               const ScanPlan& plan);
-  // Clears the target and draws every prism touching grid layers [z0, z0 + layers); returns the
-  // number of draws.
+  // Clears the target and draws every prism touching grid layers [z0, z0 + layers) (or, on the
+  // compute path, runs the triangle/brick pairs of those layers); returns the number of draws (or 0).
   int draw(int z0, int layers);
   // The band voxels of the target's first `layers` layers, compacted on the GPU and read back: their
   // slab indices (x fastest, then y, then layer; ascending) and 4 floats each (unit gradient,
@@ -309,8 +327,10 @@ class SlabScanner {
   // Render target, geometry and compaction buffers [bytes] (the largest they have been).
   std::size_t gpu_bytes() const {
     return bytes_per_layer(spec_) * static_cast<std::size_t>(plan_.slab_layers) + triangles_.bytes() +
-           prisms_.bytes() + indices_.bytes() + flags_.bytes() + band_indices_.bytes() + band_values_.bytes();
+           prisms_.bytes() + indices_.bytes() + flags_.bytes() + band_indices_.bytes() +
+           band_values_.bytes() + (compute_ ? compute_->gpu_bytes() : 0);
   }
+  std::size_t brick_pairs_run() const { return brick_pairs_run_; }  // compute path, over all slabs
   std::size_t readback_bytes() const { return readback_bytes_; }  // host traffic so far
 
  private:
@@ -332,6 +352,8 @@ class SlabScanner {
   std::vector<std::size_t> band_slab_indices_;
   std::vector<float> band_values_host_;
   std::size_t readback_bytes_ = 0;
+  std::unique_ptr<ComputeScan> compute_;  // the compute path's kernels and buffers; null on the geometry path
+  std::size_t brick_pairs_run_ = 0;
   gpu::StateScope state_;  // last: restores the state before the target is released
 };
 
@@ -351,7 +373,10 @@ SlabScanner::SlabScanner(const gpu::ShaderLibrary& library, gpu::Queue& queue, c
       flags_(static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y()) *
              static_cast<std::size_t>(plan.slab_layers) * sizeof(std::uint32_t)) {
   target_.color.set_sampling(GL_NEAREST);  // read by texelFetch; a complete texture needs a non-mip filter
-  for (int invocations : kVariantInvocations) {
+  if (plan.method == ScanMethod::Compute)
+    compute_ = std::make_unique<ComputeScan>(library, plan.pairs, spec, plan.slab_layers, plan.band);
+  // The compute path draws nothing: no geometry-shader programs to compile.
+  for (int invocations : compute_ ? std::span<const int>{} : std::span<const int>{kVariantInvocations}) {
     programs_.push_back(gpu::Program::graphics(library, "sdf/scan_convert.vert", "sdf/scan_convert.geom",
                                                "sdf/scan_convert.frag",
                                                {"INVOCATIONS " + std::to_string(invocations)}));
@@ -368,6 +393,10 @@ int SlabScanner::draw(int z0, int layers) {
   prisms_.bind(TS_SDF_PRISMS);
   target_.framebuffer.clear_color(0, {0.0f, 0.0f, 0.0f, kUntouched});
   target_.framebuffer.clear_depth(1.0f);
+  if (compute_) {
+    brick_pairs_run_ += compute_->fill(queue_, target_.color, z0, layers);
+    return 0;
+  }
   struct Draw {
     std::size_t variant, begin, count;
   };
@@ -552,7 +581,7 @@ void scan_slabs(SlabScanner& scanner, const std::vector<std::unique_ptr<SlabCons
     const Slab slab{spec, z0, layers, voxels.indices, voxels.values};
     for (const auto& output : outputs) output->consume(slab);
     stats.host_build_seconds += seconds_since(lap);
-    if (check_errors) gpu::check_gl("SDF scan conversion (shaders sdf/scan_convert.*, sdf/band_*.comp)");
+    if (check_errors) gpu::check_gl("SDF scan conversion (shaders sdf/scan_*, sdf/band_*.comp)");
     stats.band_voxels += voxels.indices.size();
     ++stats.slabs;
     if (options.progress) options.progress(static_cast<double>(z0 + layers) / spec.dims.z());
@@ -599,13 +628,17 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
                                const GridSpec& spec, const ScanConvertOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   check_request(context, spec, options);
-  const ScanPlan plan = plan_scan(max_slab_items(context), max_slab_layers(context), mesh, normals, spec, options);
+  const ScanPlan plan = plan_scan(max_slab_items(context), max_slab_layers(context),
+                                  options.compute_brick > 0 ? options.compute_brick
+                                                            : compute_brick_side(context.software()),
+                                  mesh, normals, spec, options);
   gpu::ShaderLibrary library;
   gpu::Queue queue(options.timings, context.debug());
   SlabScanner scanner(library, queue, spec, plan);
 
   ScanConvertResult result;
   ScanConvertStats& stats = result.stats;
+  stats.method = plan.method;
   stats.layers_per_slab = plan.slab_layers;
   stats.degenerate_triangles = plan.geometry.degenerate;
   stats.needle_triangles = plan.geometry.needles;
@@ -613,6 +646,7 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
   scan_slabs(scanner, outputs, spec, options, queue.checks_errors(), stats);
   stats.peak_gpu_bytes = scanner.gpu_bytes();
   stats.readback_bytes = scanner.readback_bytes();
+  stats.brick_pairs = scanner.brick_pairs_run();
   // Voxels outside the band take +-band: a closed band separates the inside from the outside, so a
   // flood fill classifies the whole grid (OpenVDB's signedFloodFill for the level set; a fill from
   // the grid border for the dense copy).

@@ -16,10 +16,13 @@
 #include "gpu/context.h"
 #include "sdf/grid.h"
 #include "sdf/pseudonormals.h"
+#include "sdf/settings.h"
 
 namespace ts::sdf {
 
 struct ScanConvertOptions {
+  ScanMethod method = ScanMethod::Geometry;
+  int compute_brick = 0;  // compute path: brick side [voxels], 2 or 4; 0: compute_brick_side for the device
   double band = 3.0;                         // half-width of the narrow band [voxels]
   std::size_t max_slab_bytes = 1ull << 30;   // GPU render-target budget per slab [bytes]
   bool timings = false;                      // per-kernel GPU timer queries
@@ -35,7 +38,9 @@ struct ScanConvertOptions {
 struct ScanConvertStats {
   int slabs = 0;
   int layers_per_slab = 0;
-  int draws = 0;
+  ScanMethod method = ScanMethod::Geometry;
+  int draws = 0;                       // geometry path: draw calls
+  std::size_t brick_pairs = 0;         // compute path: triangle/brick pairs (sdf/compute_scan.h)
   std::size_t peak_gpu_bytes = 0;      // render target, geometry and band-compaction buffers
   std::size_t band_voxels = 0;         // voxels with |d| < band written to the grid
   std::size_t readback_bytes = 0;      // GPU -> host traffic: the compacted band (20 bytes a voxel) and counts

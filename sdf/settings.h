@@ -1,6 +1,8 @@
 #pragma once
 // What the user asks of an SDF: `tetrasand sdf --voxel H | --resolution N --band W --sign ...`.
 #include <cstddef>
+#include <optional>
+#include <string_view>
 
 namespace ts::sdf {
 
@@ -8,6 +10,26 @@ enum class SignMethod {
   Pseudonormal,  // angle-weighted pseudonormals: exact for closed, consistently oriented meshes
   Winding,       // generalised winding number (Jacobson et al. 2013): robust to holes
 };
+
+// How the triangles reach the voxels. Geometry: the thesis's method, each triangle's prism sliced by a
+// geometry shader and rasterised, the depth test keeping the nearest (fast where the raster hardware
+// is). Compute: triangle/brick pairs and atomic minima in compute shaders (sdf/compute_scan.h), which
+// use the whole GPU. Both give every band voxel its exact float distance and the same signs; compute
+// breaks ties by the lower triangle index, so its bytes never depend on the order work runs in.
+enum class ScanMethod { Geometry, Compute };
+
+// "geometry", "compute": the --scan spellings.
+inline const char* scan_method_name(ScanMethod method) {
+  return method == ScanMethod::Compute ? "compute" : "geometry";
+}
+// The --scan spellings "compute", "geometry" and "auto"; nullopt for any other text. Auto takes
+// Compute: a calibration timed once per renderer and driver that would pick Geometry where the raster
+// hardware makes it faster is not built yet (docs/commands/sdf.md).
+inline std::optional<ScanMethod> parse_scan_method(std::string_view text) {
+  if (text == "compute" || text == "auto") return ScanMethod::Compute;
+  if (text == "geometry") return ScanMethod::Geometry;
+  return std::nullopt;
+}
 
 struct SdfSettings {
   double voxel_size = 0.0;   // [m]; 0: the longest bounding-box side / resolution

@@ -85,6 +85,16 @@ TS_PARAMS(BandParams) {
   vec4 band;              // x: half-width [voxels]; yzw unused
 };
 
+// ---- sdf/scan_pairs.comp and sdf/scan_write.comp: the compute scan conversion of one slab
+// (sdf/compute_scan.h).
+TS_PARAMS(ComputeScanParams) {
+  ivec4 grid;   // xyz: grid dims [voxels]; w: brick rows (bricks along z) of the whole grid
+  ivec4 slab;   // x: grid z of slab layer 0; y: layers of this slab; zw unused
+  uvec4 pairs;  // x: first triangle/brick pair of this slab; y: its pairs; z: slab voxels
+                // (grid.x * grid.y * slab.y); w unused
+  vec4 band;    // x: half-width [voxels]; yzw unused
+};
+
 // ---- sim/contact_forces.comp. SimContactParams64 is the same for the double-precision pipeline
 // (TS_FP64), whose step length is a double.
 TS_PARAMS(SimContactParams) {

@@ -1,8 +1,14 @@
-// Buffer bindings and texture units of the sdf passes, shared by GLSL and C++ (sdf/scan_convert.cpp).
+// Buffer bindings and texture units of the sdf passes, shared by GLSL and C++ (sdf/scan_convert.cpp,
+// sdf/compute_scan.cpp).
 //
 // Slots per pass (program):
 //   scan conversion (scan_convert.vert + scan_convert.geom + scan_convert.frag):
 //     buffers TS_SDF_PRISMS (geometry stage), TS_SDF_TRIANGLES (fragment stage)
+//   compute scan conversion, nearest distance and nearest triangle (scan_pairs.comp, two variants):
+//     buffers TS_SDF_TRIANGLES, TS_SDF_PAIRS, TS_SDF_PAIR_ROWS, TS_SDF_NEAREST_DISTANCE,
+//     TS_SDF_NEAREST_TRIANGLE
+//   compute scan conversion, values (scan_write.comp): buffers TS_SDF_TRIANGLES, TS_SDF_NEAREST_TRIANGLE,
+//     image unit TS_SDF_IMAGE_SLAB
 //   band flags (band_flags.comp): texture unit TS_SDF_UNIT_SLAB, buffer TS_SDF_BAND_FLAGS
 //   exclusive scan of the flags (common/scan_*.comp): TS_SCAN_VALUES = the flags, scanned in place
 //   band scatter (band_scatter.comp): texture unit TS_SDF_UNIT_SLAB, buffers TS_SDF_BAND_OFFSETS,
@@ -15,11 +21,20 @@
 // Uniform-block slots (a namespace of their own in GL) of the kernels' parameter structs
 // (shaders/common/params.h). A kernel's block is bound by gpu::ParamBlock::bind right before it runs,
 // so kernels of different passes share a number.
-#define TS_SDF_SCAN_PARAMS 0  // ScanConvertParams: one entry per draw (gpu::ParamArray)
-#define TS_SDF_BAND_PARAMS 0  // BandParams (band_flags.comp, band_scatter.comp)
+#define TS_SDF_SCAN_PARAMS 0     // ScanConvertParams: one entry per draw (gpu::ParamArray)
+#define TS_SDF_BAND_PARAMS 0     // BandParams (band_flags.comp, band_scatter.comp)
+#define TS_SDF_COMPUTE_PARAMS 0  // ComputeScanParams (scan_pairs.comp, scan_write.comp)
 
 #define TS_SDF_TRIANGLES 0     // SdfTriangle[]: the triangles in grid-local voxel units
 #define TS_SDF_PRISMS 1        // SdfPrism[]: each triangle's bounding prism
+
+// The compute path: a voxel brick is BRICK^3 voxels, one work group of scan_pairs.comp; the host
+// compiles it with BRICK 2 or 4 (sdf::compute_brick_side) and pairs the triangles with the same bricks.
+#define TS_SDF_PAIRS 1             // uvec2 per triangle/brick pair: triangle, brick x | brick y << 16
+#define TS_SDF_PAIR_ROWS 2         // uint per brick row (brick z) + 1: its first pair (pairs sorted by row)
+#define TS_SDF_NEAREST_DISTANCE 3  // uint per slab voxel: ~ the bits of the least distance (0: none)
+#define TS_SDF_NEAREST_TRIANGLE 4  // uint per slab voxel: ~ the nearest triangle's index (0: none)
+#define TS_SDF_IMAGE_SLAB 0        // image2DArray rgba32f: the slab target, written by scan_write.comp
 
 #define TS_SDF_UNIT_SLAB 0     // sampler2DArray rgba32f: the finished slab (unit gradient, distance [voxels])
 #define TS_SDF_BAND_FLAGS 0    // uint per slab voxel: 1 in the band

@@ -165,10 +165,14 @@ TEST(SdfBackend, NamesTheDeviceAndTheTimeAndTheCpuPathGivesTheSameBand) {
                 "sdf " + bunny + " -o " + quoted(dir / "gpu.vdb") + " --resolution 24 --backend gpu", &gpu),
             0)
       << gpu;
-  EXPECT_NE(gpu.find("backend: gpu, scan conversion (asked for)\n"), std::string::npos) << gpu;
-  EXPECT_TRUE(
-      std::regex_search(gpu, std::regex(R"(\ndevice: .+ \(device \d+(, software)?\); scan conversion )"
-                                        R"(\d+\.\d{3} s\n)")))
+  EXPECT_NE(
+      gpu.find("backend: gpu, scan conversion by compute shaders (asked for; --scan auto takes compute, no "
+               "per-driver calibration yet)\n"),
+      std::string::npos)
+      << gpu;
+  EXPECT_TRUE(std::regex_search(
+      gpu, std::regex(R"(\ndevice: .+ \(device \d+(, software)?\); scan conversion \(compute\) )"
+                      R"(\d+\.\d{3} s\n)")))
       << gpu;
   ASSERT_EQ(test::run_tetrasand(
                 "sdf " + bunny + " -o " + quoted(dir / "cpu.vdb") + " --resolution 24 --backend cpu", &cpu),
@@ -212,9 +216,69 @@ TEST(SdfBackend, AutoTakesTheExactCpuPathOnASoftwareDeviceAndSaysSo) {
                 *device + "sdf " + bunny + " -o " + quoted(dir / "gpu.vdb") + " --backend gpu", &out),
             0)
       << out;
-  EXPECT_NE(out.find("backend: gpu, scan conversion (asked for)\n"), std::string::npos) << out;
-  EXPECT_TRUE(std::regex_search(out, std::regex(R"(\ndevice: llvmpipe.*; scan conversion \d+\.\d{3} s\n)")))
+  EXPECT_NE(
+      out.find("backend: gpu, scan conversion by compute shaders (asked for; --scan auto takes compute"),
+      std::string::npos)
       << out;
+  EXPECT_TRUE(std::regex_search(
+      out, std::regex(R"(\ndevice: llvmpipe.*; scan conversion \(compute\) \d+\.\d{3} s\n)")))
+      << out;
+}
+
+// --scan picks the GPU path's method, named on the backend line, the device line and in --json; both
+// methods give the same band; a bad spelling is a usage error.
+TEST(SdfBackend, ScanComputeAndGeometryAreNamedEverywhereAndGiveTheSameBand) {
+  const auto dir = test::temp_dir();
+  const std::string bunny = quoted(test::asset("bunny.obj"));
+  std::string compute, geometry, json;
+  const std::string common = " --resolution 24 --backend gpu --scan ";
+  ASSERT_EQ(
+      test::run_tetrasand("sdf " + bunny + " -o " + quoted(dir / "c.vdb") + common + "compute", &compute), 0)
+      << compute;
+  EXPECT_NE(compute.find(
+                "backend: gpu, scan conversion by compute shaders (asked for; --scan compute asked for)\n"),
+            std::string::npos)
+      << compute;
+  EXPECT_NE(compute.find("; scan conversion (compute) "), std::string::npos) << compute;
+  ASSERT_EQ(
+      test::run_tetrasand("sdf " + bunny + " -o " + quoted(dir / "g.vdb") + common + "geometry", &geometry),
+      0)
+      << geometry;
+  EXPECT_NE(geometry.find(
+                "backend: gpu, scan conversion by geometry shader (asked for; --scan geometry asked for)\n"),
+            std::string::npos)
+      << geometry;
+  EXPECT_NE(geometry.find("; scan conversion (geometry) "), std::string::npos) << geometry;
+  EXPECT_EQ(band_voxels(compute), band_voxels(geometry)) << compute << geometry;
+  ASSERT_EQ(test::run_tetrasand("sdf " + bunny + " -o " + quoted(dir / "j.vdb") + common + "geometry --json",
+                                &json),
+            0)
+      << json;
+  const auto report = nlohmann::json::parse(json.substr(json.find("{\n")));
+  EXPECT_EQ(report.at("scan"), "geometry") << json;
+  EXPECT_EQ(test::run_tetrasand("sdf " + bunny + " -o " + quoted(dir / "x.vdb") + common + "raster", &json),
+            2)
+      << json;
+  EXPECT_NE(json.find("--scan"), std::string::npos) << json;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.vdb"));
+}
+
+// --sign winding re-signs the compute path's band as it does the geometry path's: the same file.
+TEST(SdfBackend, WindingSignsWorkOnTheComputePath) {
+  const auto dir = test::temp_dir();
+  const std::string cube = quoted(test::asset("cube.obj"));
+  std::string out;
+  const std::string common = " --resolution 16 --backend gpu --sign winding --json --scan ";
+  ASSERT_EQ(test::run_tetrasand("sdf " + cube + " -o " + quoted(dir / "c.vdb") + common + "compute", &out), 0)
+      << out;
+  const auto compute = nlohmann::json::parse(out.substr(out.find("{\n")));
+  ASSERT_EQ(test::run_tetrasand("sdf " + cube + " -o " + quoted(dir / "g.vdb") + common + "geometry", &out),
+            0)
+      << out;
+  const auto geometry = nlohmann::json::parse(out.substr(out.find("{\n")));
+  EXPECT_EQ(compute.at("scan"), "compute");
+  EXPECT_EQ(compute.at("band_voxels"), geometry.at("band_voxels"));
+  EXPECT_GT(compute.at("band_voxels").get<long>(), 100);
 }
 
 TEST(SdfBackend, BadBackendAndCompareWithTheCpuPathAreRefused) {
@@ -264,6 +328,19 @@ TEST(CliSampleBackend, AutoRelaxesOnTheCpuOnASoftwareDeviceAndSaysSoOnTheDeviceL
   EXPECT_EQ(json.at("run").at("relax_backend"), "cpu") << out;
   EXPECT_EQ(json.at("run").at("certificate_backend"), "cpu") << out;
   EXPECT_EQ(json.at("run").at("software_device"), true) << out;
+}
+
+// --scan picks the method of a field built on the GPU (auto: compute); run.scan names it, null for a
+// field built on the CPU.
+TEST(CliSampleBackend, ScanPicksTheGpuFieldsMethodAndTheJsonNamesIt) {
+  std::string out;
+  ASSERT_EQ(run_sample("", "--sdf-backend gpu --scan geometry --json", &out), 0) << out;
+  EXPECT_EQ(nlohmann::json::parse(out.substr(out.find("{\n"))).at("run").at("scan"), "geometry") << out;
+  ASSERT_EQ(run_sample("", "--sdf-backend gpu", &out), 0) << out;
+  EXPECT_NE(out.find("SDF: by GPU scan conversion (compute, --scan auto), asked for)"), std::string::npos) << out;
+  ASSERT_EQ(run_sample("", "--sdf-backend cpu --backend cpu --json", &out), 0) << out;
+  EXPECT_TRUE(nlohmann::json::parse(out.substr(out.find("{\n"))).at("run").at("scan").is_null()) << out;
+  EXPECT_EQ(run_sample("", "--scan raster", &out), 2) << out;
 }
 
 TEST(CliSampleBackend, BackendGpuForcesTheGpuRelaxationOnASoftwareDevice) {
