@@ -5,7 +5,10 @@
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <tuple>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -20,34 +23,33 @@ NanoGrid to_nanovdb(const openvdb::FloatGrid& level_set) {
                                                      nanovdb::ChecksumMode::Disable);
 }
 
-Eigen::Vector3i gpu_index_shift(const GridSpec& spec) {
-  Eigen::Vector3i shift;
-  for (int a = 0; a < 3; ++a) shift[a] = -static_cast<int>(std::floor(spec.index_offset[a] / 128.0)) * 128;
-  return shift;
-}
-
-NanoGrid to_gpu_nanovdb(const openvdb::FloatGrid& level_set, const GridSpec& spec) {
-  const Eigen::Vector3i s = gpu_index_shift(spec);
-  if (s.isZero()) return to_nanovdb(level_set);
-  const openvdb::Coord shift(s.x(), s.y(), s.z());
-  // A copy of the band moved by `shift`: leaves keep their voxels (the shift is a multiple of 8), tiles
-  // (the flood fill's inside and any constant region) are filled at their moved boxes.
-  openvdb::FloatGrid::Ptr moved = openvdb::FloatGrid::create(level_set.background());
-  moved->setGridClass(level_set.getGridClass());
-  moved->setTransform(level_set.transform().copy());
-  openvdb::FloatTree& tree = moved->tree();
-  for (auto leaf = level_set.tree().cbeginLeaf(); leaf; ++leaf) {
-    auto* copy = new openvdb::FloatTree::LeafNodeType(*leaf);
-    copy->setOrigin(leaf->origin() + shift);
-    tree.addLeaf(copy);
+std::vector<gpu::layout::FieldRootTile> gpu_root_table(const nanovdb::FloatGrid& grid) {
+  using Root = nanovdb::FloatGrid::TreeType::RootType;
+  const Root& root = grid.tree().root();
+  const auto* base = reinterpret_cast<const char*>(&grid);
+  const auto offset_of = [&](const void* p) {
+    const std::ptrdiff_t offset = static_cast<const char*>(p) - base;
+    if (offset < 0 || offset > static_cast<std::ptrdiff_t>(UINT32_MAX)) {
+      throw Error(ExitCode::Internal, "gpu_root_table: a root tile lies past the 32-bit addresses PNanoVDB reads");
+    }
+    return static_cast<std::uint32_t>(offset);
+  };
+  std::vector<gpu::layout::FieldRootTile> table;
+  table.reserve(root.tileCount());
+  for (std::uint32_t t = 0; t < root.tileCount(); ++t) {
+    const Root::DataType::Tile* tile = root.data()->tile(t);
+    const nanovdb::Coord origin = tile->origin();
+    gpu::layout::FieldRootTile entry{};
+    entry.origin = {origin.x(), origin.y(), origin.z(), tile->isActive() ? 1 : 0};
+    entry.address.x = tile->isChild() ? offset_of(root.data()->getChild(tile)) : 0u;
+    entry.address.y = offset_of(&tile->value);
+    table.push_back(entry);
   }
-  for (auto tile = level_set.tree().cbeginValueAll(); tile; ++tile) {
-    if (!tile.isTileValue()) continue;
-    openvdb::CoordBBox box = tile.getBoundingBox();
-    box.translate(shift);
-    tree.fill(box, *tile, tile.isValueOn());
-  }
-  return to_nanovdb(*moved);
+  // The GLSL binary search compares x, then y, then z as signed ints.
+  std::sort(table.begin(), table.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.origin.x, a.origin.y, a.origin.z) < std::tie(b.origin.x, b.origin.y, b.origin.z);
+  });
+  return table;
 }
 
 namespace {
@@ -62,7 +64,7 @@ int largest_fitting_resolution(const GridSpec& spec, std::size_t bytes, std::siz
 }  // namespace
 
 SparseField::SparseField(const openvdb::FloatGrid& level_set, const GridSpec& spec, double band_voxels)
-    : SparseField(to_gpu_nanovdb(level_set, spec), spec, band_voxels) {}
+    : SparseField(to_nanovdb(level_set), spec, band_voxels) {}
 
 SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels, std::size_t block_bytes)
     : spec_(spec),
@@ -72,13 +74,6 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
   const nanovdb::FloatGrid* nano = host_.grid<float>();
   if (!nano) throw Error(ExitCode::Internal, "SparseField: the NanoVDB grid is not a float grid");
   band_voxels_ = nano->activeVoxelCount();
-  const Eigen::Vector3i far_corner = gpu_index_offset() + spec.dims - Eigen::Vector3i::Ones();
-  if (far_corner.maxCoeff() >= 4096) {
-    log::warn("the sparse SDF is {} voxels along its longest side: past 4096 voxels from its corner the GPU "
-              "reads walk NanoVDB's root, which NVIDIA's driver 580 computed wrong (docs/architecture.md, "
-              "\"The GPU field\"); on an NVIDIA GPU prefer a coarser voxel or the CPU path (--backend cpu)",
-              spec.dims.maxCoeff());
-  }
   if (block_bytes == 0) {
     GLint64 max_block = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
@@ -110,6 +105,7 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
     for (std::size_t offset = 0; offset < bytes; offset += chunk_bytes) {
       chunks_.emplace_back(std::min(chunk_bytes, bytes - offset), data + offset);
     }
+    upload_root_table(*nano);
   } catch (const GpuError& e) {
     chunks_.clear();
     throw GpuError(fmt::format("{} for the sparse SDF ({} band voxels); the largest grid that might fit has about {} "
@@ -118,8 +114,17 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
   }
 }
 
+void SparseField::upload_root_table(const nanovdb::FloatGrid& grid) {
+  std::vector<gpu::layout::FieldRootTile> table = gpu_root_table(grid);
+  root_tiles_ = static_cast<int>(table.size());
+  background_address_ = static_cast<std::uint32_t>(reinterpret_cast<const char*>(&grid.tree().root().background()) -
+                                                   reinterpret_cast<const char*>(&grid));
+  if (table.empty()) table.emplace_back();  // GL has no empty buffers; the reader searches none of it
+  roots_ = gpu::Buffer::from<gpu::layout::FieldRootTile>(table);
+}
+
 std::size_t SparseField::gpu_bytes() const {
-  std::size_t bytes = 0;
+  std::size_t bytes = roots_.bytes();
   for (const auto& chunk : chunks_) bytes += chunk.bytes();
   return bytes;
 }
@@ -131,10 +136,12 @@ std::vector<std::string> SparseField::shader_defines() const {
 
 void SparseField::bind(const FieldSlots& slots) const {
   for (std::size_t c = 0; c < chunks_.size(); ++c) chunks_[c].bind(c == 0 ? slots.first : slots.more[c - 1]);
-  const Eigen::Vector3i offset = gpu_index_offset();
+  roots_.bind(slots.roots);
+  const Eigen::Vector3i offset = spec_.index_offset;
   // The corner count is read only by a chunked field's programs (TS_FIELD_CHUNKS > 1).
   params_.values.index_offset = {offset.x(), offset.y(), offset.z(), chunks_.size() > 1 ? 8 : 0};
   params_.values.scale = {static_cast<float>(spec_.voxel_size), background_, 0.0f, 0.0f};
+  params_.values.roots = {static_cast<std::uint32_t>(root_tiles_), background_address_, 0u, 0u};
   params_.bind(slots.params);
 }
 
