@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <tuple>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -23,7 +22,7 @@ NanoGrid to_nanovdb(const openvdb::FloatGrid& level_set) {
                                                      nanovdb::ChecksumMode::Disable);
 }
 
-std::vector<gpu::layout::FieldRootTile> gpu_root_table(const nanovdb::FloatGrid& grid) {
+GpuRootTable gpu_root_table(const nanovdb::FloatGrid& grid) {
   using Root = nanovdb::FloatGrid::TreeType::RootType;
   const Root& root = grid.tree().root();
   const auto* base = reinterpret_cast<const char*>(&grid);
@@ -34,21 +33,43 @@ std::vector<gpu::layout::FieldRootTile> gpu_root_table(const nanovdb::FloatGrid&
     }
     return static_cast<std::uint32_t>(offset);
   };
-  std::vector<gpu::layout::FieldRootTile> table;
-  table.reserve(root.tileCount());
+  GpuRootTable table;
+  table.background_address = offset_of(&root.background());
+  if (root.tileCount() == 0) return table;
+  // Tile indices (origin >> 12, rounding down) and the box that holds them all.
+  const auto tile_of = [](const nanovdb::Coord& origin) {
+    return Eigen::Vector3i(origin.x() >> 12, origin.y() >> 12, origin.z() >> 12);
+  };
+  Eigen::Vector3i lo = Eigen::Vector3i::Constant(INT32_MAX), hi = Eigen::Vector3i::Constant(INT32_MIN);
+  for (std::uint32_t t = 0; t < root.tileCount(); ++t) {
+    const Eigen::Vector3i index = tile_of(root.data()->tile(t)->origin());
+    lo = lo.cwiseMin(index);
+    hi = hi.cwiseMax(index);
+  }
+  table.first_tile = lo;
+  table.extent = hi - lo + Eigen::Vector3i::Ones();
+  const double cells = static_cast<double>(table.extent.x()) * table.extent.y() * table.extent.z();
+  if (cells > static_cast<double>(kMaxRootTableEntries)) {
+    throw GpuError(fmt::format("the sparse SDF's {} root tiles span a box of {:.0f} tiles, more than the {} the GPU "
+                               "root table holds", root.tileCount(), cells, kMaxRootTableEntries));
+  }
+  table.entries.resize(static_cast<std::size_t>(cells));
+  for (std::size_t n = 0; n < table.entries.size(); ++n) {  // tiles the grid lacks: the background
+    const auto i = static_cast<int>(n / (table.extent.y() * table.extent.z()));
+    const auto j = static_cast<int>(n / table.extent.z() % table.extent.y());
+    const auto k = static_cast<int>(n % table.extent.z());
+    const Eigen::Vector3i origin = (lo + Eigen::Vector3i(i, j, k)) * 4096;
+    table.entries[n].origin = {origin.x(), origin.y(), origin.z(), 0};
+    table.entries[n].address = {0u, table.background_address, 0u, 0u};
+  }
   for (std::uint32_t t = 0; t < root.tileCount(); ++t) {
     const Root::DataType::Tile* tile = root.data()->tile(t);
-    const nanovdb::Coord origin = tile->origin();
-    gpu::layout::FieldRootTile entry{};
-    entry.origin = {origin.x(), origin.y(), origin.z(), tile->isActive() ? 1 : 0};
-    entry.address.x = tile->isChild() ? offset_of(root.data()->getChild(tile)) : 0u;
-    entry.address.y = offset_of(&tile->value);
-    table.push_back(entry);
+    const Eigen::Vector3i rel = tile_of(tile->origin()) - lo;
+    gpu::layout::FieldRootTile& entry =
+        table.entries[(static_cast<std::size_t>(rel.x()) * table.extent.y() + rel.y()) * table.extent.z() + rel.z()];
+    entry.origin.w = tile->isActive() ? 1 : 0;
+    entry.address = {tile->isChild() ? offset_of(root.data()->getChild(tile)) : 0u, offset_of(&tile->value), 1u, 0u};
   }
-  // The GLSL binary search compares x, then y, then z as signed ints.
-  std::sort(table.begin(), table.end(), [](const auto& a, const auto& b) {
-    return std::tie(a.origin.x, a.origin.y, a.origin.z) < std::tie(b.origin.x, b.origin.y, b.origin.z);
-  });
   return table;
 }
 
@@ -115,12 +136,10 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
 }
 
 void SparseField::upload_root_table(const nanovdb::FloatGrid& grid) {
-  std::vector<gpu::layout::FieldRootTile> table = gpu_root_table(grid);
-  root_tiles_ = static_cast<int>(table.size());
-  background_address_ = static_cast<std::uint32_t>(reinterpret_cast<const char*>(&grid.tree().root().background()) -
-                                                   reinterpret_cast<const char*>(&grid));
-  if (table.empty()) table.emplace_back();  // GL has no empty buffers; the reader searches none of it
-  roots_ = gpu::Buffer::from<gpu::layout::FieldRootTile>(table);
+  roots_table_ = gpu_root_table(grid);
+  std::vector<gpu::layout::FieldRootTile> entries = roots_table_.entries;
+  if (entries.empty()) entries.emplace_back();  // GL has no empty buffers; an empty box reads none of it
+  roots_ = gpu::Buffer::from<gpu::layout::FieldRootTile>(entries);
 }
 
 std::size_t SparseField::gpu_bytes() const {
@@ -141,7 +160,10 @@ void SparseField::bind(const FieldSlots& slots) const {
   // The corner count is read only by a chunked field's programs (TS_FIELD_CHUNKS > 1).
   params_.values.index_offset = {offset.x(), offset.y(), offset.z(), chunks_.size() > 1 ? 8 : 0};
   params_.values.scale = {static_cast<float>(spec_.voxel_size), background_, 0.0f, 0.0f};
-  params_.values.roots = {static_cast<std::uint32_t>(root_tiles_), background_address_, 0u, 0u};
+  const GpuRootTable& t = roots_table_;
+  params_.values.root_first = {t.first_tile.x(), t.first_tile.y(), t.first_tile.z(), 0};
+  params_.values.roots = {static_cast<std::uint32_t>(t.extent.x()), static_cast<std::uint32_t>(t.extent.y()),
+                          static_cast<std::uint32_t>(t.extent.z()), t.background_address};
   params_.bind(slots.params);
 }
 

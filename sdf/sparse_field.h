@@ -31,13 +31,23 @@ using NanoGrid = nanovdb::GridHandle<nanovdb::HostBuffer>;
 // level set's own index space (.nvdb output, the CPU's sdf::HostField).
 NanoGrid to_nanovdb(const openvdb::FloatGrid& level_set);
 
-// The root of `grid` as the GPU reads it (shaders/common/sparse_field.glsl, field_root_find): one entry
-// per root tile, sorted by origin (x, then y, then z), with the byte offsets of its upper node (0 for
-// none) and of its value in the grid. The GLSL reader finds a coordinate's tile by a binary search over
-// these 32-bit ints instead of PNanoVDB's root walk, whose 64-bit key NVIDIA's GLSL compiler (driver
-// 580.159.04, H200, seen 2026-12-04) computed wrong: the walk found no tile and every read was the
-// background. Any grid size and any coordinate sign. Throws Error (internal) when an offset passes 32 bits.
-std::vector<gpu::layout::FieldRootTile> gpu_root_table(const nanovdb::FloatGrid& grid);
+// The root of a NanoVDB grid as the GPU reads it (shaders/common/sparse_field.glsl, field_root_find):
+// one entry per tile of the box of root tiles the grid spans, x slowest and z fastest, with the byte
+// offsets of the tile's upper node (0 for none) and of its value in the grid; a box tile the grid lacks
+// reads as the background. The GLSL reader finds a coordinate's entry by arithmetic on these 32-bit
+// ints instead of PNanoVDB's root walk, whose 64-bit key NVIDIA's GLSL compiler (driver 580.159.04,
+// H200, seen 2026-12-04) computed wrong: the walk found no tile and every read was the background.
+// Any grid size and any coordinate sign.
+struct GpuRootTable {
+  Eigen::Vector3i first_tile = Eigen::Vector3i::Zero();  // tile index (origin / 4096) of entry 0
+  Eigen::Vector3i extent = Eigen::Vector3i::Zero();      // the box [root tiles]; zero for a grid without tiles
+  std::uint32_t background_address = 0;                  // byte offset of the root's background value
+  std::vector<gpu::layout::FieldRootTile> entries;
+};
+// Throws GpuError when the box would pass kMaxRootTableEntries (root tiles far apart: a grid no level set
+// of ours makes) and Error (internal) when an offset passes 32 bits.
+inline constexpr std::size_t kMaxRootTableEntries = std::size_t{1} << 20;
+GpuRootTable gpu_root_table(const nanovdb::FloatGrid& grid);
 
 // At most this many storage blocks hold one field (shaders/common/sparse_field.glsl): 1 GiB on
 // llvmpipe's 128 MiB blocks. A kernel reads the field through chunk 0's slot and 7 more its stage names.
@@ -78,13 +88,13 @@ class SparseField {
   std::vector<std::string> shader_defines() const;
   std::size_t band_voxels() const { return band_voxels_; }  // active voxels of the level set
   const NanoGrid& host() const { return host_; }         // the uploaded bytes (tests), in the level set's index space
-  int root_tiles() const { return root_tiles_; }          // entries of the uploaded root table
+  const GpuRootTable& root_table() const { return roots_table_; }  // what the root table's buffer holds
 
   // Binds the grid's chunks, its root table and the parameters shaders/common/sparse_field.glsl reads to `slots`.
   void bind(const FieldSlots& slots) const;
 
  private:
-  // Builds and uploads the root table of `grid` (the uploaded one) and the background's address.
+  // Builds and uploads the root table of `grid` (the uploaded one).
   void upload_root_table(const nanovdb::FloatGrid& grid);
 
   GridSpec spec_;
@@ -94,9 +104,8 @@ class SparseField {
   NanoGrid host_;
   int chunk_shift_ = 0;  // log2 of a chunk's words; 0 for one block
   std::vector<gpu::Buffer> chunks_;
-  int root_tiles_ = 0;
-  std::uint32_t background_address_ = 0;  // byte offset of the root's background value
-  gpu::Buffer roots_;                     // gpu_root_table (one zero entry for a grid without tiles)
+  GpuRootTable roots_table_;
+  gpu::Buffer roots_;  // roots_table_.entries (one zero entry for a grid without tiles)
   // Where the grid sits; mutable: bind() uploads it on first use, from a const field.
   mutable gpu::ParamBlock<gpu::params::FieldParams> params_;
 };

@@ -90,12 +90,14 @@ uvec2 pnanovdb_buf_read_uint64(pnanovdb_buf_t buf, uint byte_offset) {
 
 
 // The root as a flat table (FieldRootTile, sdf::gpu_root_table), bound at the slot the kernel's stage
-// names TS_FIELD_ROOTS: every read finds its root tile here by a binary search over 32-bit ints, and
-// PNanoVDB's 32-bit-safe upper, lower and leaf reads go on from the tile's upper node. PNanoVDB's own
-// root walk (pnanovdb_root_find_tile) compares 64-bit keys made of two 32-bit words, and NVIDIA's GLSL
-// compiler (driver 580.159.04, H200, seen 2026-12-04) computed the key's high word as 3 where it is 0,
-// so the walk found no tile and every read was the background; llvmpipe computed it right. No read
-// here goes through that walk (tests/sdf/sparse_field_test.cpp, tests/gpu/shader_audit.py).
+// names TS_FIELD_ROOTS: one entry per tile of the box of root tiles the grid spans, so every read finds
+// its root tile by arithmetic on 32-bit ints, and PNanoVDB's 32-bit-safe upper, lower and leaf reads go
+// on from the tile's upper node. PNanoVDB's own root walk (pnanovdb_root_find_tile) compares 64-bit
+// keys made of two 32-bit words, and NVIDIA's GLSL compiler (driver 580.159.04, H200, seen 2026-12-04)
+// computed the key's high word as 3 where it is 0, so the walk found no tile and every read was the
+// background; llvmpipe computed it right. No read here goes through that walk
+// (tests/sdf/sparse_field_test.cpp, tests/gpu/shader_audit.py). No loop either: a search loop in each
+// inlined read made llvmpipe compile the preview's ray caster 10x longer (LLVM's loop analysis).
 layout(std430, binding = TS_FIELD_ROOTS) readonly buffer FieldRootTable { FieldRootTile field_roots[]; };
 
 // One accessor per invocation: it caches the last leaf, lower and upper node, so neighbouring reads
@@ -104,58 +106,40 @@ struct FieldReader {
   pnanovdb_readaccessor_t accessor;
 };
 
-// The entry of the root tile holding NanoVDB coordinate `ijk`, or -1 when no tile holds it.
+// The entry of the root tile holding NanoVDB coordinate `ijk`, or -1 off the table's box.
 int field_root_find(ivec3 ijk) {
-  ivec3 origin = ijk & ivec3(~4095);  // two's complement: rounds negative coordinates down as well
-  int lo = 0;
-  int hi = int(field_params.roots.x) - 1;
-  while (lo <= hi) {
-    int mid = (lo + hi) >> 1;  // no overflow: the table holds at most a few thousand tiles
-    ivec3 o = field_roots[mid].origin.xyz;
-    if (o == origin) return mid;
-    bool below = o.x != origin.x ? o.x < origin.x : (o.y != origin.y ? o.y < origin.y : o.z < origin.z);
-    if (below) {
-      lo = mid + 1;
-    } else {
-      hi = mid - 1;
-    }
-  }
-  return -1;
+  // >> of a signed int extends the sign (GLSL 4.50, 5.9): the tile index rounds negative coordinates down.
+  ivec3 rel = (ijk >> 12) - field_params.root_first.xyz;
+  ivec3 extent = ivec3(field_params.roots.xyz);
+  if (any(lessThan(rel, ivec3(0))) || any(greaterThanEqual(rel, extent))) return -1;
+  return (rel.x * extent.y + rel.y) * extent.z + rel.z;  // no overflow: the host caps the box's size
 }
 
-// Caches the upper node of root tile `t` (an entry with one) in the accessor for `ijk`, as PNanoVDB's
-// root step does, so that later reads in that node skip the root table.
-pnanovdb_upper_handle_t field_cache_upper(inout pnanovdb_readaccessor_t acc, int t, ivec3 ijk) {
-  pnanovdb_upper_handle_t upper;
-  upper.address.byte_offset = field_roots[t].address.x;
-  acc.upper = upper;
+// The root step of a read at `ijk` that missed the accessor's cached nodes: finds the root tile in the
+// table and, where it has an upper node, caches that in the accessor (as PNanoVDB's root step does) and
+// returns true; else returns false with `address` at the tile's value or the root's background.
+bool field_root_step(inout pnanovdb_readaccessor_t acc, ivec3 ijk, out pnanovdb_address_t address) {
+  int t = field_root_find(ijk);
+  address.byte_offset = t < 0 ? field_params.roots.w : field_roots[t].address.y;
+  if (t < 0 || field_roots[t].address.x == 0u) return false;
+  acc.upper.address.byte_offset = field_roots[t].address.x;
   acc.key = ijk;
-  return upper;
+  return true;
 }
 
 // The byte address of the value at `ijk`: PNanoVDB's accessor read (pnanovdb_readaccessor_get_value_address)
-// with its root step replaced by the root table.
+// with its root step replaced by the root table. One exit and one inlined upper-node read: llvmpipe's
+// compile time follows the inlined code, and a kernel inlines this once per voxel read.
 pnanovdb_address_t field_value_address(inout pnanovdb_readaccessor_t acc, ivec3 ijk) {
   pnanovdb_buf_t buf = pnanovdb_buf_t(0u);  // unused by the reads (they read the bound blocks): set, so nothing reads an undefined value
   int dirty = pnanovdb_readaccessor_computedirty(acc, ijk);
-  if (pnanovdb_readaccessor_iscached0(acc, dirty)) {
-    return pnanovdb_leaf_get_value_address_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.leaf, ijk, acc);
-  }
-  if (pnanovdb_readaccessor_iscached1(acc, dirty)) {
-    return pnanovdb_lower_get_value_address_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.lower, ijk, acc);
-  }
-  if (pnanovdb_readaccessor_iscached2(acc, dirty)) {
-    return pnanovdb_upper_get_value_address_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.upper, ijk, acc);
-  }
-  int t = field_root_find(ijk);
   pnanovdb_address_t address;
-  if (t < 0) {
-    address.byte_offset = field_params.roots.y;  // the root's background
-  } else if (field_roots[t].address.x == 0u) {
-    address.byte_offset = field_roots[t].address.y;  // a tile value
-  } else {
-    pnanovdb_upper_handle_t upper = field_cache_upper(acc, t, ijk);
-    address = pnanovdb_upper_get_value_address_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, upper, ijk, acc);
+  if (pnanovdb_readaccessor_iscached0(acc, dirty)) {
+    address = pnanovdb_leaf_get_value_address_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.leaf, ijk, acc);
+  } else if (pnanovdb_readaccessor_iscached1(acc, dirty)) {
+    address = pnanovdb_lower_get_value_address_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.lower, ijk, acc);
+  } else if (pnanovdb_readaccessor_iscached2(acc, dirty) || field_root_step(acc, ijk, address)) {
+    address = pnanovdb_upper_get_value_address_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.upper, ijk, acc);
   }
   return address;
 }
@@ -165,37 +149,35 @@ pnanovdb_address_t field_value_address(inout pnanovdb_readaccessor_t acc, ivec3 
 uint field_dim(inout pnanovdb_readaccessor_t acc, ivec3 ijk) {
   pnanovdb_buf_t buf = pnanovdb_buf_t(0u);  // unused by the reads (they read the bound blocks): set, so nothing reads an undefined value
   int dirty = pnanovdb_readaccessor_computedirty(acc, ijk);
-  if (pnanovdb_readaccessor_iscached0(acc, dirty)) return 1u;
-  if (pnanovdb_readaccessor_iscached1(acc, dirty)) {
-    return pnanovdb_lower_get_dim_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.lower, ijk, acc);
+  pnanovdb_address_t unused;
+  uint dim = 4096u;  // the root's background or a tile value: a root tile's edge
+  if (pnanovdb_readaccessor_iscached0(acc, dirty)) {
+    dim = 1u;
+  } else if (pnanovdb_readaccessor_iscached1(acc, dirty)) {
+    dim = pnanovdb_lower_get_dim_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.lower, ijk, acc);
+  } else if (pnanovdb_readaccessor_iscached2(acc, dirty) || field_root_step(acc, ijk, unused)) {
+    dim = pnanovdb_upper_get_dim_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.upper, ijk, acc);
   }
-  if (pnanovdb_readaccessor_iscached2(acc, dirty)) {
-    return pnanovdb_upper_get_dim_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.upper, ijk, acc);
-  }
-  int t = field_root_find(ijk);
-  if (t < 0 || field_roots[t].address.x == 0u) return 4096u;  // background or a tile value: a root tile's edge
-  pnanovdb_upper_handle_t upper = field_cache_upper(acc, t, ijk);
-  return pnanovdb_upper_get_dim_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, upper, ijk, acc);
+  return dim;
 }
 
 // Whether the value at `ijk` is active (a band voxel): pnanovdb_readaccessor_is_active with the root table.
 bool field_is_active(inout pnanovdb_readaccessor_t acc, ivec3 ijk) {
   pnanovdb_buf_t buf = pnanovdb_buf_t(0u);  // unused by the reads (they read the bound blocks): set, so nothing reads an undefined value
   int dirty = pnanovdb_readaccessor_computedirty(acc, ijk);
+  pnanovdb_address_t unused;
+  bool is_active;
   if (pnanovdb_readaccessor_iscached0(acc, dirty)) {
-    return pnanovdb_leaf_is_active_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.leaf, ijk, acc);
+    is_active = pnanovdb_leaf_is_active_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.leaf, ijk, acc);
+  } else if (pnanovdb_readaccessor_iscached1(acc, dirty)) {
+    is_active = pnanovdb_lower_is_active_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.lower, ijk, acc);
+  } else if (pnanovdb_readaccessor_iscached2(acc, dirty) || field_root_step(acc, ijk, unused)) {
+    is_active = pnanovdb_upper_is_active_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.upper, ijk, acc);
+  } else {
+    int t = field_root_find(ijk);  // a root tile's state; off the box: the background, inactive
+    is_active = t >= 0 && field_roots[t].origin.w != 0;
   }
-  if (pnanovdb_readaccessor_iscached1(acc, dirty)) {
-    return pnanovdb_lower_is_active_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.lower, ijk, acc);
-  }
-  if (pnanovdb_readaccessor_iscached2(acc, dirty)) {
-    return pnanovdb_upper_is_active_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.upper, ijk, acc);
-  }
-  int t = field_root_find(ijk);
-  if (t < 0) return false;
-  if (field_roots[t].address.x == 0u) return field_roots[t].origin.w != 0;
-  pnanovdb_upper_handle_t upper = field_cache_upper(acc, t, ijk);
-  return pnanovdb_upper_is_active_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, upper, ijk, acc);
+  return is_active;
 }
 
 FieldReader field_reader() {

@@ -42,7 +42,7 @@ BlockSpec field() {
   return {"FieldBlock",
           sizeof(FieldParams),
           {TS_MEMBER(field_params, FieldParams, index_offset), TS_MEMBER(field_params, FieldParams, scale),
-           TS_MEMBER(field_params, FieldParams, roots)}};
+           TS_MEMBER(field_params, FieldParams, root_first), TS_MEMBER(field_params, FieldParams, roots)}};
 }
 BlockSpec camera() {
   return {"CameraBlock",

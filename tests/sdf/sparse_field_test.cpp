@@ -193,10 +193,11 @@ TEST_F(SparseFieldTest, GlslFindsEachVoxelsRootTileInTheTableAsTheHostGridIsLaid
   const SparseField field(*result_.grid, spec_, 3.0);
   const nanovdb::FloatGrid* nano = field.host().grid<float>();
   ASSERT_NE(nano, nullptr);
-  const auto table = gpu_root_table(*nano);
-  ASSERT_EQ(field.root_tiles(), static_cast<int>(table.size()));
+  const auto& table = field.root_table().entries;
+  EXPECT_EQ(table.size(), gpu_root_table(*nano).entries.size());
   // The torus straddles index 0 on every axis: its band lies in 8 root tiles, half at negative origins.
-  EXPECT_EQ(table.size(), 8u);
+  ASSERT_EQ(table.size(), 8u);
+  EXPECT_EQ(field.root_table().first_tile, Eigen::Vector3i::Constant(-1));
   EXPECT_EQ(table.front().origin.x, -4096);
   const auto offset_of = [&](const void* p) {
     return static_cast<std::uint32_t>(static_cast<const char*>(p) - reinterpret_cast<const char*>(nano));
@@ -462,7 +463,14 @@ class SparseFieldPast4096Test : public ::testing::Test {
 
 TEST_F(SparseFieldPast4096Test, GlslReadsEveryBandVoxelAndTheBackgroundOffItBitForBit) {
   const SparseField field(*grid_, spec_, 3.0);
-  EXPECT_GT(field.root_tiles(), 8);  // the corner spheres' tiles and the 8 about (0, 4096, 0)
+  // The box of root tiles: x from -8192, y from -4096, z from -8192, 3 tiles each; 9 hold band voxels
+  // (the near corner's and the 8 about (0, 4096, 0), one of which holds the far corner's too), the
+  // other 18 read as the background.
+  ASSERT_EQ(field.root_table().extent, Eigen::Vector3i::Constant(3));
+  EXPECT_EQ(field.root_table().first_tile, Eigen::Vector3i(-2, -1, -2));
+  std::size_t held = 0;
+  for (const auto& entry : field.root_table().entries) held += entry.address.z;
+  EXPECT_EQ(held, 9u);
   const auto points = band_and_off_band_points();
   const auto values = probe_field(field, points, 0);
   std::size_t in_band = 0, inside = 0, outside = 0;
