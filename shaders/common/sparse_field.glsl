@@ -96,8 +96,8 @@ uvec2 pnanovdb_buf_read_uint64(pnanovdb_buf_t buf, uint byte_offset) {
 // keys made of two 32-bit words, and NVIDIA's GLSL compiler (driver 580.159.04, H200, seen 2026-12-04)
 // computed the key's high word as 3 where it is 0, so the walk found no tile and every read was the
 // background; llvmpipe computed it right. No read here goes through that walk
-// (tests/sdf/sparse_field_test.cpp, tests/gpu/shader_audit.py). No loop either: a search loop in each
-// inlined read made llvmpipe compile the preview's ray caster 10x longer (LLVM's loop analysis).
+// (tests/sdf/sparse_field_test.cpp, tests/gpu/shader_audit.py). No search loop either: each read is
+// inlined, and llvmpipe's compile time follows what the reads inline.
 layout(std430, binding = TS_FIELD_ROOTS) readonly buffer FieldRootTable { FieldRootTile field_roots[]; };
 
 // One accessor per invocation: it caches the last leaf, lower and upper node, so neighbouring reads
