@@ -15,6 +15,8 @@ static_assert(offsetof(SdfTriangle, edge_normal) == 64);
 static_assert(offsetof(SdfTriangle, vertex_normal) == 112);
 static_assert(sizeof(SdfPrism) == 80);
 static_assert(offsetof(SdfPrism, normal_margin) == 64);
+static_assert(sizeof(FieldRootTile) == 32);
+static_assert(offsetof(FieldRootTile, address) == 16);
 static_assert(sizeof(SamplerGrid) == 32);
 static_assert(offsetof(SamplerGrid, dims) == 16);
 static_assert(sizeof(CertTriangle) == 48);

@@ -311,7 +311,7 @@ void Renderer::Impl::bind_volume() {
   field.bind({TS_PREVIEW_SPARSE_FIELD,
               {TS_PREVIEW_FIELD_CHUNK_1, TS_PREVIEW_FIELD_CHUNK_2, TS_PREVIEW_FIELD_CHUNK_3, TS_PREVIEW_FIELD_CHUNK_4,
                TS_PREVIEW_FIELD_CHUNK_5, TS_PREVIEW_FIELD_CHUNK_6, TS_PREVIEW_FIELD_CHUNK_7},
-              TS_PREVIEW_FIELD_PARAMS});
+              TS_PREVIEW_FIELD_PARAMS, TS_PREVIEW_FIELD_ROOTS});
   volume_block.values.origin_voxel = xyz(Eigen::Vector3d(volume_spec.origin - origin));
   volume_block.values.origin_voxel.w = static_cast<float>(volume_spec.voxel_size);
   volume_block.values.dims_band = {static_cast<float>(volume_spec.dims.x()), static_cast<float>(volume_spec.dims.y()),

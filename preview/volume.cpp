@@ -32,7 +32,7 @@ SdfVolume make_volume(const openvdb::FloatGrid& grid, const sdf::GridSpec& spec,
   SdfVolume v;
   v.spec = spec;
   v.band = band;
-  v.grid = sdf::to_gpu_nanovdb(grid, spec);
+  v.grid = sdf::to_nanovdb(grid);
   v.band_voxels = grid.activeVoxelCount();
   v.surface = surface_box(grid, spec, v.world_box());
   return v;

@@ -30,7 +30,7 @@ void GpuRelaxer::bind_sdf() const {
   field_.bind({TS_SAMPLER_SPARSE_FIELD,
                {TS_SAMPLER_FIELD_CHUNK_1, TS_SAMPLER_FIELD_CHUNK_2, TS_SAMPLER_FIELD_CHUNK_3, TS_SAMPLER_FIELD_CHUNK_4,
                 TS_SAMPLER_FIELD_CHUNK_5, TS_SAMPLER_FIELD_CHUNK_6, TS_SAMPLER_FIELD_CHUNK_7},
-               TS_SAMPLER_FIELD_PARAMS});
+               TS_SAMPLER_FIELD_PARAMS, TS_SAMPLER_FIELD_ROOTS});
 }
 
 void GpuRelaxer::project(std::uint32_t count, int steps) {

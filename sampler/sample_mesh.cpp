@@ -307,8 +307,8 @@ RelaxField make_field(gpu::Context* context, const TriangleMesh& mesh, const sdf
                       SampleResult& result) {
   result.sdf_path = choose_sdf_path(context, settings);
   const openvdb::FloatGrid::Ptr grid = band_level_set(context, mesh, exact, spec, settings, result);
-  // The CPU reads the level set's own index space, the GPU a moved copy (sdf::gpu_index_shift says why).
-  sdf::NanoGrid nano = result.relax_on_cpu ? sdf::to_nanovdb(*grid) : sdf::to_gpu_nanovdb(*grid, spec);
+  // CPU and GPU read the same grid, in the level set's own index space.
+  sdf::NanoGrid nano = sdf::to_nanovdb(*grid);
   FieldStats& f = result.field;
   f.host_bytes = grid->memUsage() + nano.size();
   if (nano.size() > settings.max_sdf_bytes) {

@@ -5,7 +5,9 @@
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -20,34 +22,55 @@ NanoGrid to_nanovdb(const openvdb::FloatGrid& level_set) {
                                                      nanovdb::ChecksumMode::Disable);
 }
 
-Eigen::Vector3i gpu_index_shift(const GridSpec& spec) {
-  Eigen::Vector3i shift;
-  for (int a = 0; a < 3; ++a) shift[a] = -static_cast<int>(std::floor(spec.index_offset[a] / 128.0)) * 128;
-  return shift;
-}
-
-NanoGrid to_gpu_nanovdb(const openvdb::FloatGrid& level_set, const GridSpec& spec) {
-  const Eigen::Vector3i s = gpu_index_shift(spec);
-  if (s.isZero()) return to_nanovdb(level_set);
-  const openvdb::Coord shift(s.x(), s.y(), s.z());
-  // A copy of the band moved by `shift`: leaves keep their voxels (the shift is a multiple of 8), tiles
-  // (the flood fill's inside and any constant region) are filled at their moved boxes.
-  openvdb::FloatGrid::Ptr moved = openvdb::FloatGrid::create(level_set.background());
-  moved->setGridClass(level_set.getGridClass());
-  moved->setTransform(level_set.transform().copy());
-  openvdb::FloatTree& tree = moved->tree();
-  for (auto leaf = level_set.tree().cbeginLeaf(); leaf; ++leaf) {
-    auto* copy = new openvdb::FloatTree::LeafNodeType(*leaf);
-    copy->setOrigin(leaf->origin() + shift);
-    tree.addLeaf(copy);
+GpuRootTable gpu_root_table(const nanovdb::FloatGrid& grid) {
+  using Root = nanovdb::FloatGrid::TreeType::RootType;
+  const Root& root = grid.tree().root();
+  const auto* base = reinterpret_cast<const char*>(&grid);
+  const auto offset_of = [&](const void* p) {
+    const std::ptrdiff_t offset = static_cast<const char*>(p) - base;
+    if (offset < 0 || offset > static_cast<std::ptrdiff_t>(UINT32_MAX)) {
+      throw Error(ExitCode::Internal, "gpu_root_table: a root tile lies past the 32-bit addresses PNanoVDB reads");
+    }
+    return static_cast<std::uint32_t>(offset);
+  };
+  GpuRootTable table;
+  table.background_address = offset_of(&root.background());
+  if (root.tileCount() == 0) return table;
+  // Tile indices (origin >> 12, rounding down) and the box that holds them all.
+  const auto tile_of = [](const nanovdb::Coord& origin) {
+    return Eigen::Vector3i(origin.x() >> 12, origin.y() >> 12, origin.z() >> 12);
+  };
+  Eigen::Vector3i lo = Eigen::Vector3i::Constant(INT32_MAX), hi = Eigen::Vector3i::Constant(INT32_MIN);
+  for (std::uint32_t t = 0; t < root.tileCount(); ++t) {
+    const Eigen::Vector3i index = tile_of(root.data()->tile(t)->origin());
+    lo = lo.cwiseMin(index);
+    hi = hi.cwiseMax(index);
   }
-  for (auto tile = level_set.tree().cbeginValueAll(); tile; ++tile) {
-    if (!tile.isTileValue()) continue;
-    openvdb::CoordBBox box = tile.getBoundingBox();
-    box.translate(shift);
-    tree.fill(box, *tile, tile.isValueOn());
+  table.first_tile = lo;
+  table.extent = hi - lo + Eigen::Vector3i::Ones();
+  const double cells = static_cast<double>(table.extent.x()) * table.extent.y() * table.extent.z();
+  if (cells > static_cast<double>(kMaxRootTableEntries)) {
+    throw GpuError(fmt::format("the sparse SDF's {} root tiles span a box of {:.0f} tiles, more than the {} the GPU "
+                               "root table holds", root.tileCount(), cells, kMaxRootTableEntries));
   }
-  return to_nanovdb(*moved);
+  table.entries.resize(static_cast<std::size_t>(cells));
+  for (std::size_t n = 0; n < table.entries.size(); ++n) {  // tiles the grid lacks: the background
+    const auto i = static_cast<int>(n / (table.extent.y() * table.extent.z()));
+    const auto j = static_cast<int>(n / table.extent.z() % table.extent.y());
+    const auto k = static_cast<int>(n % table.extent.z());
+    const Eigen::Vector3i origin = (lo + Eigen::Vector3i(i, j, k)) * 4096;
+    table.entries[n].origin = {origin.x(), origin.y(), origin.z(), 0};
+    table.entries[n].address = {0u, table.background_address, 0u, 0u};
+  }
+  for (std::uint32_t t = 0; t < root.tileCount(); ++t) {
+    const Root::DataType::Tile* tile = root.data()->tile(t);
+    const Eigen::Vector3i rel = tile_of(tile->origin()) - lo;
+    gpu::layout::FieldRootTile& entry =
+        table.entries[(static_cast<std::size_t>(rel.x()) * table.extent.y() + rel.y()) * table.extent.z() + rel.z()];
+    entry.origin.w = tile->isActive() ? 1 : 0;
+    entry.address = {tile->isChild() ? offset_of(root.data()->getChild(tile)) : 0u, offset_of(&tile->value), 1u, 0u};
+  }
+  return table;
 }
 
 namespace {
@@ -62,7 +85,7 @@ int largest_fitting_resolution(const GridSpec& spec, std::size_t bytes, std::siz
 }  // namespace
 
 SparseField::SparseField(const openvdb::FloatGrid& level_set, const GridSpec& spec, double band_voxels)
-    : SparseField(to_gpu_nanovdb(level_set, spec), spec, band_voxels) {}
+    : SparseField(to_nanovdb(level_set), spec, band_voxels) {}
 
 SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels, std::size_t block_bytes)
     : spec_(spec),
@@ -72,13 +95,6 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
   const nanovdb::FloatGrid* nano = host_.grid<float>();
   if (!nano) throw Error(ExitCode::Internal, "SparseField: the NanoVDB grid is not a float grid");
   band_voxels_ = nano->activeVoxelCount();
-  const Eigen::Vector3i far_corner = gpu_index_offset() + spec.dims - Eigen::Vector3i::Ones();
-  if (far_corner.maxCoeff() >= 4096) {
-    log::warn("the sparse SDF is {} voxels along its longest side: past 4096 voxels from its corner the GPU "
-              "reads walk NanoVDB's root, which NVIDIA's driver 580 computed wrong (docs/architecture.md, "
-              "\"The GPU field\"); on an NVIDIA GPU prefer a coarser voxel or the CPU path (--backend cpu)",
-              spec.dims.maxCoeff());
-  }
   if (block_bytes == 0) {
     GLint64 max_block = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
@@ -110,6 +126,7 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
     for (std::size_t offset = 0; offset < bytes; offset += chunk_bytes) {
       chunks_.emplace_back(std::min(chunk_bytes, bytes - offset), data + offset);
     }
+    upload_root_table(*nano);
   } catch (const GpuError& e) {
     chunks_.clear();
     throw GpuError(fmt::format("{} for the sparse SDF ({} band voxels); the largest grid that might fit has about {} "
@@ -118,8 +135,15 @@ SparseField::SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels
   }
 }
 
+void SparseField::upload_root_table(const nanovdb::FloatGrid& grid) {
+  roots_table_ = gpu_root_table(grid);
+  std::vector<gpu::layout::FieldRootTile> entries = roots_table_.entries;
+  if (entries.empty()) entries.emplace_back();  // GL has no empty buffers; an empty box reads none of it
+  roots_ = gpu::Buffer::from<gpu::layout::FieldRootTile>(entries);
+}
+
 std::size_t SparseField::gpu_bytes() const {
-  std::size_t bytes = 0;
+  std::size_t bytes = roots_.bytes();
   for (const auto& chunk : chunks_) bytes += chunk.bytes();
   return bytes;
 }
@@ -131,10 +155,15 @@ std::vector<std::string> SparseField::shader_defines() const {
 
 void SparseField::bind(const FieldSlots& slots) const {
   for (std::size_t c = 0; c < chunks_.size(); ++c) chunks_[c].bind(c == 0 ? slots.first : slots.more[c - 1]);
-  const Eigen::Vector3i offset = gpu_index_offset();
+  roots_.bind(slots.roots);
+  const Eigen::Vector3i offset = spec_.index_offset;
   // The corner count is read only by a chunked field's programs (TS_FIELD_CHUNKS > 1).
   params_.values.index_offset = {offset.x(), offset.y(), offset.z(), chunks_.size() > 1 ? 8 : 0};
   params_.values.scale = {static_cast<float>(spec_.voxel_size), background_, 0.0f, 0.0f};
+  const GpuRootTable& t = roots_table_;
+  params_.values.root_first = {t.first_tile.x(), t.first_tile.y(), t.first_tile.z(), 0};
+  params_.values.roots = {static_cast<std::uint32_t>(t.extent.x()), static_cast<std::uint32_t>(t.extent.y()),
+                          static_cast<std::uint32_t>(t.extent.z()), t.background_address};
   params_.bind(slots.params);
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 // The narrow-band SDF where the GPU reads it: a NanoVDB float level set (signed distance in world
 // units in the band, +-band off it with the sign of the flood fill) in one shader storage buffer, or
-// in up to kMaxFieldChunks of them when it is larger than the GPU's largest storage block, read in GLSL through NanoVDB's PNanoVDB.h (shaders/common/sparse_field.glsl: trilinear values and
-// central-difference gradients). GPU memory follows the band (its leaves), not the bounding box:
+// in up to kMaxFieldChunks of them when it is larger than the GPU's largest storage block, with its root
+// as a flat table in one more (gpu_root_table), read in GLSL through NanoVDB's PNanoVDB.h below the root
+// (shaders/common/sparse_field.glsl: trilinear values and central-difference gradients). GPU memory follows the band (its leaves), not the bounding box:
 // doubling the resolution multiplies it by about 4, not 8. Used by the sampler and the preview.
 #include <openvdb/openvdb.h>
 
@@ -11,12 +12,14 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "gpu/gl.h"
+#include "gpu/layouts.h"
 #include "gpu/params.h"
 #include "sdf/grid.h"
 
@@ -28,19 +31,23 @@ using NanoGrid = nanovdb::GridHandle<nanovdb::HostBuffer>;
 // level set's own index space (.nvdb output, the CPU's sdf::HostField).
 NanoGrid to_nanovdb(const openvdb::FloatGrid& level_set);
 
-// The translation from a level set's index space to the GPU field's: a multiple of 128 voxels (a lower
-// internal node of OpenVDB's tree, so leaves and tiles move whole) that puts spec's voxel (0, 0, 0) in
-// [0, 128)^3, so every band voxel of a grid under 3968 voxels a side has NanoVDB coordinates in
-// [0, 4096): one root tile, whose upper node the GLSL reader caches up front so that it never walks
-// the root (shaders/common/sparse_field.glsl, field_prime). Why: NVIDIA's GLSL compiler (driver
-// 580.159.04, H200, seen 2026-12-04) computes the high word of PNanoVDB's 64-bit root key
-// (pnanovdb_coord_to_key, as two 32-bit words) as 3 where it is 0, for negative and positive
-// coordinates alike, so the root walk found no tile and every read was the background; llvmpipe
-// computes it right.
-Eigen::Vector3i gpu_index_shift(const GridSpec& spec);
-
-// The level set as the GPU reads it: to_nanovdb of the level set moved by gpu_index_shift(spec).
-NanoGrid to_gpu_nanovdb(const openvdb::FloatGrid& level_set, const GridSpec& spec);
+// The root of a NanoVDB grid as the GPU reads it (shaders/common/sparse_field.glsl, field_root_find):
+// one entry per tile of the box of root tiles the grid spans, x slowest and z fastest, with the byte
+// offsets of the tile's upper node (0 for none) and of its value in the grid; a box tile the grid lacks
+// reads as the background. The GLSL reader finds a coordinate's entry by arithmetic on these 32-bit
+// ints instead of PNanoVDB's root walk, whose 64-bit key NVIDIA's GLSL compiler (driver 580.159.04,
+// H200, seen 2026-12-04) computed wrong: the walk found no tile and every read was the background.
+// Any grid size and any coordinate sign.
+struct GpuRootTable {
+  Eigen::Vector3i first_tile = Eigen::Vector3i::Zero();  // tile index (origin / 4096) of entry 0
+  Eigen::Vector3i extent = Eigen::Vector3i::Zero();      // the box [root tiles]; zero for a grid without tiles
+  std::uint32_t background_address = 0;                  // byte offset of the root's background value
+  std::vector<gpu::layout::FieldRootTile> entries;
+};
+// Throws GpuError when the box would pass kMaxRootTableEntries (root tiles far apart: a grid no level set
+// of ours makes) and Error (internal) when an offset passes 32 bits.
+inline constexpr std::size_t kMaxRootTableEntries = std::size_t{1} << 20;
+GpuRootTable gpu_root_table(const nanovdb::FloatGrid& grid);
 
 // At most this many storage blocks hold one field (shaders/common/sparse_field.glsl): 1 GiB on
 // llvmpipe's 128 MiB blocks. A kernel reads the field through chunk 0's slot and 7 more its stage names.
@@ -51,6 +58,7 @@ struct FieldSlots {
   GLuint first = 0;
   std::array<GLuint, kMaxFieldChunks - 1> more{};
   GLuint params = 0;  // uniform-block slot of its gpu::params::FieldParams
+  GLuint roots = 0;   // slot of its root table (gpu_root_table)
 };
 
 class SparseField {
@@ -61,7 +69,7 @@ class SparseField {
   // flood-filled. Converted to NanoVDB and uploaded; throws GpuError (exit 3) when the GPU cannot
   // hold it, naming the size and the largest resolution that would fit.
   SparseField(const openvdb::FloatGrid& level_set, const GridSpec& spec, double band_voxels);
-  // The same from a grid already converted by to_gpu_nanovdb(level_set, spec) and checked by the caller.
+  // The same from a grid already converted by to_nanovdb(level_set) and checked by the caller.
   // `block_bytes`: the largest storage block to use, 0 for the GPU's own (GL_MAX_SHADER_STORAGE_BLOCK_SIZE);
   // tests pass a small one to cut a small grid into chunks.
   SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels, std::size_t block_bytes = 0);
@@ -79,14 +87,16 @@ class SparseField {
   // compiled for one field reads another only if their defines are equal.
   std::vector<std::string> shader_defines() const;
   std::size_t band_voxels() const { return band_voxels_; }  // active voxels of the level set
-  const NanoGrid& host() const { return host_; }         // the uploaded bytes (tests), in the GPU's index space
-  // NanoVDB index of spec's voxel (0, 0, 0) in the uploaded grid: spec.index_offset + gpu_index_shift(spec).
-  Eigen::Vector3i gpu_index_offset() const { return spec_.index_offset + gpu_index_shift(spec_); }
+  const NanoGrid& host() const { return host_; }         // the uploaded bytes (tests), in the level set's index space
+  const GpuRootTable& root_table() const { return roots_table_; }  // what the root table's buffer holds
 
-  // Binds the grid's chunks and the parameters shaders/common/sparse_field.glsl reads to `slots`.
+  // Binds the grid's chunks, its root table and the parameters shaders/common/sparse_field.glsl reads to `slots`.
   void bind(const FieldSlots& slots) const;
 
  private:
+  // Builds and uploads the root table of `grid` (the uploaded one).
+  void upload_root_table(const nanovdb::FloatGrid& grid);
+
   GridSpec spec_;
   double band_ = 0.0;
   float background_ = 0.0f;
@@ -94,6 +104,8 @@ class SparseField {
   NanoGrid host_;
   int chunk_shift_ = 0;  // log2 of a chunk's words; 0 for one block
   std::vector<gpu::Buffer> chunks_;
+  GpuRootTable roots_table_;
+  gpu::Buffer roots_;  // roots_table_.entries (one zero entry for a grid without tiles)
   // Where the grid sits; mutable: bind() uploads it on first use, from a const field.
   mutable gpu::ParamBlock<gpu::params::FieldParams> params_;
 };

@@ -37,6 +37,20 @@ TS_LAYOUT(SdfPrism) {
   vec4 normal_margin;     // xyz: unit face normal; w: extrusion along +-normal [voxels]
 };
 
+// ---- sdf: one root tile of a sparse field's NanoVDB grid (sdf::SparseField), in the flat table the GLSL
+// reader indexes instead of walking PNanoVDB's root (common/sparse_field.glsl, field_root_find): one
+// entry per tile of the box of root tiles the grid spans (x slowest, z fastest), so a coordinate's
+// entry is found by arithmetic on 32-bit ints, with no loop and no 64-bit root key (which NVIDIA's GLSL
+// compiler computed wrong; docs/architecture.md, "The GPU field"). A box tile the grid lacks reads as
+// the root's background.
+TS_LAYOUT(FieldRootTile) {
+  ivec4 origin;           // xyz: the tile's origin (NanoVDB index, multiples of 4096); w: 1 for an active
+                          // tile value, else 0 (PNanoVDB's tile state; 0 for a tile the grid lacks)
+  uvec4 address;          // x: byte offset of the tile's upper node in the grid, 0 for none;
+                          // y: byte offset of the tile's value (the background's for a tile the grid lacks);
+                          // z: 1 for a tile of the grid, 0 for one it lacks; w unused
+};
+
 // ---- sampler: shared constants of one relaxation step.
 TS_LAYOUT(SamplerGrid) {
   vec4 origin_cell;       // xyz: world position of cell (0,0,0)'s corner [m]; w: cell size [m]

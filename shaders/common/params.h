@@ -44,6 +44,9 @@ TS_PARAMS(FieldParams) {
   ivec4 index_offset;     // xyz: NanoVDB index of the grid spec's voxel (0,0,0); w: 8, the corners
                           // a chunked field's trilinear read loops over (a count the compiler cannot see)
   vec4 scale;             // x: voxel size [world units]; y: |value| off the band [world units]; zw unused
+  ivec4 root_first;       // xyz: tile index (origin / 4096) of the root table's first entry; w unused
+  uvec4 roots;            // xyz: extent of the root table's box [root tiles]; w: byte offset of the
+                          // root's background value in the grid (what a coordinate off the box reads)
 };
 
 // ---- sampler/relax.comp: one relaxation step.

@@ -22,6 +22,9 @@ layout(std140, binding = TS_FIELD_PARAMS) uniform FieldBlock { FieldParams field
 #if TS_FIELD_CHUNKS > 8
 #error "sdf::SparseField uploads at most 8 chunks"
 #endif
+#if TS_FIELD_CHUNK_SHIFT < 1 || TS_FIELD_CHUNK_SHIFT > 30
+#error "a chunk holds 2^TS_FIELD_CHUNK_SHIFT words: a shift of 32 or more is undefined, and 32-bit addresses need at most 30"
+#endif
 layout(std430, binding = TS_FIELD_CHUNK_1) readonly buffer SparseFieldChunk1 { uint field_chunk1[]; };
 #if TS_FIELD_CHUNKS > 2
 layout(std430, binding = TS_FIELD_CHUNK_2) readonly buffer SparseFieldChunk2 { uint field_chunk2[]; };
@@ -86,67 +89,113 @@ uvec2 pnanovdb_buf_read_uint64(pnanovdb_buf_t buf, uint byte_offset) {
 #include "nanovdb/PNanoVDB.h"
 
 
-// One accessor per invocation: it caches the last leaf, so neighbouring reads skip the tree walk.
+// The root as a flat table (FieldRootTile, sdf::gpu_root_table), bound at the slot the kernel's stage
+// names TS_FIELD_ROOTS: one entry per tile of the box of root tiles the grid spans, so every read finds
+// its root tile by arithmetic on 32-bit ints, and PNanoVDB's 32-bit-safe upper, lower and leaf reads go
+// on from the tile's upper node. PNanoVDB's own root walk (pnanovdb_root_find_tile) compares 64-bit
+// keys made of two 32-bit words, and NVIDIA's GLSL compiler (driver 580.159.04, H200, seen 2026-12-04)
+// computed the key's high word as 3 where it is 0, so the walk found no tile and every read was the
+// background; llvmpipe computed it right. No read here goes through that walk
+// (tests/sdf/sparse_field_test.cpp, tests/gpu/shader_audit.py). No search loop either: each read is
+// inlined, and llvmpipe's compile time follows what the reads inline.
+layout(std430, binding = TS_FIELD_ROOTS) readonly buffer FieldRootTable { FieldRootTile field_roots[]; };
+
+// One accessor per invocation: it caches the last leaf, lower and upper node, so neighbouring reads
+// skip the tree walk, and a read in the cached upper node skips the root table too.
 struct FieldReader {
   pnanovdb_readaccessor_t accessor;
 };
 
-// NanoVDB coordinates of the root tile at (0, 0, 0), where sdf::gpu_index_shift puts every band voxel
-// of a grid under 3968 voxels a side.
-bool field_in_first_root_tile(ivec3 ijk) {
-  return all(greaterThanEqual(ijk, ivec3(0))) && all(lessThan(ijk, ivec3(4096)));
+// The entry of the root tile holding NanoVDB coordinate `ijk`, or -1 off the table's box.
+int field_root_find(ivec3 ijk) {
+  // >> of a signed int extends the sign (GLSL 4.50, 5.9): the tile index rounds negative coordinates down.
+  ivec3 rel = (ijk >> 12) - field_params.root_first.xyz;
+  ivec3 extent = ivec3(field_params.roots.xyz);
+  if (any(lessThan(rel, ivec3(0))) || any(greaterThanEqual(rel, extent))) return -1;
+  return (rel.x * extent.y + rel.y) * extent.z + rel.z;  // no overflow: the host caps the box's size
 }
 
-// Caches the upper node of the root tile at (0, 0, 0) in the accessor, so that reads in that tile
-// never walk the root. Why: NVIDIA's GLSL compiler (driver 580.159.04, seen 2026-12-04 by
-// tests/sdf/sparse_field_test.cpp on an H200) gives the high word of PNanoVDB's root key
-// (pnanovdb_coord_to_key) as 3 where it is 0, so the root walk found no tile and every read was the
-// background; llvmpipe computes it right. The accessor's own cache test (ijk ^ key above bit 12) keeps
-// the node for every coordinate of the tile. Without such a tile (an empty grid) nothing is cached.
-void field_prime(inout FieldReader reader) {
-  pnanovdb_buf_t buf;
-  pnanovdb_root_handle_t root = reader.accessor.root;
-  uint tiles = pnanovdb_root_get_tile_count(buf, root);
-  pnanovdb_root_tile_handle_t tile = pnanovdb_root_get_tile_zero(PNANOVDB_GRID_TYPE_FLOAT, root);
-  for (uint t = 0u; t < tiles; ++t) {
-    pnanovdb_uint64_t key = pnanovdb_root_tile_get_key(buf, tile);
-    if (key.x == 0u && key.y == 0u && !pnanovdb_int64_is_zero(pnanovdb_root_tile_get_child(buf, tile))) {
-      reader.accessor.upper = pnanovdb_root_get_child(PNANOVDB_GRID_TYPE_FLOAT, buf, root, tile);
-      reader.accessor.key = ivec3(0);
-      return;
-    }
-    tile.address = pnanovdb_address_offset(tile.address, PNANOVDB_GRID_TYPE_GET(PNANOVDB_GRID_TYPE_FLOAT, root_tile_size));
+// The root step of a read at `ijk` that missed the accessor's cached nodes: finds the root tile in the
+// table and, where it has an upper node, caches that in the accessor (as PNanoVDB's root step does) and
+// returns true; else returns false with `address` at the tile's value or the root's background.
+bool field_root_step(inout pnanovdb_readaccessor_t acc, ivec3 ijk, out pnanovdb_address_t address) {
+  int t = field_root_find(ijk);
+  address.byte_offset = t < 0 ? field_params.roots.w : field_roots[t].address.y;
+  if (t < 0 || field_roots[t].address.x == 0u) return false;
+  acc.upper.address.byte_offset = field_roots[t].address.x;
+  acc.key = ijk;
+  return true;
+}
+
+// The byte address of the value at `ijk`: PNanoVDB's accessor read (pnanovdb_readaccessor_get_value_address)
+// with its root step replaced by the root table. One exit and one inlined upper-node read: llvmpipe's
+// compile time follows the inlined code, and a kernel inlines this once per voxel read.
+pnanovdb_address_t field_value_address(inout pnanovdb_readaccessor_t acc, ivec3 ijk) {
+  pnanovdb_buf_t buf = pnanovdb_buf_t(0u);  // unused by the reads (they read the bound blocks): set, so nothing reads an undefined value
+  int dirty = pnanovdb_readaccessor_computedirty(acc, ijk);
+  pnanovdb_address_t address;
+  if (pnanovdb_readaccessor_iscached0(acc, dirty)) {
+    address = pnanovdb_leaf_get_value_address_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.leaf, ijk, acc);
+  } else if (pnanovdb_readaccessor_iscached1(acc, dirty)) {
+    address = pnanovdb_lower_get_value_address_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.lower, ijk, acc);
+  } else if (pnanovdb_readaccessor_iscached2(acc, dirty) || field_root_step(acc, ijk, address)) {
+    address = pnanovdb_upper_get_value_address_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.upper, ijk, acc);
   }
+  return address;
 }
 
-// A read outside the first root tile drops the accessor's cached upper node: cache it again.
-void field_keep_primed(inout FieldReader reader) {
-  if (pnanovdb_address_is_null(reader.accessor.upper.address)) field_prime(reader);
+// The edge of the node or tile holding `ijk` [voxels] (1 in a leaf): pnanovdb_readaccessor_get_dim
+// with the root table, for NanoVDB's hierarchical DDA (preview/raycast.frag).
+uint field_dim(inout pnanovdb_readaccessor_t acc, ivec3 ijk) {
+  pnanovdb_buf_t buf = pnanovdb_buf_t(0u);  // unused by the reads (they read the bound blocks): set, so nothing reads an undefined value
+  int dirty = pnanovdb_readaccessor_computedirty(acc, ijk);
+  pnanovdb_address_t unused;
+  uint dim = 4096u;  // the root's background or a tile value: a root tile's edge
+  if (pnanovdb_readaccessor_iscached0(acc, dirty)) {
+    dim = 1u;
+  } else if (pnanovdb_readaccessor_iscached1(acc, dirty)) {
+    dim = pnanovdb_lower_get_dim_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.lower, ijk, acc);
+  } else if (pnanovdb_readaccessor_iscached2(acc, dirty) || field_root_step(acc, ijk, unused)) {
+    dim = pnanovdb_upper_get_dim_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.upper, ijk, acc);
+  }
+  return dim;
+}
+
+// Whether the value at `ijk` is active (a band voxel): pnanovdb_readaccessor_is_active with the root table.
+bool field_is_active(inout pnanovdb_readaccessor_t acc, ivec3 ijk) {
+  pnanovdb_buf_t buf = pnanovdb_buf_t(0u);  // unused by the reads (they read the bound blocks): set, so nothing reads an undefined value
+  int dirty = pnanovdb_readaccessor_computedirty(acc, ijk);
+  pnanovdb_address_t unused;
+  bool is_active;
+  if (pnanovdb_readaccessor_iscached0(acc, dirty)) {
+    is_active = pnanovdb_leaf_is_active_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.leaf, ijk, acc);
+  } else if (pnanovdb_readaccessor_iscached1(acc, dirty)) {
+    is_active = pnanovdb_lower_is_active_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.lower, ijk, acc);
+  } else if (pnanovdb_readaccessor_iscached2(acc, dirty) || field_root_step(acc, ijk, unused)) {
+    is_active = pnanovdb_upper_is_active_and_cache(PNANOVDB_GRID_TYPE_FLOAT, buf, acc.upper, ijk, acc);
+  } else {
+    int t = field_root_find(ijk);  // a root tile's state; off the box: the background, inactive
+    is_active = t >= 0 && field_roots[t].origin.w != 0;
+  }
+  return is_active;
 }
 
 FieldReader field_reader() {
-  pnanovdb_buf_t buf;
+  pnanovdb_buf_t buf = pnanovdb_buf_t(0u);  // unused by the reads (they read the bound blocks): set, so nothing reads an undefined value
   pnanovdb_grid_handle_t grid;
   grid.address.byte_offset = 0u;
   pnanovdb_root_handle_t root = pnanovdb_tree_get_root(buf, pnanovdb_grid_get_tree(buf, grid));
   FieldReader reader;
-  pnanovdb_readaccessor_init(reader.accessor, root);
-  field_prime(reader);
+  pnanovdb_readaccessor_init(reader.accessor, root);  // the root handle: for its bounding box only
   return reader;
 }
 
 // The value of grid voxel `g` (grid-local integer coordinates) [world units]; off the band the
-// background's +-value (tiles and inactive voxels keep the flood fill's sign). The read goes through a
-// copy of the accessor, kept only for coordinates in the first root tile: a read outside it (grids of
-// 3968 voxels a side or more, or probes off the grid) walks the root without dropping the primed node.
-// One PNanoVDB call per read: each call is inlined, and llvmpipe's compile time follows the count.
+// background's +-value (tiles and inactive voxels keep the flood fill's sign).
+// One read per call: each call is inlined, and llvmpipe's compile time follows the count.
 float field_voxel(inout FieldReader reader, ivec3 g) {
-  pnanovdb_buf_t buf;
-  pnanovdb_coord_t ijk = g + field_params.index_offset.xyz;
-  pnanovdb_readaccessor_t walker = reader.accessor;
-  pnanovdb_address_t address = pnanovdb_readaccessor_get_value_address(PNANOVDB_GRID_TYPE_FLOAT, buf, walker, ijk);
-  if (field_in_first_root_tile(ijk)) reader.accessor = walker;
-  return pnanovdb_read_float(buf, address);
+  pnanovdb_buf_t buf = pnanovdb_buf_t(0u);  // unused by the reads (they read the bound blocks): set, so nothing reads an undefined value
+  return pnanovdb_read_float(buf, field_value_address(reader.accessor, g + field_params.index_offset.xyz));
 }
 
 // Trilinear interpolation at grid-local position `x` [voxels], the same weights in the same order
@@ -160,7 +209,8 @@ float field_trilinear(inout FieldReader reader, vec3 x) {
   // so the read, with its chunk branch, is inlined once instead of 8 times: llvmpipe compiled the
   // unrolled form of the gradient's 56 reads for minutes. Same reads, same order, same weights.
   float corner[8];
-  for (int n = 0; n < field_params.index_offset.w; ++n) corner[n] = field_voxel(reader, g + ivec3(n & 1, (n >> 1) & 1, n >> 2));
+  // `n & 7`: the array's range whatever the uniform holds (an index past it is undefined in GLSL).
+  for (int n = 0; n < field_params.index_offset.w; ++n) corner[n & 7] = field_voxel(reader, g + ivec3(n & 1, (n >> 1) & 1, (n >> 2) & 1));
   float c000 = corner[0], c100 = corner[1], c010 = corner[2], c110 = corner[3];
   float c001 = corner[4], c101 = corner[5], c011 = corner[6], c111 = corner[7];
 #else

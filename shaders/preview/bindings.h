@@ -4,9 +4,9 @@
 //   particles (particles.vert + particles.frag; shadow map and G-buffer):
 //     buffers TS_PREVIEW_SPHERES, TS_PREVIEW_COLORS
 //   ray cast (raycast.vert + raycast.frag; shadow map and G-buffer):
-//     buffer TS_PREVIEW_SPARSE_FIELD, unit TS_PREVIEW_UNIT_PARTICLE_DEPTH
+//     buffers TS_PREVIEW_SPARSE_FIELD, TS_PREVIEW_FIELD_ROOTS, unit TS_PREVIEW_UNIT_PARTICLE_DEPTH
 //   shade (shade.vert + shade.frag; the lighting pass):
-//     buffer TS_PREVIEW_SPARSE_FIELD, units TS_PREVIEW_UNIT_ALBEDO, TS_PREVIEW_UNIT_NORMAL, TS_PREVIEW_UNIT_DEPTH,
+//     buffers TS_PREVIEW_SPARSE_FIELD, TS_PREVIEW_FIELD_ROOTS, units TS_PREVIEW_UNIT_ALBEDO, TS_PREVIEW_UNIT_NORMAL, TS_PREVIEW_UNIT_DEPTH,
 //     TS_PREVIEW_UNIT_SHADOW
 //
 // The buffers sit at 27 and up because the simulator's kernels use bindings 0-26
@@ -35,6 +35,7 @@
 #define TS_PREVIEW_FIELD_CHUNK_5 34
 #define TS_PREVIEW_FIELD_CHUNK_6 35
 #define TS_PREVIEW_FIELD_CHUNK_7 36
+#define TS_PREVIEW_FIELD_ROOTS 37  // FieldRootTile[]: the field's root table (sdf::SparseField, common/sparse_field.glsl)
 
 #define TS_PREVIEW_UNIT_PARTICLE_DEPTH 1  // sampler2D: window depth of the particle layer
 #define TS_PREVIEW_UNIT_ALBEDO 2          // sampler2D: G-buffer albedo (sRGB)

@@ -57,7 +57,7 @@ bool trace_window(vec3 o, vec3 dir, float t, float t_end, out float t_hit) {
 const float kNearSurface = 1.6;  // [voxels]
 bool find_surface(vec3 o, vec3 dir, float t, float t_exit, out float t_hit) {
   ensure_volume_reader();
-  pnanovdb_buf_t buf;
+  pnanovdb_buf_t buf = pnanovdb_buf_t(0u);  // unused by the reads: set, so nothing reads an undefined value
   t_hit = t;
   pnanovdb_vec3_t origin = o + vec3(field_params.index_offset.xyz) + vec3(0.5);
   pnanovdb_vec3_t direction = dir;
@@ -70,23 +70,20 @@ bool find_surface(vec3 o, vec3 dir, float t, float t_exit, out float t_hit) {
   float traced_to = t_min;  // the field has no crossing before here
   pnanovdb_vec3_t pos = pnanovdb_hdda_ray_start(origin, t_min, direction);
   pnanovdb_coord_t ijk = pnanovdb_hdda_pos_to_ijk(pos);
-  field_keep_primed(volume_reader);  // (common/sparse_field.glsl: the root walk is what NVIDIA miscompiles)
-  int dim = int(pnanovdb_readaccessor_get_dim(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk));
+  int dim = int(field_dim(volume_reader.accessor, ijk));
   pnanovdb_hdda_t hdda;
   pnanovdb_hdda_init(hdda, origin, t_min, direction, t_max, dim);
   while (pnanovdb_hdda_step(hdda)) {
     pnanovdb_vec3_t next = pnanovdb_hdda_ray_start(origin, hdda.tmin + 1.0001, direction);
     ijk = pnanovdb_hdda_pos_to_ijk(next);
-    field_keep_primed(volume_reader);
-    dim = int(pnanovdb_readaccessor_get_dim(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk));
+    dim = int(field_dim(volume_reader.accessor, ijk));
     pnanovdb_hdda_update(hdda, origin, direction, dim);
-    if (hdda.dim > 1 || !pnanovdb_readaccessor_is_active(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, ijk)) {
+    if (hdda.dim > 1 || !field_is_active(volume_reader.accessor, ijk)) {
       continue;
     }
     while (pnanovdb_hdda_step(hdda) &&
-           pnanovdb_readaccessor_is_active(PNANOVDB_GRID_TYPE_FLOAT, buf, volume_reader.accessor, hdda.voxel)) {
-      pnanovdb_address_t address = pnanovdb_readaccessor_get_value_address(PNANOVDB_GRID_TYPE_FLOAT, buf,
-                                                                           volume_reader.accessor, hdda.voxel);
+           field_is_active(volume_reader.accessor, hdda.voxel)) {
+      pnanovdb_address_t address = field_value_address(volume_reader.accessor, hdda.voxel);
       float value = pnanovdb_read_float(buf, address);
       float t_end = min(hdda.tmin + 2.0, t_exit);
       if (value < near_surface && t_end > traced_to) {

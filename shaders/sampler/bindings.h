@@ -5,9 +5,9 @@
 //   pass (kernel)               slots
 //   common/grid_* (the grid)    TS_GRID_POSITIONS = TS_SAMPLER_POSITIONS_IN, TS_SORT_* (1-5)
 //   sampler/relax.comp          POSITIONS_IN, POSITIONS_OUT, VELOCITIES, STEP_INFO, TS_GRID_CELL_COUNT,
-//                               TS_GRID_CELL_START, TS_GRID_SORTED, SPARSE_FIELD
+//                               TS_GRID_CELL_START, TS_GRID_SORTED, SPARSE_FIELD, FIELD_ROOTS
 //   sampler/reduce_steps.comp   STEP_INFO, PARTIALS
-//   sampler/project.comp        POSITIONS, SPARSE_FIELD
+//   sampler/project.comp        POSITIONS, SPARSE_FIELD, FIELD_ROOTS
 //   common/grid_* for the certificate: TS_GRID_POSITIONS = TS_CERT_CENTRES, TS_SORT_* (1-5)
 //   sampler/certify_evaluate.comp  CERT_CENTRES, CERT_TRIANGLES, CERT_QUEUE, TS_GRID_CELL_COUNT,
 //                               TS_GRID_CELL_START, TS_GRID_SORTED, CERT_SPLITS, CERT_UNCOVERED,
@@ -53,5 +53,6 @@
 #define TS_SAMPLER_FIELD_CHUNK_5 13
 #define TS_SAMPLER_FIELD_CHUNK_6 14
 #define TS_SAMPLER_FIELD_CHUNK_7 15
+#define TS_SAMPLER_FIELD_ROOTS 16  // FieldRootTile[]: the field's root table (sdf::SparseField, common/sparse_field.glsl)
 
 #endif

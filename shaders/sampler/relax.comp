@@ -46,6 +46,7 @@ vec3 repulsion_at(uint i, vec3 p) {
         uint h = hash_cell(c + ivec3(dx, dy, dz), params.sizes.y);
         // Two neighbour cells may share a hash bucket: visit each bucket once.
         bool seen = false;
+        // ts-audit: allow uninitialised-read (only entries below visited_count, each written before)
         for (int v = 0; v < visited_count; ++v) seen = seen || visited[v] == h;
         if (seen) continue;
         visited[visited_count++] = h;

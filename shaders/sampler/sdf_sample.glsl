@@ -8,6 +8,8 @@
 layout(std430, binding = TS_SAMPLER_SPARSE_FIELD) readonly buffer SparseField { uint pnanovdb_buf_data[]; };
 // The field's parameter block at this stage's slot.
 #define TS_FIELD_PARAMS TS_SAMPLER_FIELD_PARAMS
+// The field's root table (FieldRootTile[]) at this stage's slot.
+#define TS_FIELD_ROOTS TS_SAMPLER_FIELD_ROOTS
 // Chunks 1-7 of a field larger than one storage block, at this stage's slots.
 #define TS_FIELD_CHUNK_1 TS_SAMPLER_FIELD_CHUNK_1
 #define TS_FIELD_CHUNK_2 TS_SAMPLER_FIELD_CHUNK_2

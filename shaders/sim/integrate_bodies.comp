@@ -33,7 +33,7 @@ layout(std140, binding = TS_SIM_PARAMS) uniform IntegrateBlock { SimIntegratePar
 void main() {
   uint b = dispatch_item();
   if (b >= params.sizes.x) return;
-  uint motion = uint(body_velocity[b].w);
+  uint motion = uint(max(body_velocity[b].w, 0.0));  // a motion type (0-2); clamped: a negative float to uint is undefined
   if (motion == TS_MOTION_STATIC) return;
   real h = params.gravity_dt.w;
   real4 q = body_orientation[b];

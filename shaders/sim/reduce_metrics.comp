@@ -20,7 +20,7 @@ void main() {
   uint b = dispatch_item(), t = gl_LocalInvocationID.x;
   if (dispatch_group() * gl_WorkGroupSize.x >= params.sizes.x) return;  // past the end: no partial
   dvec4 e = dvec4(0.0);
-  if (b < params.sizes.x && uint(body_velocity[b].w) == TS_MOTION_DYNAMIC) {
+  if (b < params.sizes.x && uint(max(body_velocity[b].w, 0.0)) == TS_MOTION_DYNAMIC) {
     double m = 1.0 / double(body_position[b].w);
     dvec3 v = dvec3(body_velocity[b].xyz);
     e.x = 0.5 * m * dot(v, v);

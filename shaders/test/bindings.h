@@ -1,7 +1,7 @@
 // Binding slots of the test kernels (tests/gpu/), named once for GLSL and the tests.
 //   test/saxpy.comp          TS_TEST_SAXPY_X, TS_TEST_SAXPY_Y
 //   test/layout_probe.comp   TS_TEST_PROBE_* (one block per shared layout; the tests read offsets back)
-//   test/sparse_field_probe.comp  TS_TEST_FIELD_GRID, TS_TEST_FIELD_POINTS, TS_TEST_FIELD_VALUES
+//   test/sparse_field_probe.comp  TS_TEST_FIELD_GRID, TS_TEST_FIELD_POINTS, TS_TEST_FIELD_VALUES, TS_TEST_FIELD_ROOTS
 #ifndef TETRASAND_TEST_BINDINGS_H
 #define TETRASAND_TEST_BINDINGS_H
 
@@ -24,6 +24,7 @@
 #define TS_TEST_PROBE_SIM_SPRINGS64 7
 #define TS_TEST_PROBE_CERT_TRIANGLES 8
 #define TS_TEST_PROBE_CERT_LEAVES 9
+#define TS_TEST_PROBE_FIELD_ROOTS 10
 
 #define TS_TEST_FIELD_GRID 0    // uint[]: an sdf::SparseField's NanoVDB grid
 #define TS_TEST_FIELD_POINTS 1  // vec4: xyz grid-local position [voxels]
@@ -36,5 +37,6 @@
 #define TS_TEST_FIELD_CHUNK_5 7
 #define TS_TEST_FIELD_CHUNK_6 8
 #define TS_TEST_FIELD_CHUNK_7 9
+#define TS_TEST_FIELD_ROOTS 10  // FieldRootTile[]: the field's root table (sdf::SparseField)
 
 #endif

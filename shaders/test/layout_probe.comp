@@ -14,6 +14,7 @@ layout(std430, binding = TS_TEST_PROBE_SIM_SPRINGS) buffer SimSprings { SimSprin
 layout(std430, binding = TS_TEST_PROBE_SIM_SPRINGS64) buffer SimSprings64 { SimSpringSlots64 sim_springs64[]; };
 layout(std430, binding = TS_TEST_PROBE_CERT_TRIANGLES) buffer CertTriangles { CertTriangle cert_triangles[]; };
 layout(std430, binding = TS_TEST_PROBE_CERT_LEAVES) buffer CertLeaves { CertLeaf cert_leaves[]; };
+layout(std430, binding = TS_TEST_PROBE_FIELD_ROOTS) buffer FieldRoots { FieldRootTile field_roots[]; };
 void main() {
   // Touch each block so no compiler drops it.
   sdf_triangles[0].face_normal.w += 1.0;
@@ -26,4 +27,5 @@ void main() {
   sim_springs64[0].displacement[0].w += 1.0;
   cert_triangles[0].edge2.w += 1.0;
   cert_leaves[0].bounds.w += 1.0;
+  field_roots[0].address.w += 1u;
 }

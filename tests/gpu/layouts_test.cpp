@@ -53,6 +53,12 @@ TEST_F(GpuLayouts, SdfPrismMatchesCpp) {
   EXPECT_EQ(query(probe, "sdf_prisms[0].normal_margin").offset, static_cast<GLint>(offsetof(SdfPrism, normal_margin)));
 }
 
+TEST_F(GpuLayouts, FieldRootTileMatchesCpp) {
+  using layout::FieldRootTile;
+  EXPECT_EQ(query(probe, "field_roots[0].origin").top_level_stride, static_cast<GLint>(sizeof(FieldRootTile)));
+  EXPECT_EQ(query(probe, "field_roots[0].address").offset, static_cast<GLint>(offsetof(FieldRootTile, address)));
+}
+
 TEST_F(GpuLayouts, SamplerGridMatchesCpp) {
   using layout::SamplerGrid;
   EXPECT_EQ(query(probe, "sampler_grids[0].origin_cell").top_level_stride, static_cast<GLint>(sizeof(SamplerGrid)));

@@ -41,7 +41,8 @@ BlockSpec grid(const std::string& block) {
 BlockSpec field() {
   return {"FieldBlock",
           sizeof(FieldParams),
-          {TS_MEMBER(field_params, FieldParams, index_offset), TS_MEMBER(field_params, FieldParams, scale)}};
+          {TS_MEMBER(field_params, FieldParams, index_offset), TS_MEMBER(field_params, FieldParams, scale),
+           TS_MEMBER(field_params, FieldParams, root_first), TS_MEMBER(field_params, FieldParams, roots)}};
 }
 BlockSpec camera() {
   return {"CameraBlock",

@@ -55,7 +55,7 @@ struct Scene {
 
   sdf::HostField host_field() const { return sdf::HostField(sdf::to_nanovdb(*level_set), spec, kBandVoxels); }
   sdf::SparseField gpu_field() const {
-    return sdf::SparseField(sdf::to_gpu_nanovdb(*level_set, spec), spec, kBandVoxels);
+    return sdf::SparseField(sdf::to_nanovdb(*level_set), spec, kBandVoxels);
   }
 };
 

@@ -132,7 +132,7 @@ TEST_F(Relaxer, AFieldCutIntoChunksRelaxesBitwiseAsOneBlock) {
   auto field = sdf::scan_convert(context, sphere, sdf::compute_pseudonormals(sphere), spec, options);
   sdf::SparseField whole_field(*field.grid, spec, options.band);
   const std::size_t bytes = whole_field.gpu_bytes();
-  sdf::SparseField chunked_field(sdf::to_gpu_nanovdb(*field.grid, spec), spec, options.band, bytes / 3);
+  sdf::SparseField chunked_field(sdf::to_nanovdb(*field.grid), spec, options.band, bytes / 3);
   ASSERT_EQ(whole_field.chunk_count(), 1);
   ASSERT_GE(chunked_field.chunk_count(), 3);
   GpuRelaxer whole(context, std::move(whole_field));

@@ -6,13 +6,16 @@
 #include <gtest/gtest.h>
 
 #include <nanovdb/util/IO.h>
+#include <openvdb/tools/Composite.h>
 #include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/LevelSetSphere.h>
 
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <array>
 #include <random>
+#include <set>
 
 #include "core/error.h"
 #include "core/primitives.h"
@@ -31,6 +34,29 @@ namespace {
 
 using test::grid_around;
 
+// Runs the probe kernel (shaders/test/sparse_field_probe.comp) at grid-local `points`.
+std::vector<Eigen::Vector4f> probe_field(const SparseField& field, const std::vector<Eigen::Vector4f>& points, int mode) {
+  gpu::ShaderLibrary library;
+  std::vector<std::string> defines = field.shader_defines();
+  defines.push_back("TS_PROBE_MODE " + std::to_string(mode));
+  gpu::Program program = gpu::Program::compute(library, "test/sparse_field_probe.comp", defines);
+  gpu::Buffer in = gpu::Buffer::from<Eigen::Vector4f>(points);
+  gpu::Buffer out(points.size() * sizeof(Eigen::Vector4f));
+  field.bind({TS_TEST_FIELD_GRID,
+              {TS_TEST_FIELD_CHUNK_1, TS_TEST_FIELD_CHUNK_2, TS_TEST_FIELD_CHUNK_3, TS_TEST_FIELD_CHUNK_4,
+               TS_TEST_FIELD_CHUNK_5, TS_TEST_FIELD_CHUNK_6, TS_TEST_FIELD_CHUNK_7},
+              TS_TEST_FIELD_PARAMS, TS_TEST_FIELD_ROOTS});
+  in.bind(TS_TEST_FIELD_POINTS);
+  out.bind(TS_TEST_FIELD_VALUES);
+  gpu::ParamBlock<gpu::params::FieldProbeParams> params;
+  params.values.count.x = static_cast<unsigned>(points.size());
+  params.values.mode.x = mode;
+  params.bind(TS_TEST_PARAMS);
+  gpu::Queue queue(false, true);
+  queue.dispatch_items(program, points.size(), GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  return out.read<Eigen::Vector4f>(points.size());
+}
+
 class SparseFieldTest : public ::testing::Test {
  protected:
   // The torus has an inside off the band (the tube's core) and an outside the band encloses in the
@@ -46,27 +72,23 @@ class SparseFieldTest : public ::testing::Test {
     result_ = scan_convert(context_, torus_, compute_pseudonormals(torus_), spec_, options);
   }
 
-  // Runs the probe kernel (shaders/test/sparse_field_probe.comp) at grid-local `points`.
   std::vector<Eigen::Vector4f> probe(const SparseField& field, const std::vector<Eigen::Vector4f>& points, int mode) {
-    gpu::ShaderLibrary library;
-    std::vector<std::string> defines = field.shader_defines();
-    defines.push_back("TS_PROBE_MODE " + std::to_string(mode));
-    gpu::Program program = gpu::Program::compute(library, "test/sparse_field_probe.comp", defines);
-    gpu::Buffer in = gpu::Buffer::from<Eigen::Vector4f>(points);
-    gpu::Buffer out(points.size() * sizeof(Eigen::Vector4f));
-    field.bind({TS_TEST_FIELD_GRID,
-                {TS_TEST_FIELD_CHUNK_1, TS_TEST_FIELD_CHUNK_2, TS_TEST_FIELD_CHUNK_3, TS_TEST_FIELD_CHUNK_4,
-                 TS_TEST_FIELD_CHUNK_5, TS_TEST_FIELD_CHUNK_6, TS_TEST_FIELD_CHUNK_7},
-                TS_TEST_FIELD_PARAMS});
-    in.bind(TS_TEST_FIELD_POINTS);
-    out.bind(TS_TEST_FIELD_VALUES);
-    gpu::ParamBlock<gpu::params::FieldProbeParams> params;
-    params.values.count.x = static_cast<unsigned>(points.size());
-    params.values.mode.x = mode;
-    params.bind(TS_TEST_PARAMS);
-    gpu::Queue queue(false, true);
-    queue.dispatch_items(program, points.size(), GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    return out.read<Eigen::Vector4f>(points.size());
+    return probe_field(field, points, mode);
+  }
+
+  // Band voxels of the torus at random, grid-local.
+  std::vector<Eigen::Vector4f> random_band_voxels(std::size_t count) {
+    std::vector<Eigen::Vector4f> points;
+    std::mt19937_64 rng(11);
+    std::uniform_int_distribution<int> ux(0, spec_.dims.x() - 1), uy(0, spec_.dims.y() - 1), uz(0, spec_.dims.z() - 1);
+    auto accessor = result_.grid->getConstAccessor();
+    while (points.size() < count) {
+      const Eigen::Vector3i g(ux(rng), uy(rng), uz(rng));
+      const Eigen::Vector3i ijk = g + spec_.index_offset;
+      if (!accessor.isValueOn(openvdb::Coord(ijk.x(), ijk.y(), ijk.z()))) continue;
+      points.emplace_back(g.x(), g.y(), g.z(), 0.0f);
+    }
+    return points;
   }
 
   gpu::Context context_;
@@ -105,7 +127,7 @@ TEST_F(SparseFieldTest, AFieldCutIntoChunksReadsEveryVoxelBitForBitAsOneBlock) {
   ASSERT_EQ(whole.chunk_count(), 1);
   EXPECT_TRUE(whole.shader_defines().empty());  // one block: the kernels compile as they always did
   const std::size_t bytes = whole.gpu_bytes();
-  const SparseField chunked(to_gpu_nanovdb(*result_.grid, spec_), spec_, 3.0, bytes / 3);
+  const SparseField chunked(to_nanovdb(*result_.grid), spec_, 3.0, bytes / 3);
   EXPECT_GE(chunked.chunk_count(), 4);
   EXPECT_LE(chunked.chunk_count(), 6);
   EXPECT_EQ(chunked.gpu_bytes(), bytes);
@@ -127,7 +149,7 @@ TEST_F(SparseFieldTest, AFieldCutIntoChunksReadsEveryVoxelBitForBitAsOneBlock) {
 // (one inlined read; unrolled, llvmpipe compiled the gradient's 56 reads with the chunk branch for 14 min).
 TEST_F(SparseFieldTest, AFieldCutIntoChunksInterpolatesBitForBitAsOneBlock) {
   const SparseField whole(*result_.grid, spec_, 3.0);
-  const SparseField chunked(to_gpu_nanovdb(*result_.grid, spec_), spec_, 3.0, whole.gpu_bytes() / 3);
+  const SparseField chunked(to_nanovdb(*result_.grid), spec_, 3.0, whole.gpu_bytes() / 3);
   ASSERT_GE(chunked.chunk_count(), 4);
   std::vector<Eigen::Vector4f> between;
   std::mt19937 rng(7);
@@ -147,9 +169,9 @@ TEST_F(SparseFieldTest, AFieldCutIntoChunksInterpolatesBitForBitAsOneBlock) {
 }
 
 TEST_F(SparseFieldTest, AFieldNeedingMoreThanEightChunksIsRefusedWithTheResolutionThatFits) {
-  const std::size_t bytes = to_gpu_nanovdb(*result_.grid, spec_).size();
+  const std::size_t bytes = to_nanovdb(*result_.grid).size();
   try {
-    const SparseField field(to_gpu_nanovdb(*result_.grid, spec_), spec_, 3.0, bytes / 12);
+    const SparseField field(to_nanovdb(*result_.grid), spec_, 3.0, bytes / 12);
     FAIL() << "a grid of " << bytes << " bytes was cut into " << field.chunk_count() << " chunks";
   } catch (const GpuError& e) {
     const std::string message = e.what();
@@ -158,12 +180,57 @@ TEST_F(SparseFieldTest, AFieldNeedingMoreThanEightChunksIsRefusedWithTheResoluti
   }
 }
 
-// PNanoVDB's tree walk in GLSL, step by step against the host's NanoVDB grid: the root's offset and
-// tile count, the root key of a voxel, the root tile that holds it and the value's address. When a
-// driver reads the field wrong (every voxel the background), this says at which step the walk parts.
-// On NVIDIA's driver 580.159.04 (H200, 2026-12-04) it fails at the key's high word (3 for 0): the
-// driver's miscompile, which the next test shows the reads no longer depend on.
-TEST_F(SparseFieldTest, GlslWalksTheTreeAsTheHostGridIsLaidOut) {
+std::array<std::uint32_t, 4> bits(const Eigen::Vector4f& v) {
+  std::array<std::uint32_t, 4> u{};
+  std::memcpy(u.data(), v.data(), sizeof(u));
+  return u;
+}
+
+// The GLSL reader's root step against the host's NanoVDB grid: the root table's entry of a voxel (its
+// tile's origin, in any of the torus's root tiles, at negative indices too) and the value's address it
+// leads to. When a driver reads the field wrong, this says whether the root step or the nodes below part.
+TEST_F(SparseFieldTest, GlslFindsEachVoxelsRootTileInTheTableAsTheHostGridIsLaidOut) {
+  const SparseField field(*result_.grid, spec_, 3.0);
+  const nanovdb::FloatGrid* nano = field.host().grid<float>();
+  ASSERT_NE(nano, nullptr);
+  const auto& table = field.root_table().entries;
+  EXPECT_EQ(table.size(), gpu_root_table(*nano).entries.size());
+  // The torus straddles index 0 on every axis: its band lies in 8 root tiles, half at negative origins.
+  ASSERT_EQ(table.size(), 8u);
+  EXPECT_EQ(field.root_table().first_tile, Eigen::Vector3i::Constant(-1));
+  EXPECT_EQ(table.front().origin.x, -4096);
+  const auto offset_of = [&](const void* p) {
+    return static_cast<std::uint32_t>(static_cast<const char*>(p) - reinterpret_cast<const char*>(nano));
+  };
+  const auto points = random_band_voxels(256);
+  const auto found = probe(field, points, 4);
+  std::set<int> entries;
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    const Eigen::Vector3i ijk = points[p].head<3>().cast<int>() + spec_.index_offset;
+    const nanovdb::Coord coord(ijk.x(), ijk.y(), ijk.z());
+    const auto f = bits(found[p]);
+    SCOPED_TRACE(::testing::Message() << "voxel " << ijk.transpose());
+    const auto entry = static_cast<std::int32_t>(f[3]);
+    ASSERT_GE(entry, 0) << "no root tile found";
+    ASSERT_LT(entry, static_cast<std::int32_t>(table.size()));
+    const nanovdb::Coord origin = coord & ~4095;
+    EXPECT_EQ(nanovdb::Coord(table[entry].origin.x, table[entry].origin.y, table[entry].origin.z), origin);
+    entries.insert(entry);
+    const auto* leaf = nano->tree().root().probeLeaf(coord);
+    ASSERT_NE(leaf, nullptr);
+    const float* value = &leaf->data()->mValues[nanovdb::FloatGrid::TreeType::LeafNodeType::CoordToOffset(coord)];
+    EXPECT_EQ(f[1], offset_of(value)) << "value address";
+    if (::testing::Test::HasFailure()) break;  // one voxel's trace says where the reads part
+  }
+  EXPECT_EQ(entries.size(), table.size());  // every tile of the table was found by some voxel
+}
+
+// PNanoVDB's own root walk in GLSL, step by step against the host's NanoVDB grid: the root's offset and
+// tile count, the 64-bit root key of a voxel (two 32-bit words) and the root tile the walk finds. The
+// reader no longer takes this path (ReadsNeverDependOnPnanovdbsRootWalk); the test stays to show a
+// driver's fault where one is: on NVIDIA's driver 580.159.04 (H200, 2026-12-04) the key's high word
+// came out 3 for 0, so this test fails there while every read test passes.
+TEST_F(SparseFieldTest, PnanovdbsRootKeyAndWalkMatchTheHostGrid) {
   const SparseField field(*result_.grid, spec_, 3.0);
   const nanovdb::FloatGrid* nano = field.host().grid<float>();
   ASSERT_NE(nano, nullptr);
@@ -172,27 +239,11 @@ TEST_F(SparseFieldTest, GlslWalksTheTreeAsTheHostGridIsLaidOut) {
   const auto offset_of = [&](const void* p) {
     return static_cast<std::uint32_t>(static_cast<const char*>(p) - reinterpret_cast<const char*>(nano));
   };
-  std::vector<Eigen::Vector4f> points;
-  std::mt19937_64 rng(11);
-  std::uniform_int_distribution<int> ux(0, spec_.dims.x() - 1), uy(0, spec_.dims.y() - 1), uz(0, spec_.dims.z() - 1);
-  auto accessor = result_.grid->getConstAccessor();
-  while (points.size() < 64) {
-    const Eigen::Vector3i g(ux(rng), uy(rng), uz(rng));
-    const Eigen::Vector3i ijk = g + spec_.index_offset;
-    if (!accessor.isValueOn(openvdb::Coord(ijk.x(), ijk.y(), ijk.z()))) continue;  // band voxels only
-    points.emplace_back(g.x(), g.y(), g.z(), 0.0f);
-  }
-  const auto bits = [](const Eigen::Vector4f& v) {
-    std::array<std::uint32_t, 4> u{};
-    std::memcpy(u.data(), v.data(), sizeof(u));
-    return u;
-  };
+  const auto points = random_band_voxels(64);
   const auto walk = probe(field, points, 3);
   const auto found = probe(field, points, 4);
-  ASSERT_FALSE(gpu_index_shift(spec_).isZero());  // the torus's grid starts at negative indices: moved
   for (std::size_t p = 0; p < points.size(); ++p) {
-    const Eigen::Vector3i ijk = points[p].head<3>().cast<int>() + field.gpu_index_offset();
-    ASSERT_TRUE((ijk.array() >= 0).all() && (ijk.array() < 4096).all()) << ijk.transpose();
+    const Eigen::Vector3i ijk = points[p].head<3>().cast<int>() + spec_.index_offset;
     const nanovdb::Coord coord(ijk.x(), ijk.y(), ijk.z());
     const std::uint64_t key = Root::DataType::CoordToKey(coord);
     std::uint32_t tile_offset = 0;
@@ -207,19 +258,14 @@ TEST_F(SparseFieldTest, GlslWalksTheTreeAsTheHostGridIsLaidOut) {
     EXPECT_EQ(w[3], static_cast<std::uint32_t>(key >> 32)) << "root key, high word";
     EXPECT_EQ(f[2], sizeof(Root::DataType::Tile)) << "root tile size";
     EXPECT_EQ(f[0], tile_offset) << "root tile holding the voxel";
-    const auto* leaf = root.probeLeaf(coord);
-    ASSERT_NE(leaf, nullptr);
-    const float* value = &leaf->data()->mValues[nanovdb::FloatGrid::TreeType::LeafNodeType::CoordToOffset(coord)];
-    ASSERT_NE(value, nullptr);
-    EXPECT_EQ(f[1], offset_of(value)) << "value address";
-    if (::testing::Test::HasFailure()) break;  // one voxel's trace says where the walk parts
+    if (::testing::Test::HasFailure()) break;
   }
 }
 
-// The work-around for NVIDIA's miscompiled root key (common/sparse_field.glsl, field_prime): with the
-// root made unusable after the accessor is primed, every voxel still reads bit for bit, so no read in
-// the first root tile depends on the root walk.
-TEST_F(SparseFieldTest, ReadsInTheFirstRootTileNeverWalkTheRoot) {
+// No read goes through PNanoVDB's root walk, the step NVIDIA's driver miscompiled: with the accessor's
+// root handle pointed at the grid header (a walk from there finds no tile and gives the background),
+// every voxel of the torus, in all 8 of its root tiles, still reads bit for bit.
+TEST_F(SparseFieldTest, ReadsNeverDependOnPnanovdbsRootWalk) {
   const SparseField field(*result_.grid, spec_, 3.0);
   std::vector<Eigen::Vector4f> points;
   for (int k = 0; k < spec_.dims.z(); ++k)
@@ -352,6 +398,117 @@ TEST_F(SparseFieldTest, NanoVdbFilesPassNanovdbValidate) {
   ASSERT_TRUE(back.grid<float>());
   EXPECT_EQ(back.grid<float>()->activeVoxelCount(), result_.grid->activeVoxelCount());
   EXPECT_EQ(std::system(("nanovdb_validate " + file.string() + " > " + (dir / "validate.txt").string() + " 2>&1").c_str()), 0);
+}
+
+// A sparse grid past 4096 voxels a side (5300), in index space that runs negative on two axes: sphere
+// bands at two opposite corners of the box and one about index (0, 4096, 0), where 8 root tiles meet.
+// Built with OpenVDB directly in index space (voxel size 1), so it costs kilobytes, not a 5300^3 box.
+class SparseFieldPast4096Test : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    spec_.voxel_size = 1.0;
+    spec_.index_offset = Eigen::Vector3i(-4200, -100, -4300);
+    spec_.dims = Eigen::Vector3i::Constant(5300);
+    spec_.origin = spec_.index_offset.cast<double>();
+    const Eigen::Vector3i far = spec_.index_offset + spec_.dims - Eigen::Vector3i::Constant(9);
+    const Eigen::Vector3i near = spec_.index_offset + Eigen::Vector3i::Constant(8);
+    grid_ = sphere(near);
+    for (const Eigen::Vector3i& centre : {far, Eigen::Vector3i(0, 4096, 0)}) {
+      openvdb::tools::csgUnion(*grid_, *sphere(centre));
+    }
+  }
+
+  static openvdb::FloatGrid::Ptr sphere(const Eigen::Vector3i& centre) {
+    return openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        6.0f, openvdb::Vec3f(centre.x(), centre.y(), centre.z()), 1.0f, 3.0f);
+  }
+
+  // Grid-local points: every band voxel and, off it, each band voxel's neighbours 4 voxels out along
+  // the axes (inside the spheres and beyond their bands), and points across the whole box.
+  std::vector<Eigen::Vector4f> band_and_off_band_points() const {
+    std::vector<Eigen::Vector4f> points;
+    const auto add = [&](const openvdb::Coord& c) {
+      points.emplace_back(c.x() - spec_.index_offset.x(), c.y() - spec_.index_offset.y(),
+                          c.z() - spec_.index_offset.z(), 0.0f);
+    };
+    for (auto voxel = grid_->cbeginValueOn(); voxel; ++voxel) {
+      const openvdb::Coord c = voxel.getCoord();
+      add(c);
+      if ((c.x() + c.y() + c.z()) % 7 == 0) {
+        for (int axis = 0; axis < 3; ++axis) {
+          openvdb::Coord out = c, in = c;
+          out[axis] += 4;
+          in[axis] -= 4;
+          add(out);
+          add(in);
+        }
+      }
+    }
+    std::mt19937 rng(3);
+    std::uniform_int_distribution<int> u(-2, 5301);
+    for (int n = 0; n < 4000; ++n) points.emplace_back(u(rng), u(rng), u(rng), 0.0f);
+    return points;
+  }
+
+  // What OpenVDB holds at the grid-local voxel `point`.
+  float host_value(const Eigen::Vector4f& point) const {
+    const Eigen::Vector3i ijk = point.head<3>().cast<int>() + spec_.index_offset;
+    return grid_->tree().getValue(openvdb::Coord(ijk.x(), ijk.y(), ijk.z()));
+  }
+
+  gpu::Context context_;
+  GridSpec spec_;
+  openvdb::FloatGrid::Ptr grid_;
+};
+
+TEST_F(SparseFieldPast4096Test, GlslReadsEveryBandVoxelAndTheBackgroundOffItBitForBit) {
+  const SparseField field(*grid_, spec_, 3.0);
+  // The box of root tiles: x from -8192, y from -4096, z from -8192, 3 tiles each; 9 hold band voxels
+  // (the near corner's and the 8 about (0, 4096, 0), one of which holds the far corner's too), the
+  // other 18 read as the background.
+  ASSERT_EQ(field.root_table().extent, Eigen::Vector3i::Constant(3));
+  EXPECT_EQ(field.root_table().first_tile, Eigen::Vector3i(-2, -1, -2));
+  std::size_t held = 0;
+  for (const auto& entry : field.root_table().entries) held += entry.address.z;
+  EXPECT_EQ(held, 9u);
+  const auto points = band_and_off_band_points();
+  const auto values = probe_field(field, points, 0);
+  std::size_t in_band = 0, inside = 0, outside = 0;
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    const float expected = host_value(points[p]);
+    ASSERT_EQ(values[p].x(), expected) << "grid-local voxel " << points[p].transpose();
+    in_band += std::abs(expected) < field.background();
+    inside += expected == -field.background();
+    outside += expected == field.background();
+  }
+  EXPECT_GE(in_band, grid_->activeVoxelCount());  // every band voxel, some twice as another's neighbour
+  EXPECT_GT(inside, 100u);
+  EXPECT_GT(outside, 4000u);
+}
+
+// The same reads with the accessor's root handle made useless (see ReadsNeverDependOnPnanovdbsRootWalk),
+// and trilinear values between voxels across the root tiles' faces, against OpenVDB's box sampler.
+TEST_F(SparseFieldPast4096Test, ReadsNeverDependOnPnanovdbsRootWalkAndInterpolateAcrossRootTiles) {
+  const SparseField field(*grid_, spec_, 3.0);
+  const auto points = band_and_off_band_points();
+  const auto values = probe_field(field, points, 5);
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    ASSERT_EQ(values[p].x(), host_value(points[p])) << "grid-local voxel " << points[p].transpose();
+  }
+  std::vector<Eigen::Vector4f> between;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(-9.0f, 9.0f);
+  const Eigen::Vector3f meet = (Eigen::Vector3i(0, 4096, 0) - spec_.index_offset).cast<float>();
+  for (int n = 0; n < 5000; ++n) between.emplace_back(meet.x() + u(rng), meet.y() + u(rng), meet.z() + u(rng), 0.0f);
+  const auto trilinear = probe_field(field, between, 1);
+  auto accessor = grid_->getConstAccessor();
+  double worst = 0.0;
+  for (std::size_t p = 0; p < between.size(); ++p) {
+    const Eigen::Vector3d x = between[p].head<3>().cast<double>() + spec_.index_offset.cast<double>();
+    const double expected = openvdb::tools::BoxSampler::sample(accessor, openvdb::Vec3d(x.x(), x.y(), x.z()));
+    worst = std::max(worst, std::abs(trilinear[p].x() - expected));
+  }
+  EXPECT_LT(worst, 1e-5) << "[voxels]";
 }
 
 }  // namespace
