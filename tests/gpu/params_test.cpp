@@ -178,13 +178,13 @@ TEST_F(GpuParams, SdfProgramsMatchCpp) {
                         TS_MEMBER(params, BandParams, band)}};
   check(compute("sdf/band_flags.comp"), {band});
   check(compute("sdf/band_scatter.comp"), {band});
-  const BlockSpec scan{"ComputeScanBlock",
+  const BlockSpec compute_scan{"ComputeScanBlock",
                        sizeof(ComputeScanParams),
                        {TS_MEMBER(params, ComputeScanParams, grid), TS_MEMBER(params, ComputeScanParams, slab),
                         TS_MEMBER(params, ComputeScanParams, pairs), TS_MEMBER(params, ComputeScanParams, band)}};
-  check(compute("sdf/scan_pairs.comp"), {scan});
-  check(compute("sdf/scan_pairs.comp", {"NEAREST_TRIANGLE 1"}), {scan});
-  check(compute("sdf/scan_write.comp"), {scan});
+  check(compute("sdf/scan_pairs.comp"), {compute_scan});
+  check(compute("sdf/scan_pairs.comp", {"NEAREST_TRIANGLE 1"}), {compute_scan});
+  check(compute("sdf/scan_write.comp"), {compute_scan});
 }
 
 TEST_F(GpuParams, SimKernelsMatchCppInBothPrecisions) {
