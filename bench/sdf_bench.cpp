@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/mesh_cases.h"
 #include "core/mesh_io.h"
 #include "core/primitives.h"
 #include "gpu/context.h"
@@ -34,29 +35,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-struct Case {
-  std::string mesh;
-  std::vector<int> resolutions;
-};
-
-Case parse_case(const std::string& text) {
-  const auto at = text.rfind('@');
-  if (at == std::string::npos) throw std::runtime_error("case '" + text + "' needs @resolutions, e.g. bunny.off@64,128");
-  Case c;
-  c.mesh = text.substr(0, at);
-  std::stringstream list(text.substr(at + 1));
-  for (std::string item; std::getline(list, item, ',');) c.resolutions.push_back(std::stoi(item));
-  return c;
-}
-
-ts::TriangleMesh load_case_mesh(const std::string& name) {
-  if (name.rfind("icosphere:", 0) == 0) return ts::make_icosphere(0.5, std::stoi(name.substr(10)));
-  return ts::load_mesh(name);
-}
-
-std::string short_name(const std::string& name) {
-  return name.rfind("icosphere:", 0) == 0 ? name : std::filesystem::path(name).stem().string();
-}
+using Case = ts::bench::MeshCase;
+using ts::bench::load_case_mesh;
+using ts::bench::short_name;
 
 struct Row {
   std::string mesh;
@@ -179,7 +160,7 @@ int main(int argc, char** argv) {
       } else if (arg.rfind("--", 0) == 0) {
         throw std::runtime_error("unknown option " + arg);
       } else {
-        cases.push_back(parse_case(arg));
+        cases.push_back(ts::bench::parse_mesh_case(arg));
       }
     }
     if (cases.empty()) throw std::runtime_error("usage: tetrasand_bench_sdf MESH@64,128... [--band 3] [--csv FILE] [--markdown] [--openvdb-ridges]");

@@ -27,6 +27,7 @@
 #include "fuzz/run_checks.h"
 #include "scene/checkpoint.h"
 #include "scene/scene.h"
+#include "tests/scene_texts.h"
 
 namespace {
 
@@ -35,34 +36,13 @@ namespace fs = std::filesystem;
 constexpr std::size_t kHeader = 8 + 16;  // magic, version, flags, payload length
 constexpr std::size_t kDigest = 32;
 
-constexpr const char* kScene = R"([[material]]
-name = "sand"
-E = 1.0e6
-nu = 0.3
-restitution = 0.5
-mu = 0.5
-gamma_s = 2.0
-density = 2600.0
-[grain]
-radius = 5.0e-3
-material = "sand"
-[[boundary]]
-type = "plane"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-material = "sand"
-[[emitter]]
-type = "fill"
-min = [-0.03, -0.03, 0.01]
-max = [0.03, 0.03, 0.05]
-count = 4
-velocity = [0.0, 0.0, -1.0]
-[simulation]
-duration = 0.04
-[output]
-every = 40
-checkpoint_every = 80
-)";
+// Coarse 5 mm grains thrown at a floor, with checkpoints every 80 steps of about 200.
+std::string base_scene() {
+  return std::string(ts::test::kCoarseSand) + ts::test::smooth_plane("[0.0, 0.0, 0.0]", "[0.0, 0.0, 1.0]") +
+         ts::test::box_emitter("fill", "[-0.03, -0.03, 0.01]", "[0.03, 0.03, 0.05]", 4,
+                               "velocity = [0.0, 0.0, -1.0]\n") +
+         "[simulation]\nduration = 0.04\n[output]\nevery = 40\ncheckpoint_every = 80\n";
+}
 
 struct Base {
   ts::scene::Scene scene;
@@ -74,7 +54,7 @@ struct Base {
 const Base& base() {
   static const Base b = [] {
     Base out;
-    const fs::path scene_file = ts::fuzz::scratch_file("checkpoint_scene.toml", kScene);
+    const fs::path scene_file = ts::fuzz::scratch_file("checkpoint_scene.toml", base_scene());
     out.scene = ts::scene::load_scene(scene_file);
     out.dir = scene_file.parent_path() / "checkpoint_base";
     ts::scene::run_scene(out.scene, out.dir);

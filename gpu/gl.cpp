@@ -77,8 +77,11 @@ struct ProgramCache {
   std::map<EGLContext, std::map<std::string, GLuint>> programs;
   std::atomic<std::size_t> links{0};
 };
+// Never destroyed: a gpu::Context held in a static (test fixtures, the preview's shared context) is
+// destroyed at exit after a function-local static made later would be, and its destructor releases
+// its programs here; with a destroyed map that walk never ended (preview tests hung at exit).
 ProgramCache& program_cache() {
-  static ProgramCache cache;
+  static ProgramCache& cache = *new ProgramCache;
   return cache;
 }
 
