@@ -13,6 +13,7 @@
 #include "body/json_fields.h"
 #include "body/particles_ply.h"
 #include "core/atomic_file.h"
+#include "core/checked_values.h"
 #include "core/error.h"
 
 namespace ts::body {
@@ -83,12 +84,9 @@ void check_mass_properties(const Fields& f, const ParticleBody& b, const GivenMa
   if ((b.inertia - b.inertia.transpose()).norm() > 1e-9 * scale) f.fail("inertia", "must be symmetric");
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(b.inertia);
   if (!(eigen.eigenvalues().minCoeff() > 0.0)) f.fail("inertia", "must be positive definite (kg m^2)");
-  // The simulator inverts both (1/m, a 3x3 inverse whose determinant cubes the moments) and multiplies
-  // by squared speeds: beyond 1e+-100 that leaves double's range (a grain of density 1e200 wrote a NaN
-  // energy), so a body is refused there as a scene's grains are (scene/scene_limits.cpp).
-  const auto fits = [](double v) { return v >= 1e-100 && v <= 1e100; };
-  if (!fits(b.mass)) f.fail("mass", fmt::format("{:.3g} kg is beyond 1e-100..1e+100 kg, what the simulator can invert", b.mass));
-  if (!fits(eigen.eigenvalues().minCoeff()) || !fits(eigen.eigenvalues().maxCoeff())) {
+  // Within the mass range the simulator can invert (core/checked_values.h), as a scene's grains are.
+  if (!mass_fits(b.mass)) f.fail("mass", fmt::format("{:.3g} kg is beyond 1e-100..1e+100 kg, what the simulator can invert", b.mass));
+  if (!mass_fits(eigen.eigenvalues().minCoeff()) || !mass_fits(eigen.eigenvalues().maxCoeff())) {
     f.fail("inertia", fmt::format("principal moments {:.3g}..{:.3g} kg m^2 are beyond 1e-100..1e+100, what the "
                                   "simulator can invert",
                                   eigen.eigenvalues().minCoeff(), eigen.eigenvalues().maxCoeff()));

@@ -45,4 +45,10 @@ Eigen::Vector3d checked_position(const Eigen::Vector3d& p, double bound, const W
 inline constexpr double kMaxSpeed = 299792458.0;  // m/s
 Eigen::Vector3d checked_velocity(const Eigen::Vector3d& v, const Where& where);
 
+// A rigid body's mass (kg) or principal moment of inertia (kg m^2) the simulator can use: it inverts
+// both (1/m, a 3x3 inverse whose determinant cubes the moments) and multiplies by squared speeds, so
+// beyond 1e+-100 the arithmetic leaves double's range (density = 1e200 wrote a NaN energy).
+inline constexpr double kLeastMass = 1e-100, kMostMass = 1e100;
+inline bool mass_fits(double value) { return value >= kLeastMass && value <= kMostMass; }
+
 }  // namespace ts

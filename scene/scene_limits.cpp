@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/checked_values.h"
 #include "core/error.h"
 #include "scene/grain_mix.h"
 #include "scene/lattice.h"
@@ -154,15 +155,11 @@ void check_emitter_cells(const Scene& scene, const Emitter& e, double cell) {
   }
 }
 
-// A grain's mass and inertia feed 1/m, a 3x3 inverse (the cube of its entries: the determinant) and
-// m v^2: beyond 1e+-100 those leave double's range, and density = 1e200 made a run write a NaN
-// rotational energy at exit 0 (found by fuzz_scene). Both must lie in [kLeastMass, kMostMass].
-constexpr double kLeastMass = 1e-100, kMostMass = 1e100;  // kg and kg m^2 alike
-
+// A grain's mass and inertia within core/checked_values.h's mass range: density = 1e200 made a run
+// write a NaN rotational energy at exit 0 (found by fuzz_scene).
 void check_grain_mass(const Scene& scene, const GrainKind& kind) {
   const GrainShape& g = kind.shape;
-  const auto fits = [](double v) { return v >= kLeastMass && v <= kMostMass; };
-  if (fits(g.mass) && fits(g.inertia)) return;
+  if (mass_fits(g.mass) && mass_fits(g.inertia)) return;
   const GrainSpec& spec = scene.grains[kind.type];
   fail(scene, spec.line, "grain",
        fmt::format("{} weighs {:.3g} kg with a moment of inertia of {:.3g} kg m^2 (density {:.3g} kg/m^3, radius "
