@@ -75,6 +75,9 @@ SELFTESTS = {
               ("tetrasand_sdf_tests", "SparseFieldTest.ReadsNeverDependOnPnanovdbsRootWalk")],
 }
 TEST_BINARIES = [exe for exe, _ in SELFTESTS["full"]]
+# The sampler part times the GPU path whatever `--backend auto` would pick (issue 43: the scan, the field kept
+# on the GPU and the relaxation on it), after the selftest has checked the sparse field's reads there.
+SAMPLER_GPU_PATH = ["--backend", "gpu", "--sdf-backend", "gpu"]
 BINARIES = {"selftest": "tetrasand_gpu_tests", "sdf": "tetrasand_bench_sdf", "sampler": "tetrasand", "sim": "tetrasand_bench_sim",
             "preview": "tetrasand_bench_preview"}
 
@@ -209,13 +212,18 @@ class Run:
                 continue
             out = os.path.join(self.work, f"sample-{count}")
             try:
-                body, secs, timings = run_sample(exe, mesh, count, out, ["--timings"], timeout=left)
-                q = body["quality"]
+                body, secs, timings = run_sample(exe, mesh, count, out, ["--timings", *SAMPLER_GPU_PATH], timeout=left)
+                q, run = body["quality"], body.get("run", {})
+                field = run.get("sdf", {}) if isinstance(run.get("sdf"), dict) else {}
                 rows.append({"count": count, "status": "ok", "seconds": secs, "particles": body["particle_count"],
                              "radius_m": body["particle_radius"], "iterations": q["iterations"],
                              "converged": q["converged"], "injection_rounds": q["injection_rounds"],
                              "relaxation_s": q["seconds"], "relative_radius": q["relative_radius"], "cv": q["cv"],
-                             "covering_over_r": q["covering_over_r"], "timings": timings})
+                             "covering_over_r": q["covering_over_r"], "scan": run.get("scan", ""),
+                             "relax_backend": run.get("relax_backend", ""),
+                             "sdf_s": run.get("seconds", {}).get("sdf"),
+                             "field_readback_bytes": field.get("readback_bytes"),
+                             "band_voxels": field.get("band_voxels"), "timings": timings})
             except subprocess.TimeoutExpired:
                 rc = None
                 rows.append({"count": count, "status": "timeout"})
@@ -394,20 +402,25 @@ def sampler_section(res, baseline=None):
     here = {r["count"]: r for r in (baseline or {}).get("parts", {}).get("sampler", {}).get("rows", [])
             if r.get("status") == "ok"}
     lines = ["### Sampling on an NVIDIA GPU", "", provenance(res, "sampler"), "",
-             f"`tetrasand sample {p.get('mesh', 'bunny')} --count N --json --timings`, whole command's wall time. "
-             "The quality columns are the sampler's own figures (body.json `quality`).", ""]
+             f"`tetrasand sample {p.get('mesh', 'bunny')} --count N --json --timings {' '.join(SAMPLER_GPU_PATH)}`, "
+             "whole command's wall time. The quality columns are the sampler's own figures (body.json `quality`); "
+             "scan, SDF s and field read-back are its `run` figures (`run.scan`, `run.seconds.sdf`, "
+             "`run.sdf.readback_bytes`: 0 when the field stayed on the GPU between scan and relaxation).", ""]
     if here:
         b = baseline["machine"]
         lines += [f"Baseline (a different machine): the same run on {b['gl_renderer']}, {b['cores']} cores, "
                   f"{b['date'][:10]}; speed-up = baseline time / this run's time.", ""]
-    lines += ["| N requested | N | time s | relaxation s | iterations | converged | rho | CV | c / r"
-              + (" | baseline s | speed-up |" if here else " |"),
-              "|---|---|---|---|---|---|---|---|---|" + ("---|---|" if here else "")]
+    lines += ["| N requested | N | time s | scan | SDF s | field read-back bytes | relaxation s | iterations | converged "
+              "| rho | CV | c / r" + (" | baseline s | speed-up |" if here else " |"),
+              "|---|---|---|---|---|---|---|---|---|---|---|---|" + ("---|---|" if here else "")]
     for r in p.get("rows", []):
         if r["status"] != "ok":
-            lines.append(f"| {r['count']} | {r['status']} |" + " |" * (8 + 2 * bool(here)))
+            lines.append(f"| {r['count']} | {r['status']} |" + " |" * (11 + 2 * bool(here)))
             continue
-        row = (f"| {r['count']} | {r['particles']} | {r['seconds']:.2f} | {r['relaxation_s']:.2f} | {r['iterations']} "
+        sdf_s = f"{r['sdf_s']:.2f}" if r.get("sdf_s") is not None else "n/r"
+        readback = r.get("field_readback_bytes")
+        row = (f"| {r['count']} | {r['particles']} | {r['seconds']:.2f} | {r.get('scan') or 'n/r'} | {sdf_s} "
+               f"| {readback if readback is not None else 'n/r'} | {r['relaxation_s']:.2f} | {r['iterations']} "
                f"| {r['converged']} | {r['relative_radius']:.3f} | {r['cv']:.3f} | {r['covering_over_r']:.3f} |")
         if here:
             b = here.get(r["count"])

@@ -46,19 +46,34 @@ def f(x, fmt):
     return format(float(x), fmt) if x not in ("", None) else "n/r"
 
 
+def has_compute(rows):
+    """Whether the rows carry the compute path's columns (CSV files written before issue 43 do not)."""
+    return bool(rows) and all(r.get("compute_s") not in ("", None) for r in rows)
+
+
 def table(rows):
-    lines = ["| mesh | triangles | grid | band voxels | slabs | peak GPU MiB | GPU s | CPU exact s | OpenVDB s | exact / GPU "
-             "| OpenVDB / GPU | GPU vs exact mean / max (voxels) | GPU wrong signs | OpenVDB vs exact mean / p99 / max (voxels) "
-             "| OpenVDB wrong signs |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    compute = has_compute(rows)
+    head = ("| mesh | triangles | grid | band voxels | slabs | peak GPU MiB | geometry s | CPU exact s | OpenVDB s "
+            "| exact / geometry | OpenVDB / geometry | geometry vs exact mean / max (voxels) | geometry wrong signs "
+            "| OpenVDB vs exact mean / p99 / max (voxels) | OpenVDB wrong signs |")
+    if compute:
+        head += (" compute s | OpenVDB / compute | geometry / compute | compute vs exact mean / max (voxels) "
+                 "| compute wrong signs | compute band = geometry band |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         g, e, v = float(r["gpu_s"]), float(r["exact_s"]), float(r["openvdb_s"])
-        lines.append(
+        line = (
             f"| {r['mesh']} | {r['triangles']} | {r['nx']}x{r['ny']}x{r['nz']} ({r['resolution']}) | {r['band_voxels']} "
             f"| {r['slabs']} | {f(r['peak_gpu_mib'], '.1f')} | {g:.2f} | {e:.2f} | {v:.2f} | {e / g:.2f} | {v / g:.2f} "
             f"| {f(r['gpu_mean'], '.1e')} / {f(r['gpu_max'], '.1e')} | {r['gpu_wrong_signs']} "
             f"| {f(r['openvdb_mean'], '.4f')} / {f(r['openvdb_p99'], '.3f')} / {f(r['openvdb_max'], '.3f')} "
             f"| {r['openvdb_wrong_signs']} |")
+        if compute:
+            c = float(r["compute_s"])
+            same = "yes" if r["compute_band_voxels"] == r["band_voxels"] else f"no ({r['compute_band_voxels']})"
+            line += (f" {c:.2f} | {v / c:.2f} | {g / c:.2f} | {f(r['compute_mean'], '.1e')} / "
+                     f"{f(r['compute_max'], '.1e')} | {r['compute_wrong_signs']} | {same} |")
+        lines.append(line)
     return lines
 
 
@@ -71,19 +86,21 @@ def findings(rows):
     vdb_p99 = max(rows, key=lambda r: num(r, "openvdb_p99"))
     vdb_signs = [int(r["openvdb_wrong_signs"]) for r in rows]
     closer = sum(num(r, "gpu_max") < num(r, "openvdb_max") and num(r, "gpu_mean") < num(r, "openvdb_mean") for r in rows)
-    out = [f"- **Accuracy.** The GPU path's largest error against exact is {num(worst_gpu, 'gpu_max'):.1e} voxel "
+    out = [f"- **Accuracy.** The geometry path's largest error against exact is {num(worst_gpu, 'gpu_max'):.1e} voxel "
            f"({worst_gpu['mesh']} at {worst_gpu['resolution']}), with {gpu_signs} wrong signs over all {len(rows)} "
            f"runs. OpenVDB's mean error is {min(vdb_means):.1e} to {max(vdb_means):.1e} voxel, its p99 up to "
            f"{num(vdb_p99, 'openvdb_p99'):.3f} voxel ({vdb_p99['mesh']} at {vdb_p99['resolution']}), with "
-           f"{min(vdb_signs)} to {max(vdb_signs)} wrong signs per run. The GPU field is closer to exact than "
+           f"{min(vdb_signs)} to {max(vdb_signs)} wrong signs per run. The geometry path's field is closer to exact than "
            f"OpenVDB's (mean and max) in {closer} of {len(rows)} runs."]
     speed = []
     for mesh in dict.fromkeys(r["mesh"] for r in rows):
         rs = [r for r in rows if r["mesh"] == mesh]
         ratios = ", ".join(f"{num(r, 'exact_s') / num(r, 'gpu_s'):.2f} at {r['resolution']}" for r in rs)
         vdb = ", ".join(f"{num(r, 'openvdb_s') / num(r, 'gpu_s'):.2f}" for r in rs)
-        speed.append(f"{mesh} ({rs[0]['triangles']} triangles): exact / GPU {ratios}; OpenVDB / GPU {vdb}")
-    out.append("- **Speed** (time ratios; above 1 the GPU path is faster): " + "; ".join(speed) + ".")
+        speed.append(f"{mesh} ({rs[0]['triangles']} triangles): exact / geometry {ratios}; OpenVDB / geometry {vdb}")
+    out.append("- **Speed** (time ratios; above 1 the geometry path is faster): " + "; ".join(speed) + ".")
+    if has_compute(rows):
+        out += compute_findings(rows)
     mem = [r for r in rows if r["peak_gpu_mib"] not in ("", None)]
     if mem:
         big = max(mem, key=lambda r: int(r["nx"]) * int(r["ny"]) * int(r["nz"]))
@@ -91,6 +108,25 @@ def findings(rows):
                    f"{big['resolution']}), ran in {big['slabs']} z-slabs with peak GPU memory {float(big['peak_gpu_mib']):.0f} "
                    f"MiB (slab render target plus geometry buffers) for {int(big['band_voxels']):,} band voxels; "
                    "the host holds one slab's readback and the sparse level set.")
+    return out
+
+
+def compute_findings(rows):
+    """The compute scan conversion's bullets (issue 43), every number from `rows`."""
+    num = lambda r, k: float(r[k])
+    worst = max(rows, key=lambda r: num(r, "compute_max"))
+    signs = sum(int(r["compute_wrong_signs"]) for r in rows)
+    same = sum(r["compute_band_voxels"] == r["band_voxels"] for r in rows)
+    out = [f"- **Compute path.** Largest error against exact {num(worst, 'compute_max'):.1e} voxel ({worst['mesh']} at "
+           f"{worst['resolution']}), {signs} wrong signs over all {len(rows)} runs; the same band voxel count as the "
+           f"geometry path in {same} of {len(rows)} runs."]
+    speed = []
+    for mesh in dict.fromkeys(r["mesh"] for r in rows):
+        rs = [r for r in rows if r["mesh"] == mesh]
+        geometry = ", ".join(f"{num(r, 'gpu_s') / num(r, 'compute_s'):.2f} at {r['resolution']}" for r in rs)
+        vdb = ", ".join(f"{num(r, 'openvdb_s') / num(r, 'compute_s'):.2f}" for r in rs)
+        speed.append(f"{mesh}: geometry / compute {geometry}; OpenVDB / compute {vdb}")
+    out.append("- **Compute speed** (above 1 the compute path is faster): " + "; ".join(speed) + ".")
     return out
 
 
@@ -117,10 +153,11 @@ def main():
                 "which the CPU paths share, so read the ratios, not the absolute seconds." if software else "")
              + (f" Load average: {a.load}." if a.load else ""), "",
              "For each mesh and resolution (voxels along the longest side, band half-width 3 voxels, automatic "
-             "padding), one run builds the field three ways: tetrasand's GPU scan conversion (`sdf::scan_convert`, "
+             "padding), one run builds the field four ways: tetrasand's GPU scan conversion by its geometry-shader path and "
+             "by its compute path (`sdf::scan_convert`, "
              "wall time from upload to the flood-filled OpenVDB level set), the CPU exact SDF (`sdf::exact_sdf_grid`: "
              "CGAL AABB tree, double precision, TBB on all cores, tree build included) and OpenVDB's "
-             "`tools::meshToLevelSet` (TBB, all cores). Both approximate paths are compared with exact over every "
+             "`tools::meshToLevelSet` (TBB, all cores). The three approximate paths are compared with exact over every "
              "voxel either has in its band (errors in voxels).", "",
              "```", a.command, "```", ""]
     lines += table(rows)

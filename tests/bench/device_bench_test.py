@@ -55,6 +55,8 @@ def quick(build):
           f"selftest: every test executable ran its GPU tests and passed ({selftest})")
     sdf = res["parts"]["sdf"]["rows"]
     check(len(sdf) == 4 and all(int(r["gpu_wrong_signs"]) == 0 for r in sdf), "sdf: 2 meshes x 2 grids, no wrong sign")
+    check(all(int(r["compute_wrong_signs"]) == 0 and r["compute_band_voxels"] == r["band_voxels"] for r in sdf),
+          "sdf: both scan paths timed, the compute path with no wrong sign and the geometry path's band")
     sim = res["parts"]["sim"]["rows"]
     check(sorted(r["precision"] for r in sim) == ["double", "float"], "sim: a float and a double row")
     kernels = res["parts"]["sim"].get("kernels", {})
@@ -62,9 +64,10 @@ def quick(build):
     check(kernels.get("status") == "ok" and any(t["kernel"] == "sim/contact_forces.comp" and t["calls"] > 0 for t in table)
           and abs(sum(t["share"] for t in table) - 100) < 1, f"sim: the per-kernel table of the 1000-grain float run ({kernels})")
     sampler = res["parts"]["sampler"]["rows"]
-    # --backend auto: the GPU kernels on a hardware GPU, the CPU relaxation on llvmpipe; either names itself.
-    check(all(r["status"] == "ok" and ("sampler/relax.comp" in r["timings"] or "CPU relaxation" in r["timings"])
-              for r in sampler), "sampler: every count ok, with the timings of the relaxation that ran")
+    # The GPU path on every device (SAMPLER_GPU_PATH), llvmpipe included.
+    check(all(r["status"] == "ok" and r["relax_backend"] == "gpu" and "sampler/relax.comp" in r["timings"]
+              and r["scan"] in ("compute", "geometry") for r in sampler),
+          "sampler: every count ok on the GPU path (scan, relaxation kernels), with their timings")
     check(len(res["parts"]["preview"]["rows"]) == 3, "preview: SDF, impostor and hybrid rows")
     md = open(os.path.join(out, "device-bench.md")).read()
     check(all(f"### {t} on an NVIDIA GPU" in md for t in ("GPU self-test", "SDF", "Sampling", "Simulation", "Preview")),
