@@ -162,6 +162,7 @@ sdf::ScanConvertResult gpu_level_set(const Options& o, gpu::Context& context, co
   scan.method = sdf::parse_scan_method(o.scan).value();  // CLI::IsMember checked the spelling
   scan.band = o.band;
   scan.timings = o.timings;
+  scan.pipeline_statistics = o.timings;
   scan.max_slab_bytes = static_cast<std::size_t>(o.slab_mb * 1048576.0);
   Progress progress;  // a tenth of the grid a line in a pipe
   scan.progress = [&progress](double done) {

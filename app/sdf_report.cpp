@@ -37,6 +37,19 @@ void print_sdf_times(const SdfOptions& o, const sdf::ScanConvertStats& st, const
   }
 }
 
+namespace {
+
+// The geometry path's pipeline statistics against the prism model (sdf --timings), null when not counted.
+nlohmann::ordered_json pipeline_json(const sdf::ScanPipelineWork& p) {
+  if (!p.measured) return nullptr;
+  return {{"geometry_invocations", p.geometry_invocations}, {"model_invocations", p.model_invocations},
+          {"drawn_prisms", p.drawn_prisms},
+          {"geometry_primitives", p.geometry_primitives}, {"model_primitives", p.model_primitives},
+          {"fragments", p.fragments}, {"model_prism_volume_voxels", p.model_volume}};
+}
+
+}  // namespace
+
 void print_sdf_json(const SdfOptions& o, const TriangleMesh& mesh, const sdf::GridSpec& spec,
                 const sdf::ScanConvertStats& st, const SdfFigures& f, const std::string& device) {
   const nlohmann::ordered_json out = {
@@ -70,6 +83,7 @@ void print_sdf_json(const SdfOptions& o, const TriangleMesh& mesh, const sdf::Gr
       {"scan", o.backend == "cpu" ? nlohmann::ordered_json(nullptr)
                                   : nlohmann::ordered_json(sdf::scan_method_name(st.method))},
       {"brick_pairs", st.brick_pairs},
+      {"pipeline", pipeline_json(st.pipeline)},
       {"renderer", device}};
   fmt::print("{}\n", out.dump(2));
 }
@@ -86,6 +100,14 @@ void print_sdf_summary(const SdfOptions& o, const TriangleMesh& mesh, const sdf:
   if (o.timings && o.backend == "gpu") {
     fmt::print("{} slabs of {} layers, {} draws, peak GPU memory {:.1f} MiB, {:.3f} s\n{}", st.slabs,
                st.layers_per_slab, st.draws, st.peak_gpu_bytes / 1048576.0, st.seconds, st.timing_report);
+  }
+  if (o.timings && st.pipeline.measured) {
+    const sdf::ScanPipelineWork& p = st.pipeline;
+    fmt::print("pipeline statistics (geometry path) against the prism model: {} geometry-shader invocations "
+               "({} asked for by {} prisms), {} primitives emitted ({} by the model), {} fragments ({:.0f} voxel centres in "
+               "the prisms; {:.2f} fragments a band voxel)\n",
+               p.geometry_invocations, p.model_invocations, p.drawn_prisms, p.geometry_primitives, p.model_primitives, p.fragments,
+               p.model_volume, st.band_voxels ? static_cast<double>(p.fragments) / st.band_voxels : 0.0);
   }
 }
 

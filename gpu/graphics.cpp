@@ -404,4 +404,47 @@ StateScope& StateScope::no_blend() {
   return *this;
 }
 
+// ---------------------------------------------------------------------------------- PipelineStatistics
+
+namespace {
+
+constexpr std::array<GLenum, 3> kPipelineTargets = {GL_GEOMETRY_SHADER_INVOCATIONS,
+                                                    GL_GEOMETRY_SHADER_PRIMITIVES_EMITTED_ARB,
+                                                    GL_FRAGMENT_SHADER_INVOCATIONS_ARB};
+
+}  // namespace
+
+bool PipelineStatistics::available() {
+  return glewIsSupported("GL_ARB_pipeline_statistics_query") || GLEW_VERSION_4_6;
+}
+
+PipelineStatistics::PipelineStatistics() {
+  if (!available()) throw GpuError("this GL device has no pipeline statistics queries (GL_ARB_pipeline_statistics_query)");
+  glGenQueries(static_cast<GLsizei>(queries_.size()), queries_.data());
+}
+
+PipelineStatistics::~PipelineStatistics() {
+  if (active_) {
+    for (GLenum target : kPipelineTargets) glEndQuery(target);
+  }
+  glDeleteQueries(static_cast<GLsizei>(queries_.size()), queries_.data());
+}
+
+void PipelineStatistics::begin() {
+  if (active_) throw Error(ExitCode::Internal, "PipelineStatistics::begin while counting");
+  for (std::size_t i = 0; i < queries_.size(); ++i) glBeginQuery(kPipelineTargets[i], queries_[i]);
+  active_ = true;
+}
+
+void PipelineStatistics::end() {
+  if (!active_) throw Error(ExitCode::Internal, "PipelineStatistics::end without begin");
+  for (GLenum target : kPipelineTargets) glEndQuery(target);
+  active_ = false;
+  std::array<GLuint64, 3> values{};
+  for (std::size_t i = 0; i < queries_.size(); ++i) glGetQueryObjectui64v(queries_[i], GL_QUERY_RESULT, &values[i]);
+  counts_.geometry_invocations += values[0];
+  counts_.geometry_primitives += values[1];
+  counts_.fragment_invocations += values[2];
+}
+
 }  // namespace ts::gpu

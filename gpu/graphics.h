@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -202,6 +203,37 @@ class StateScope {
   std::optional<Depth> depth_;
   std::optional<Culling> culling_;
   std::optional<GLboolean> blend_;
+};
+
+// What the raster pipeline did over a span of draws (GL_ARB_pipeline_statistics_query, core in GL 4.6):
+// geometry-shader invocations and emitted primitives and fragment-shader invocations, to hold against a
+// model of the work a pass should make (the SDF scan conversion's prisms, sdf/prism_model.h). Reading a
+// span's counts waits for the GPU, so a pass counts only when asked (--timings).
+struct PipelineCounts {
+  std::uint64_t geometry_invocations = 0;
+  std::uint64_t geometry_primitives = 0;
+  std::uint64_t fragment_invocations = 0;
+};
+
+class PipelineStatistics {
+ public:
+  // Whether the current context has the queries (llvmpipe and NVIDIA's drivers do).
+  static bool available();
+  // GpuError when !available().
+  PipelineStatistics();
+  ~PipelineStatistics();
+  PipelineStatistics(const PipelineStatistics&) = delete;
+  PipelineStatistics& operator=(const PipelineStatistics&) = delete;
+
+  // Counts the draws issued between begin() and end(); end() waits for them and adds their counts.
+  void begin();
+  void end();
+  const PipelineCounts& counts() const { return counts_; }
+
+ private:
+  std::array<GLuint, 3> queries_{};
+  bool active_ = false;
+  PipelineCounts counts_;
 };
 
 }  // namespace ts::gpu

@@ -19,6 +19,7 @@
 #include "gpu/layouts.h"
 #include "sdf/compute_scan.h"
 #include "sdf/level_set_builder.h"
+#include "sdf/prism_model.h"
 #include "shaders/sdf/bindings.h"
 
 namespace ts::sdf {
@@ -331,6 +332,10 @@ class SlabScanner {
            band_values_.bytes() + (compute_ ? compute_->gpu_bytes() : 0);
   }
   std::size_t brick_pairs_run() const { return brick_pairs_run_; }  // compute path, over all slabs
+  // Geometry path: starts counting the raster pipeline's work (gpu::PipelineStatistics) from the next slab.
+  void count_pipeline() { pipeline_ = std::make_unique<gpu::PipelineStatistics>(); }
+  // What was counted, with the invocations the draws asked for; measured false when nothing was.
+  ScanPipelineWork pipeline_work() const;
   std::size_t readback_bytes() const { return readback_bytes_; }  // host traffic so far
 
  private:
@@ -354,6 +359,9 @@ class SlabScanner {
   std::size_t readback_bytes_ = 0;
   std::unique_ptr<ComputeScan> compute_;  // the compute path's kernels and buffers; null on the geometry path
   std::size_t brick_pairs_run_ = 0;
+  std::unique_ptr<gpu::PipelineStatistics> pipeline_;  // null unless count_pipeline()
+  std::uint64_t drawn_prisms_ = 0;                     // sum over draws of the prisms drawn
+  std::uint64_t model_invocations_ = 0;                // sum over draws of prisms x variant invocations
   gpu::StateScope state_;  // last: restores the state before the target is released
 };
 
@@ -408,19 +416,39 @@ int SlabScanner::draw(int z0, int layers) {
       const std::size_t begin = plan_.lists.begin[list], end = plan_.lists.begin[list + 1];
       if (begin == end) continue;
       draws.push_back({variant, begin, end - begin});
-      params.push_back({{z0, plan_.slab_layers, first, plan_.block},
+      params.push_back({{z0, layers, first, plan_.block},
                         {static_cast<float>(spec_.dims.x()), static_cast<float>(spec_.dims.y()),
                          static_cast<float>(plan_.margin), 0.0f}});
     }
   }
   // The slab's parameters go up in one upload, before its first draw (gpu::ParamArray says why).
   draw_params_.upload(params);
+  if (pipeline_) pipeline_->begin();
   for (std::size_t d = 0; d < draws.size(); ++d) {
     draw_params_.bind(d, TS_SDF_SCAN_PARAMS);
     gpu::draw_elements(queue_, programs_[draws[d].variant], GL_LINES_ADJACENCY, draws[d].begin, draws[d].count,
                        timer_names_[draws[d].variant]);
+    drawn_prisms_ += draws[d].count / 4;
+    model_invocations_ += draws[d].count / 4 * static_cast<std::uint64_t>(kVariantInvocations[draws[d].variant]);
   }
+  if (pipeline_) pipeline_->end();
   return static_cast<int>(draws.size());
+}
+
+ScanPipelineWork SlabScanner::pipeline_work() const {
+  ScanPipelineWork work;
+  if (!pipeline_) return work;
+  const gpu::PipelineCounts& counts = pipeline_->counts();
+  work.measured = true;
+  work.geometry_invocations = counts.geometry_invocations;
+  work.geometry_primitives = counts.geometry_primitives;
+  work.fragments = counts.fragment_invocations;
+  work.drawn_prisms = drawn_prisms_;
+  work.model_invocations = model_invocations_;
+  const PrismWorkModel model = model_prism_work(plan_.geometry.prisms, plan_.geometry.drawn, spec_.dims.z());
+  work.model_primitives = model.primitives;
+  work.model_volume = model.volume;
+  return work;
 }
 
 SlabScanner::Band SlabScanner::read_band(int layers, float band) {
@@ -635,6 +663,8 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
   gpu::ShaderLibrary library;
   gpu::Queue queue(options.timings, context.debug());
   SlabScanner scanner(library, queue, spec, plan);
+  if (options.pipeline_statistics && plan.method == ScanMethod::Geometry && gpu::PipelineStatistics::available())
+    scanner.count_pipeline();
 
   ScanConvertResult result;
   ScanConvertStats& stats = result.stats;
@@ -647,6 +677,7 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
   stats.peak_gpu_bytes = scanner.gpu_bytes();
   stats.readback_bytes = scanner.readback_bytes();
   stats.brick_pairs = scanner.brick_pairs_run();
+  stats.pipeline = scanner.pipeline_work();
   // Voxels outside the band take +-band: a closed band separates the inside from the outside, so a
   // flood fill classifies the whole grid (OpenVDB's signedFloodFill for the level set; a fill from
   // the grid border for the dense copy).

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -26,6 +27,9 @@ struct ScanConvertOptions {
   double band = 3.0;                         // half-width of the narrow band [voxels]
   std::size_t max_slab_bytes = 1ull << 30;   // GPU render-target budget per slab [bytes]
   bool timings = false;                      // per-kernel GPU timer queries
+  // Geometry path: count what the raster pipeline did (gpu::PipelineStatistics, where the device has the
+  // queries) against the prism model (sdf/prism_model.h). A host wait per slab.
+  bool pipeline_statistics = false;
   bool keep_dense = false;                   // also return the whole grid densely on the host (tests)
   bool build_grid = true;                    // the OpenVDB level set
   // The level set's transform: world units (voxel_size, for .vdb files; needs voxel_size >=
@@ -33,6 +37,18 @@ struct ScanConvertOptions {
   // for a GPU field built in the same process, sdf::SparseField).
   bool index_space_grid = false;
   std::function<void(double fraction_done)> progress;  // called after each slab
+};
+
+// The geometry path's pipeline statistics beside the prism model's figures (options.pipeline_statistics).
+struct ScanPipelineWork {
+  bool measured = false;                    // false: not asked for, the compute path, or no queries
+  std::uint64_t geometry_invocations = 0;   // geometry-shader invocations (instances count one each)
+  std::uint64_t geometry_primitives = 0;    // primitives the geometry shader emitted
+  std::uint64_t fragments = 0;              // fragment-shader invocations (llvmpipe: 16 per 4x4 block shaded)
+  std::uint64_t drawn_prisms = 0;           // input primitives over all draws (llvmpipe counts these as invocations)
+  std::uint64_t model_invocations = 0;      // prisms per draw x the draw's variant's invocations
+  std::uint64_t model_primitives = 0;       // cross-sections by the shader's slicing rules
+  double model_volume = 0.0;                // summed prism volume [voxels^3]: voxel centres inside
 };
 
 struct ScanConvertStats {
@@ -54,6 +70,7 @@ struct ScanConvertStats {
                                     // the level set's leaves, the signed flood fill
   double leaf_build_seconds = 0.0;  // the level set's leaves built and linked, mostly beside the GPU's work
   std::string timing_report;           // filled when options.timings
+  ScanPipelineWork pipeline;           // filled when options.pipeline_statistics, geometry path
 };
 
 // A dense copy of the field: per voxel, xyz = unit gradient, w = signed distance [world units].

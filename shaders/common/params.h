@@ -74,8 +74,9 @@ TS_PARAMS(CertifyParams) {
 
 // ---- sdf/scan_convert.{vert,geom,frag}: one draw of the scan conversion.
 TS_PARAMS(ScanConvertParams) {
-  ivec4 layers;           // x: grid z of render-target layer 0 (the slab's first), y: layers in the
-                          // render target, z: first render-target layer this draw covers, w: layers
+  ivec4 layers;           // x: grid z of render-target layer 0 (the slab's first), y: layers of this
+                          // slab inside the grid (the last slab's render target has more; slicing
+                          // them would be wasted work), z: first render-target layer this draw covers, w: layers
                           // this draw covers (at most INVOCATIONS * LAYERS_PER_INVOCATION)
   vec4 grid;              // xy: grid dims along x and y = viewport size, z: |d| [voxels] that maps to
                           // depth 1 (beyond it the fragment is dropped); w unused

@@ -92,6 +92,40 @@ TEST(CliSdf, TimingsSplitTheScanIntoGpuReadbackHostBuildAndWrite) {
             json.at("total_seconds").get<double>());
 }
 
+TEST(CliSdf, TimingsOnTheGeometryPathCountItsPipelineBesideThePrismModel) {
+  const auto dir = test::temp_dir();
+  const std::string bunny = "'" + test::asset("bunny.obj").string() + "'";
+  const std::string common = " --resolution 32 --backend gpu --timings";
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sdf " + bunny + " -o '" + (dir / "g.vdb").string() + "'" + common +
+                                    " --scan geometry --json",
+                                &out),
+            0)
+      << out;
+  const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
+  if (json.at("pipeline").is_null()) GTEST_SKIP() << "no pipeline statistics queries here";
+  const auto& p = json.at("pipeline");
+  EXPECT_GT(p.at("geometry_primitives").get<double>(), 0.0);
+  EXPECT_NEAR(p.at("geometry_primitives").get<double>(), p.at("model_primitives").get<double>(),
+              1e-3 * p.at("model_primitives").get<double>());
+  EXPECT_GE(p.at("fragments").get<double>(), json.at("band_voxels").get<double>());
+  ASSERT_EQ(
+      test::run_tetrasand("sdf " + bunny + " -o '" + (dir / "g.vdb").string() + "'" + common + " --scan geometry", &out),
+      0)
+      << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(\npipeline statistics \(geometry path\) against the prism model: )"
+                                                R"(\d+ geometry-shader invocations \(\d+ asked for by \d+ prisms\), )"
+                                                R"(\d+ primitives emitted \(\d+ by the model\), \d+ fragments)")))
+      << out;
+  // The compute path draws nothing: no counts, null in the JSON.
+  ASSERT_EQ(test::run_tetrasand("sdf " + bunny + " -o '" + (dir / "c.vdb").string() + "'" + common +
+                                    " --scan compute --json",
+                                &out),
+            0)
+      << out;
+  EXPECT_TRUE(nlohmann::json::parse(out.substr(out.find("{\n"))).at("pipeline").is_null()) << out;
+}
+
 TEST(CliSdf, BadParametersAndFilesExitNonZeroWithAMessage) {
   const auto dir = test::temp_dir();
   const std::string cube = test::asset("cube.obj").string();
