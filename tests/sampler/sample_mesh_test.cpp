@@ -129,6 +129,36 @@ INSTANTIATE_TEST_SUITE_P(CgalMeshes, SampleQuality,
                                            Case{"cgal:bear", 300}, Case{"cgal:bear", 500}),
                          case_name);
 
+// Evenness on a real mesh with thin features (libcgal-demo's triceratops: 1.2 % of its area thinner
+// than the spacing at these counts), where rho, the closest pair over d_hex, is decided by one pair and
+// so by the seed: issue 43's fall at one seed was such a draw (docs/benchmarks/sampler.md, "Evenness on
+// triceratops"). Over three seeds the median must stay at 0.70 or above and no seed may fall to the
+// crowded-pair floor (0.6 spacing): 7fd726d's sampler, on the hardware-filtered dense field, gave
+// 0.608, 0.617 and 0.611 here; today's 0.725, 0.743, 0.748. CPU path, no GL context: seconds.
+TEST(SampleMesh, EvennessOnAThinFeaturedCgalMeshHoldsAcrossSeeds) {
+  const TriangleMesh mesh = load_mesh(test::cgal_mesh("triceratops"));
+  const double area = surface_area(mesh);
+  std::vector<double> rhos;
+  for (const std::uint64_t seed : {1u, 2u, 3u}) {
+    SampleSettings settings;
+    settings.count = 4000;
+    settings.seed = seed;
+    settings.probes = 100'000;  // the statistical figure only; rho does not depend on it
+    settings.backend = gpu::Backend::Cpu;
+    const SampleResult result = sample_mesh(nullptr, mesh, settings);
+    std::vector<Eigen::Vector3d> points;
+    for (const auto& p : result.body.positions) points.push_back(p.cast<double>());
+    const SpacingStatistics spacing = spacing_statistics(area, points);  // measured here, not reported
+    std::printf("  seed %llu: rho %.4f, CV %.4f, %d iterations\n", static_cast<unsigned long long>(seed),
+                spacing.relative_radius, spacing.cv_nn, result.body.quality.iterations);
+    EXPECT_GE(spacing.relative_radius, 0.6) << "seed " << seed;
+    EXPECT_LE(spacing.cv_nn, 0.05) << "seed " << seed;
+    rhos.push_back(spacing.relative_radius);
+  }
+  std::sort(rhos.begin(), rhos.end());
+  EXPECT_GE(rhos[1], 0.70);  // the median
+}
+
 // An open mesh under winding-number signs: elephant-with-holes is the closed elephant with 106
 // holes cut. Its particles must sit on its surface, their normals point out of the closed elephant,
 // and its mass properties (winding-number solid) be close to the closed elephant's (tolerances as
