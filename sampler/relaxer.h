@@ -32,10 +32,12 @@ struct RelaxSettings {
   // steps between make none. See docs/architecture.md for the measured cost of the check.
   int check_every = 10;
   // Converged when the mean gradient step of the mobile particles (gain * tangential repulsion minus
-  // phi n, the move plain descent would make) is below tolerance * spacing. Measured floor: 1.9e-4 to
-  // 2.5e-4 on llvmpipe (sphere, torus, trefoil, bunny), set by the 8-bit weights of hardware trilinear
-  // filtering that tilt the tangent plane; rho and CV stop changing well above it (bunny, 1000
-  // particles: rho 0.68, CV 0.042-0.044 from 200 to 1000 steps).
+  // phi n, the move plain descent would make) is below tolerance * spacing. The floor was measured at
+  // 1.9e-4 to 2.5e-4 on llvmpipe (sphere, torus, trefoil, bunny) when the field was a dense texture read
+  // through hardware trilinear filtering, whose 8-bit weights tilt the tangent plane; since cfe0017 the
+  // field is read in full float and the floor has not been measured again. rho and CV stop changing well
+  // above the tolerance (bunny, 1000 particles: rho 0.68, CV 0.042-0.044 from 200 to 1000 steps), and a
+  // 4x looser one visibly cuts evenness (SampleMesh.EvennessOnAThinFeaturedCgalMeshHoldsAcrossSeeds).
   double tolerance = 5e-4;
   int projection_steps = 4;  // final p <- p - phi grad(phi) iterations
 };

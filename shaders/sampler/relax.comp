@@ -26,9 +26,9 @@ layout(std430, binding = TS_GRID_CELL_COUNT) readonly buffer CellCount { uint ce
 layout(std430, binding = TS_SAMPLER_VELOCITIES) buffer Velocities { vec4 velocity[]; };  // xyz: momentum step [m], own entry only
 layout(std430, binding = TS_GRID_CELL_START) readonly buffer CellStart { uint cell_start[]; };
 layout(std430, binding = TS_GRID_SORTED) readonly buffer Sorted { uint sorted_ids[]; };
-// x: |tangential gradient step| [m] (the residual; 0 if frozen; the normal term is left out because
-// hardware trilinear filtering quantises phi to a fraction of a voxel, a floor that says nothing about
-// the arrangement, and the exact projection fixes the normal position afterwards), y: |phi| [m], z: 1 if outside the band, w: 1 if mobile
+// x: |tangential gradient step| [m] (the residual; 0 if frozen; the normal term is left out because it
+// measures the distance to the surface, not the arrangement, and the exact projection fixes the normal
+// position afterwards), y: |phi| [m], z: 1 if outside the band, w: 1 if mobile
 layout(std430, binding = TS_SAMPLER_STEP_INFO) writeonly buffer StepInfo { vec4 step_info[]; };
 
 #include "common/params.h"
