@@ -9,11 +9,13 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "core/mesh_io.h"
 #include "gpu/context.h"
 #include "gpu/gl.h"
@@ -191,6 +193,25 @@ TEST(LeafFieldBound, CoversTheBandLeavesWithoutFarOverestimating) {
   EXPECT_EQ(result.field->slots(), bound);
   EXPECT_LE(result.field->band_leaves(), bound);
   EXPECT_LT(static_cast<double>(bound), 2.0 * static_cast<double>(result.field->band_leaves()));
+}
+
+// TETRASAND_GPU_MEMORY_MIB caps what a field may take (so a test meets the out-of-memory refusal on
+// llvmpipe); a value that is not a positive number of MiB is the user's error, named as such.
+TEST(LeafFieldMemory, TheCapFromTheEnvironmentIsInMibAndNonsenseIsRefused) {
+  ::setenv("TETRASAND_GPU_MEMORY_MIB", "0.5", 1);
+  const std::size_t half = gpu_field_memory_limit();
+  std::string refused;
+  for (const char* bad : {"abc", "-2", "0", "12MiB", "nan"}) {
+    ::setenv("TETRASAND_GPU_MEMORY_MIB", bad, 1);
+    try {
+      gpu_field_memory_limit();
+    } catch (const InputError& e) {
+      if (std::string(e.what()).find("TETRASAND_GPU_MEMORY_MIB") != std::string::npos) refused += bad;
+    }
+  }
+  ::unsetenv("TETRASAND_GPU_MEMORY_MIB");
+  EXPECT_EQ(half, std::size_t{1} << 19);
+  EXPECT_EQ(refused, "abc-2012MiBnan");
 }
 
 }  // namespace
