@@ -12,8 +12,8 @@
 #include "gpu/hash_grid.h"
 #include "gpu/host_sync.h"
 #include "sampler/relaxer.h"
-#include "sdf/scan_convert.h"
 #include "sdf/gpu_field.h"
+#include "sdf/scan_convert.h"
 #include "sdf/sparse_field.h"
 
 namespace ts::sampler {
