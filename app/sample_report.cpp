@@ -133,8 +133,10 @@ void print_stage_table(const sampler::SampleResult& result, const CommandSeconds
       {"GPU context creation", c.context},
       {"mesh load and checks", c.load},
       {"plan: exact-distance tree, sizing, mass", t.plan},
-      {fmt::format("SDF: {}, NanoVDB{}", sdf_path_words(result.sdf_path).stage,
-                   result.relax_on_cpu ? "" : ", upload"),
+      {result.field.gpu_resident
+           ? fmt::format("SDF: {}, kept on the GPU", sdf_path_words(result.sdf_path).stage)
+           : fmt::format("SDF: {}, NanoVDB{}", sdf_path_words(result.sdf_path).stage,
+                         result.relax_on_cpu ? "" : ", upload"),
        t.sdf},
       {"seeds, programs and buffers", t.setup},
       {"relaxation (all rounds)", t.relaxation},
@@ -168,6 +170,14 @@ nlohmann::json run_json(const sampler::SampleResult& result, const CommandSecond
           {"certificate_backend", result.certificate_on_cpu ? "cpu" : "gpu"},
           {"probes", result.probes},
           {"certificate_passes", result.certificate_passes},
+          // The field between the scan and the relaxation: readback_bytes counts field bytes only (the
+          // band read back for the host's level set), not the few counters a scan reads besides.
+          {"sdf",
+           {{"band_voxels", result.field.band_voxels},
+            {"gpu_bytes", result.field.gpu_bytes},
+            {"host_bytes", result.field.host_bytes},
+            {"readback_bytes", result.field.readback_bytes},
+            {"gpu_resident", result.field.gpu_resident}}},
           {"seconds",
            {{"context", c.context},
             {"load", c.load},

@@ -10,24 +10,31 @@
 
 namespace ts::sampler {
 
-GpuRelaxer::GpuRelaxer(gpu::Context& context, sdf::SparseField field, bool timings)
-    : context_(context),
-      spec_(field.spec()),
-      field_(std::move(field)),
-      queue_(timings, context.debug()),
-      relax_(gpu::Program::compute(library_, "sampler/relax.comp", field_.shader_defines())),
-      project_(gpu::Program::compute(library_, "sampler/project.comp", field_.shader_defines())),
-      reduce_(gpu::Program::compute(library_, "sampler/reduce_steps.comp")),
-      grid_(library_) {
-  if (field_.empty()) throw Error(ExitCode::Internal, "GpuRelaxer needs an uploaded sdf::SparseField");
+namespace {
+
+const sdf::GpuField& required(const std::unique_ptr<const sdf::GpuField>& field) {
+  if (!field || field->empty()) throw Error(ExitCode::Internal, "GpuRelaxer needs a field on the GPU");
+  return *field;
 }
 
+}  // namespace
+
+GpuRelaxer::GpuRelaxer(gpu::Context& context, std::unique_ptr<const sdf::GpuField> field, bool timings)
+    : context_(context),
+      spec_(required(field).spec()),
+      field_(std::move(field)),
+      queue_(timings, context.debug()),
+      relax_(gpu::Program::compute(library_, "sampler/relax.comp", field_->shader_defines())),
+      project_(gpu::Program::compute(library_, "sampler/project.comp", field_->shader_defines())),
+      reduce_(gpu::Program::compute(library_, "sampler/reduce_steps.comp")),
+      grid_(library_) {}
+
 std::size_t GpuRelaxer::gpu_bytes() const {
-  return field_.gpu_bytes() + positions_[0].bytes() * 2 + step_info_.bytes() + partials_.bytes() + grid_.bytes();
+  return field_->gpu_bytes() + positions_[0].bytes() * 2 + step_info_.bytes() + partials_.bytes() + grid_.bytes();
 }
 
 void GpuRelaxer::bind_sdf() const {
-  field_.bind({TS_SAMPLER_SPARSE_FIELD,
+  field_->bind({TS_SAMPLER_SPARSE_FIELD,
                {TS_SAMPLER_FIELD_CHUNK_1, TS_SAMPLER_FIELD_CHUNK_2, TS_SAMPLER_FIELD_CHUNK_3, TS_SAMPLER_FIELD_CHUNK_4,
                 TS_SAMPLER_FIELD_CHUNK_5, TS_SAMPLER_FIELD_CHUNK_6, TS_SAMPLER_FIELD_CHUNK_7},
                TS_SAMPLER_FIELD_PARAMS, TS_SAMPLER_FIELD_ROOTS});

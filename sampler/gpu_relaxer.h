@@ -3,6 +3,7 @@
 // level set of the sparse SDF on the GPU, neighbours from a hashed grid rebuilt every step (thesis
 // 6.3). sampler/cpu_relaxer.h is the same algorithm on the CPU.
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "gpu/hash_grid.h"
 #include "gpu/host_sync.h"
 #include "sampler/relaxer.h"
+#include "sdf/gpu_field.h"
 #include "sdf/scan_convert.h"
 #include "sdf/sparse_field.h"
 
@@ -18,9 +20,12 @@ namespace ts::sampler {
 
 class GpuRelaxer final : public ParticleRelaxer {
  public:
-  // Takes the sparse SDF already on the GPU (sdf::SparseField: trilinear distance, central-difference
-  // gradient); nothing is uploaded.
-  GpuRelaxer(gpu::Context& context, sdf::SparseField field, bool timings = false);
+  // Takes the SDF already on the GPU (sdf::SparseField uploaded from the host, or sdf::LeafField built
+  // there by the scan conversion: trilinear distance, central-difference gradient, the same reads);
+  // nothing is uploaded.
+  GpuRelaxer(gpu::Context& context, std::unique_ptr<const sdf::GpuField> field, bool timings = false);
+  GpuRelaxer(gpu::Context& context, sdf::SparseField field, bool timings = false)
+      : GpuRelaxer(context, std::make_unique<const sdf::SparseField>(std::move(field)), timings) {}
   GpuRelaxer(const GpuRelaxer&) = delete;
   GpuRelaxer& operator=(const GpuRelaxer&) = delete;
 
@@ -44,7 +49,7 @@ class GpuRelaxer final : public ParticleRelaxer {
   StepSums check(std::uint32_t count);
   gpu::Context& context_;
   sdf::GridSpec spec_;
-  sdf::SparseField field_;
+  std::unique_ptr<const sdf::GpuField> field_;
   gpu::ShaderLibrary library_;
   gpu::Queue queue_;
   gpu::Program relax_, project_, reduce_;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -30,6 +31,7 @@
 #include "sdf/exact_sdf.h"
 #include "sdf/grid.h"
 #include "sdf/host_field.h"
+#include "sdf/leaf_field.h"
 #include "sdf/openvdb_compare.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
@@ -241,7 +243,8 @@ SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& e
 // A sparse field above --sdf-budget-mib: its bytes grow as the band's area, ~ 1 / voxel^2, so the
 // voxel that fits is h sqrt(bytes / budget), and with the voxel following the radius the particle
 // count that fits is N budget / bytes.
-[[noreturn]] void throw_over_budget(const sdf::GridSpec& spec, std::size_t bytes, std::size_t band_voxels,
+// `size`: the field's size in words ("N band voxels").
+[[noreturn]] void throw_over_budget(const sdf::GridSpec& spec, std::size_t bytes, const std::string& size,
                                     const SamplingPlan& plan, const SampleSettings& settings,
                                     const char* where) {
   const double over = static_cast<double>(bytes) / static_cast<double>(settings.max_sdf_bytes);
@@ -250,9 +253,9 @@ SamplingPlan plan_sampling(const TriangleMesh& mesh, const sdf::ExactDistance& e
           ? fmt::format("a --voxel of at least {:.4g} m fits it", spec.voxel_size * std::sqrt(over))
           : fmt::format("about {:.0f} particles fit it", static_cast<double>(plan.z.count) / over);
   throw InputError(fmt::format(
-      "the sparse SDF at voxel {:.4g} m ({} band voxels) needs {:.1f} MiB of {} memory, above "
+      "the sparse SDF at voxel {:.4g} m ({}) needs {:.1f} MiB of {} memory, above "
       "the budget of {} MiB (--sdf-budget-mib); {}, or raise the budget",
-      spec.voxel_size, band_voxels, bytes / 1048576.0, where, settings.max_sdf_bytes >> 20, remedy));
+      spec.voxel_size, size, bytes / 1048576.0, where, settings.max_sdf_bytes >> 20, remedy));
 }
 
 bool relax_on_cpu(const gpu::Context* context, const SampleSettings& settings) {
@@ -298,21 +301,98 @@ openvdb::FloatGrid::Ptr band_level_set(gpu::Context* context, const TriangleMesh
   return converted.grid;
 }
 
-// The SDF for the relaxation: the band as an index-space level set (any voxel size), a sparse NanoVDB
-// field, uploaded for the GPU relaxation or kept on the host for the CPU's. The field's size is
-// checked against the budget first; it grows as the particle count (band voxels ~ area / voxel^2 ~ count).
-using RelaxField = std::variant<sdf::SparseField, sdf::HostField>;
+// The finest grid whose GPU field fits `limit` bytes, coarsening `spec`'s voxel from the square law
+// (the band's leaves grow as 1 / voxel^2) in steps of 2 %; an empty spec when none does.
+sdf::GridSpec largest_fitting_grid(const TriangleMesh& mesh, const SamplingPlan& plan, const SampleSettings& settings,
+                                   const sdf::GridSpec& spec, std::size_t bytes, std::size_t limit) {
+  SampleSettings coarser = settings;
+  coarser.voxel_size = spec.voxel_size * std::max(1.0, 0.9 * std::sqrt(static_cast<double>(bytes) / limit));
+  for (int step = 0; step < 500; ++step, coarser.voxel_size *= 1.02) {
+    const sdf::GridSpec fitting = choose_grid(mesh, plan.z.radius, coarser);
+    if (sdf::leaf_field_bytes(fitting, sdf::band_leaf_bound(mesh, fitting, kBandVoxels)) <= limit) return fitting;
+  }
+  return {};
+}
+
+// A GPU field of `bytes` above the GPU memory `limit`: exit 3 before any GPU work, naming the finest
+// grid that fits.
+[[noreturn]] void throw_over_gpu_memory(const TriangleMesh& mesh, const SamplingPlan& plan,
+                                        const SampleSettings& settings, const sdf::GridSpec& spec, std::size_t bytes,
+                                        std::size_t limit) {
+  const sdf::GridSpec fits = largest_fitting_grid(mesh, plan, settings, spec, bytes, limit);
+  const std::string what =
+      fits.voxel_size > 0.0
+          ? fmt::format("the largest resolution that fits is a voxel of {:.4g} m ({} x {} x {} voxels): --voxel {:.4g}",
+                        fits.voxel_size, fits.dims.x(), fits.dims.y(), fits.dims.z(), fits.voxel_size)
+          : std::string("no resolution fits");
+  throw GpuError(fmt::format("the SDF on the GPU at voxel {:.4g} m ({} x {} x {} voxels) needs up to {:.1f} MiB, above "
+                             "the {:.1f} MiB of GPU memory it may take{}; {}",
+                             spec.voxel_size, spec.dims.x(), spec.dims.y(), spec.dims.z(), bytes / 1048576.0,
+                             limit / 1048576.0,
+                             std::getenv("TETRASAND_GPU_MEMORY_MIB") ? " (TETRASAND_GPU_MEMORY_MIB)" : "", what));
+}
+
+// The GPU path's field (sdf::LeafField): scan-converted on the GPU and kept there, no host round trip
+// and no byte of it read back. Sized before any GPU work from the band's leaf bound: above the budget
+// or the GPU's memory it stops; past one storage block (the leaf field's limit; llvmpipe's 128 MiB) it
+// gives way to the host path (std::nullopt), whose NanoVDB field is cut into chunks.
+std::optional<sdf::LeafField> resident_field(gpu::Context& context, const TriangleMesh& mesh, const sdf::GridSpec& spec,
+                                             const SamplingPlan& plan, const SampleSettings& settings,
+                                             SampleResult& result) {
+  const std::size_t slots = sdf::band_leaf_bound(mesh, spec, kBandVoxels);
+  const std::size_t bytes = sdf::leaf_field_bytes(spec, slots);
+  if (bytes > settings.max_sdf_bytes) {
+    throw_over_budget(spec, bytes, fmt::format("up to {} leaves of 8^3 voxels", slots), plan, settings, "GPU");
+  }
+  if (const std::size_t limit = sdf::gpu_field_memory_limit(); limit > 0 && bytes > limit) {
+    throw_over_gpu_memory(mesh, plan, settings, spec, bytes, limit);
+  }
+  if (static_cast<double>(slots * sdf::kLeafBytes) > static_cast<double>(context.limits().max_ssbo_bytes)) {
+    log::info("the GPU field ({} leaves) passes one storage block: the field goes through the host", slots);
+    return std::nullopt;
+  }
+  sdf::ScanConvertOptions scan;
+  scan.method = settings.scan;
+  scan.band = kBandVoxels;
+  scan.build_grid = false;
+  scan.gpu_field = true;
+  scan.gpu_field_slots = slots;
+  scan.timings = settings.timings;
+  sdf::ScanConvertResult converted = sdf::scan_convert(context, mesh, sdf::compute_pseudonormals(mesh), spec, scan);
+  FieldStats& f = result.field;
+  f.band_voxels = converted.stats.band_voxels;
+  f.scan = converted.stats.method;
+  f.readback_bytes = converted.stats.readback_bytes;
+  f.scan_peak_gpu_bytes = converted.stats.peak_gpu_bytes;
+  f.gpu_bytes = converted.field->gpu_bytes();
+  f.host_bytes = 0;
+  f.gpu_resident = true;
+  result.timing_report = converted.stats.timing_report;
+  return std::move(converted.field);
+}
+
+// The SDF for the relaxation. On the GPU path, the field built and kept on the GPU (resident_field).
+// Else the band as an index-space level set (any voxel size), a sparse NanoVDB field, uploaded for the
+// GPU relaxation or kept on the host for the CPU's. The field's size is checked against the budget
+// first; it grows as the particle count (band voxels ~ area / voxel^2 ~ count).
+using RelaxField = std::variant<sdf::SparseField, sdf::HostField, sdf::LeafField>;
 RelaxField make_field(gpu::Context* context, const TriangleMesh& mesh, const sdf::ExactDistance& exact,
                       const sdf::GridSpec& spec, const SamplingPlan& plan, const SampleSettings& settings,
                       SampleResult& result) {
   result.sdf_path = choose_sdf_path(context, settings);
+  if (result.sdf_path == SdfPath::Scan && !result.relax_on_cpu) {
+    std::optional<sdf::LeafField> resident =
+        resident_field(needed_context(context, "the GPU scan conversion"), mesh, spec, plan, settings, result);
+    if (resident) return std::move(*resident);
+  }
   const openvdb::FloatGrid::Ptr grid = band_level_set(context, mesh, exact, spec, settings, result);
   // CPU and GPU read the same grid, in the level set's own index space.
   sdf::NanoGrid nano = sdf::to_nanovdb(*grid);
   FieldStats& f = result.field;
   f.host_bytes = grid->memUsage() + nano.size();
   if (nano.size() > settings.max_sdf_bytes) {
-    throw_over_budget(spec, nano.size(), f.band_voxels, plan, settings, result.relax_on_cpu ? "host" : "GPU");
+    throw_over_budget(spec, nano.size(), fmt::format("{} band voxels", f.band_voxels), plan, settings,
+                      result.relax_on_cpu ? "host" : "GPU");
   }
   if (result.relax_on_cpu) return sdf::HostField(std::move(nano), spec, kBandVoxels);
   needed_context(context, "the GPU relaxation");
@@ -323,6 +403,9 @@ RelaxField make_field(gpu::Context* context, const TriangleMesh& mesh, const sdf
 
 std::unique_ptr<ParticleRelaxer> make_relaxer(gpu::Context* context, RelaxField field, bool timings) {
   if (auto* host = std::get_if<sdf::HostField>(&field)) return std::make_unique<CpuRelaxer>(std::move(*host));
+  if (auto* leaves = std::get_if<sdf::LeafField>(&field)) {
+    return std::make_unique<GpuRelaxer>(*context, std::make_unique<const sdf::LeafField>(std::move(*leaves)), timings);
+  }
   return std::make_unique<GpuRelaxer>(*context, std::move(std::get<sdf::SparseField>(field)), timings);
 }
 

@@ -121,9 +121,11 @@ inline constexpr std::size_t kReportedHoles = 20;
 struct FieldStats {
   std::size_t band_voxels = 0;          // voxels with |d| < band
   sdf::ScanMethod scan = sdf::ScanMethod::Geometry;  // the scan conversion's method (SdfPath::Scan)
-  std::size_t gpu_bytes = 0;            // the NanoVDB grid on the GPU
+  std::size_t gpu_bytes = 0;            // the field on the GPU (the leaf field, or the uploaded NanoVDB grid)
+  bool gpu_resident = false;            // built and kept on the GPU by the scan (sdf::LeafField): no round trip
   std::size_t host_bytes = 0;           // the OpenVDB level set and the NanoVDB grid on the host, at their peak
-  std::size_t readback_bytes = 0;       // GPU -> host during scan conversion (the compacted band)
+  std::size_t readback_bytes = 0;       // field bytes GPU -> host between the scan and the relaxation (the
+                                        // compacted band on the host path; 0 on the GPU-resident one)
   std::size_t scan_peak_gpu_bytes = 0;  // scan conversion's slab target and buffers
 };
 

@@ -267,6 +267,17 @@ int choose_slab_layers(const GridSpec& spec, std::size_t per_layer, std::size_t 
   return wanted >= kLayersPerDraw ? wanted / kLayersPerDraw * kLayersPerDraw : wanted;
 }
 
+// The GPU field builds whole leaf rows per slab (sdf/leaf_field.h): slabs of a multiple of 8 layers,
+// unless one slab holds the grid.
+int whole_leaf_rows(int layers, int dims_z) {
+  if (layers >= dims_z) return layers;
+  if (layers < kLeafSide) {
+    throw GpuError(fmt::format("the GPU field needs slabs of at least {} z-layers and this GPU holds {}; use a "
+                               "larger voxel size", kLeafSide, layers));
+  }
+  return layers / kLeafSide * kLeafSide;
+}
+
 // Everything the slab loop needs that the CPU decides before the GPU is touched.
 struct ScanPlan {
   ScanMethod method = ScanMethod::Geometry;
@@ -297,6 +308,7 @@ ScanPlan plan_scan(std::size_t max_items, int max_layers, int brick, const Trian
                                              static_cast<std::size_t>(spec.dims.y())
                                        : 0);
   plan.slab_layers = choose_slab_layers(spec, per_layer, options.max_slab_bytes, max_items, max_layers);
+  if (options.gpu_field) plan.slab_layers = whole_leaf_rows(plan.slab_layers, spec.dims.z());
   plan.block = std::min(kLayersPerDraw, plan.slab_layers);
   // The same margin as the prisms: the pairs reach every voxel a prism would.
   if (compute) {
@@ -336,7 +348,8 @@ class SlabScanner {
   void count_pipeline() { pipeline_ = std::make_unique<gpu::PipelineStatistics>(); }
   // What was counted, with the invocations the draws asked for; measured false when nothing was.
   ScanPipelineWork pipeline_work() const;
-  std::size_t readback_bytes() const { return readback_bytes_; }  // host traffic so far
+  std::size_t readback_bytes() const { return readback_bytes_; }  // field bytes read back so far
+  const gpu::Texture& slab() const { return target_.color; }       // the filled slab (after draw)
 
  private:
   const GridSpec& spec_;
@@ -482,7 +495,8 @@ SlabScanner::Band SlabScanner::read_band(int layers, float band) {
     band_indices_.download(index_words_.data(), count * sizeof(std::uint32_t));
     band_values_.download(band_values_host_.data(), count * 4 * sizeof(float));
   });
-  readback_bytes_ += 8 + count * (sizeof(std::uint32_t) + 4 * sizeof(float));
+  // Field bytes only: the two counts read above are not the field.
+  readback_bytes_ += count * (sizeof(std::uint32_t) + 4 * sizeof(float));
   band_slab_indices_.assign(index_words_.begin(), index_words_.end());
   return {band_slab_indices_, band_values_host_};
 }
@@ -595,22 +609,29 @@ double seconds_since(Clock::time_point start) {
 // Draws, reads back and hands on each slab in z order. stats.gpu_seconds gets the time spent
 // drawing and reading back (the read-back is split off by the caller), stats.host_build_seconds the
 // time spent handing slabs on.
+// `leaves`, when not null, builds the GPU field from each slab on the GPU; the band is read back only
+// for the host outputs.
 void scan_slabs(SlabScanner& scanner, const std::vector<std::unique_ptr<SlabConsumer>>& outputs,
-                const GridSpec& spec, const ScanConvertOptions& options, bool check_errors,
-                ScanConvertStats& stats) {
+                LeafFieldBuilder* leaves, const GridSpec& spec, const ScanConvertOptions& options,
+                bool check_errors, ScanConvertStats& stats) {
   const float band = static_cast<float>(options.band);
   for (int z0 = 0; z0 < spec.dims.z(); z0 += stats.layers_per_slab) {
     const int layers = std::min(stats.layers_per_slab, spec.dims.z() - z0);
     auto lap = Clock::now();
     stats.draws += scanner.draw(z0, layers);
-    const SlabScanner::Band voxels = scanner.read_band(layers, band);
-    stats.gpu_seconds += seconds_since(lap);
-    lap = Clock::now();
-    const Slab slab{spec, z0, layers, voxels.indices, voxels.values};
-    for (const auto& output : outputs) output->consume(slab);
-    stats.host_build_seconds += seconds_since(lap);
-    if (check_errors) gpu::check_gl("SDF scan conversion (shaders sdf/scan_*, sdf/band_*.comp)");
-    stats.band_voxels += voxels.indices.size();
+    if (leaves) leaves->add_slab(scanner.slab(), z0, layers);
+    if (!outputs.empty()) {
+      const SlabScanner::Band voxels = scanner.read_band(layers, band);
+      stats.gpu_seconds += seconds_since(lap);
+      lap = Clock::now();
+      const Slab slab{spec, z0, layers, voxels.indices, voxels.values};
+      for (const auto& output : outputs) output->consume(slab);
+      stats.host_build_seconds += seconds_since(lap);
+      stats.band_voxels += voxels.indices.size();
+    } else {
+      stats.gpu_seconds += seconds_since(lap);
+    }
+    if (check_errors) gpu::check_gl("SDF scan conversion (shaders sdf/scan_*, sdf/band_*.comp, sdf/leaf_*.comp)");
     ++stats.slabs;
     if (options.progress) options.progress(static_cast<double>(z0 + layers) / spec.dims.z());
   }
@@ -673,8 +694,21 @@ ScanConvertResult scan_convert(gpu::Context& context, const TriangleMesh& mesh, 
   stats.degenerate_triangles = plan.geometry.degenerate;
   stats.needle_triangles = plan.geometry.needles;
   const auto outputs = make_outputs(spec, options, result);
-  scan_slabs(scanner, outputs, spec, options, queue.checks_errors(), stats);
-  stats.peak_gpu_bytes = scanner.gpu_bytes();
+  std::optional<LeafFieldBuilder> leaves;
+  if (options.gpu_field) {
+    result.field.emplace(spec, options.band,
+                         options.gpu_field_slots > 0 ? options.gpu_field_slots
+                                                     : band_leaf_bound(mesh, spec, options.band));
+    leaves.emplace(library, queue, *result.field);
+  }
+  scan_slabs(scanner, outputs, leaves ? &*leaves : nullptr, spec, options, queue.checks_errors(), stats);
+  stats.peak_gpu_bytes = scanner.gpu_bytes() + (leaves ? leaves->gpu_bytes() + result.field->gpu_bytes() : 0);
+  if (leaves) {
+    const auto finishing = Clock::now();
+    leaves->finish();
+    stats.gpu_seconds += seconds_since(finishing);
+    if (outputs.empty()) stats.band_voxels = result.field->band_voxels();
+  }
   stats.readback_bytes = scanner.readback_bytes();
   stats.brick_pairs = scanner.brick_pairs_run();
   stats.pipeline = scanner.pipeline_work();

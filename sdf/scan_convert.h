@@ -10,12 +10,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/mesh.h"
 #include "gpu/context.h"
 #include "sdf/grid.h"
+#include "sdf/leaf_field.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/settings.h"
 
@@ -36,6 +38,12 @@ struct ScanConvertOptions {
   // kMinVdbVoxelSize), or index space (voxel size 1, values still in world units: any voxel size,
   // for a GPU field built in the same process, sdf::SparseField).
   bool index_space_grid = false;
+  // The field as the GPU's kernels read it, built and kept on the GPU from each filled slab
+  // (sdf::LeafField): nothing of it is read back. With build_grid and keep_dense false the band is
+  // not read back at all. Slabs then hold a multiple of 8 layers.
+  bool gpu_field = false;
+  std::size_t gpu_field_slots = 0;  // leaf slots to allocate; 0: band_leaf_bound of the mesh
+
   std::function<void(double fraction_done)> progress;  // called after each slab
 };
 
@@ -59,7 +67,8 @@ struct ScanConvertStats {
   std::size_t brick_pairs = 0;         // compute path: triangle/brick pairs (sdf/compute_scan.h)
   std::size_t peak_gpu_bytes = 0;      // render target, geometry and band-compaction buffers
   std::size_t band_voxels = 0;         // voxels with |d| < band written to the grid
-  std::size_t readback_bytes = 0;      // GPU -> host traffic: the compacted band (20 bytes a voxel) and counts
+  std::size_t readback_bytes = 0;      // field bytes GPU -> host: the compacted band (20 bytes a voxel) when
+                                       // a host output asks for it; the counts read besides are not counted
   std::size_t degenerate_triangles = 0;  // zero area: skipped, their edges belong to their neighbours
   std::size_t needle_triangles = 0;      // slivers bounded by an in-plane rectangle instead of a miter
   double seconds = 0.0;                  // the whole call
@@ -84,6 +93,7 @@ struct ScanConvertResult {
   openvdb::FloatGrid::Ptr grid;  // level set in world units, background = band * voxel_size (if build_grid)
   ScanConvertStats stats;
   DenseSdf dense;                // only when options.keep_dense
+  std::optional<LeafField> field;  // only when options.gpu_field
 };
 
 // Requires a current context (gpu::Context). Throws GpuError when the GPU cannot hold one layer.

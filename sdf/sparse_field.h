@@ -21,6 +21,7 @@
 #include "gpu/gl.h"
 #include "gpu/layouts.h"
 #include "gpu/params.h"
+#include "sdf/gpu_field.h"
 #include "sdf/grid.h"
 
 namespace ts::sdf {
@@ -49,19 +50,7 @@ struct GpuRootTable {
 inline constexpr std::size_t kMaxRootTableEntries = std::size_t{1} << 20;
 GpuRootTable gpu_root_table(const nanovdb::FloatGrid& grid);
 
-// At most this many storage blocks hold one field (shaders/common/sparse_field.glsl): 1 GiB on
-// llvmpipe's 128 MiB blocks. A kernel reads the field through chunk 0's slot and 7 more its stage names.
-inline constexpr int kMaxFieldChunks = 8;
-
-// Where a stage binds the field: chunk 0's slot and the slots of chunks 1-7 (shaders/<stage>/bindings.h).
-struct FieldSlots {
-  GLuint first = 0;
-  std::array<GLuint, kMaxFieldChunks - 1> more{};
-  GLuint params = 0;  // uniform-block slot of its gpu::params::FieldParams
-  GLuint roots = 0;   // slot of its root table (gpu_root_table)
-};
-
-class SparseField {
+class SparseField final : public GpuField {
  public:
   SparseField() = default;
   // `level_set`: a float level set whose index space is `spec`'s (voxel (i, j, k) of the spec at
@@ -74,24 +63,24 @@ class SparseField {
   // tests pass a small one to cut a small grid into chunks.
   SparseField(NanoGrid grid, const GridSpec& spec, double band_voxels, std::size_t block_bytes = 0);
 
-  const GridSpec& spec() const { return spec_; }
+  const GridSpec& spec() const override { return spec_; }
   double band() const { return band_; }                 // half-width [voxels]
   float background() const { return background_; }      // +-this off the band [world units]
-  bool empty() const { return chunks_.empty(); }
-  std::size_t gpu_bytes() const;
+  bool empty() const override { return chunks_.empty(); }
+  std::size_t gpu_bytes() const override;
   // Storage blocks holding the grid (1 when it fits one), each 2^chunk_shift() words but the last.
   int chunk_count() const { return static_cast<int>(chunks_.size()); }
   int chunk_shift() const { return chunk_shift_; }
   // What a program that reads this field is compiled with (gpu::Program's defines): nothing for one
   // block, else the chunk count and size that shaders/common/sparse_field.glsl branches on. A program
   // compiled for one field reads another only if their defines are equal.
-  std::vector<std::string> shader_defines() const;
+  std::vector<std::string> shader_defines() const override;
   std::size_t band_voxels() const { return band_voxels_; }  // active voxels of the level set
   const NanoGrid& host() const { return host_; }         // the uploaded bytes (tests), in the level set's index space
   const GpuRootTable& root_table() const { return roots_table_; }  // what the root table's buffer holds
 
   // Binds the grid's chunks, its root table and the parameters shaders/common/sparse_field.glsl reads to `slots`.
-  void bind(const FieldSlots& slots) const;
+  void bind(const FieldSlots& slots) const override;
 
  private:
   // Builds and uploads the root table of `grid` (the uploaded one).

@@ -51,6 +51,15 @@ TS_LAYOUT(FieldRootTile) {
                           // z: 1 for a tile of the grid, 0 for one it lacks; w unused
 };
 
+// ---- sdf: the GPU-resident leaf field (sdf::LeafField; common/sparse_field.glsl compiled with
+// TS_FIELD_LEAVES). The grid is cut into 8^3 leaf cells from grid-local voxel (0,0,0); a uint per cell
+// (x fastest, then y, then z) holds the cell's slot in the values (512 floats a slot, world units,
+// x fastest within the leaf) or one of these codes, which lie above any slot (sdf::kMaxLeafSlots).
+#define TS_LEAF_EMPTY 0xfffffffcu    // while building: no band voxel in the cell, its sign not yet known
+#define TS_LEAF_BAND 0xfffffffdu     // while building: a band leaf waiting for its slot
+#define TS_LEAF_INSIDE 0xfffffffeu   // no band voxel, inside: every voxel reads -background
+#define TS_LEAF_OUTSIDE 0xffffffffu  // no band voxel, outside: every voxel reads +background
+
 // ---- sampler: shared constants of one relaxation step.
 TS_LAYOUT(SamplerGrid) {
   vec4 origin_cell;       // xyz: world position of cell (0,0,0)'s corner [m]; w: cell size [m]

@@ -44,9 +44,11 @@ TS_PARAMS(FieldParams) {
   ivec4 index_offset;     // xyz: NanoVDB index of the grid spec's voxel (0,0,0); w: 8, the corners
                           // a chunked field's trilinear read loops over (a count the compiler cannot see)
   vec4 scale;             // x: voxel size [world units]; y: |value| off the band [world units]; zw unused
-  ivec4 root_first;       // xyz: tile index (origin / 4096) of the root table's first entry; w unused
+  ivec4 root_first;       // xyz: tile index (origin / 4096) of the root table's first entry; w unused.
+                          // A leaf field (TS_FIELD_LEAVES): xyz: its leaf cells along x, y, z
   uvec4 roots;            // xyz: extent of the root table's box [root tiles]; w: byte offset of the
-                          // root's background value in the grid (what a coordinate off the box reads)
+                          // root's background value in the grid (what a coordinate off the box reads).
+                          // A leaf field: unused
 };
 
 // ---- sampler/relax.comp: one relaxation step.
@@ -87,6 +89,17 @@ TS_PARAMS(BandParams) {
   ivec4 layer_size;       // xy: voxels along x, y; zw unused
   uvec4 voxels;           // x: layer_size.x * layer_size.y * layers; yzw unused
   vec4 band;              // x: half-width [voxels]; yzw unused
+};
+
+// ---- sdf/leaf_flags.comp, sdf/leaf_assign.comp, sdf/leaf_fill.comp, sdf/leaf_signs.comp: the GPU-resident
+// leaf field built from each finished slab (sdf/leaf_field.h).
+TS_PARAMS(LeafBuildParams) {
+  ivec4 grid;             // xyz: grid dims [voxels]; w: grid z of the slab's layer 0 (a multiple of 8)
+  ivec4 leaves;           // xyz: leaf cells of the grid along x, y, z; w: leaf rows (cells along z) of the slab
+  uvec4 cells;            // x: leaf cells of the slab; y: index of its first cell in the grid's;
+                          // z: leaf slots the values hold; w: which counter holds the slots used so far (0, 1)
+  vec4 band;              // x: half-width [voxels]; y: voxel size [world units]; z: |value| off the band
+                          // [world units]; w unused
 };
 
 // ---- sdf/scan_pairs.comp and sdf/scan_write.comp: the compute scan conversion of one slab

@@ -12,6 +12,37 @@
 // TS_FIELD_PARAMS (defined, like the chunk slots below, before this file is included).
 layout(std140, binding = TS_FIELD_PARAMS) uniform FieldBlock { FieldParams field_params; };
 
+#if defined(TS_FIELD_LEAVES)
+// The GPU-resident leaf field (sdf::LeafField, built by the scan conversion on the GPU; compiled with
+// TS_FIELD_LEAVES, sdf::LeafField::shader_defines): 8^3 leaves from grid-local voxel (0,0,0). The
+// kernel's SparseField block holds the leaves' values (512 floats a slot as uint bits, x fastest), the
+// root table's slot holds the leaf index (a uint per leaf cell, x fastest: slot or TS_LEAF_* code;
+// common/layouts.h), and field_params.root_first.xyz the leaf cells along x, y, z. The same
+// field_voxel/field_trilinear/field_sample as the NanoVDB reader, the same values voxel for voxel.
+#include "common/layouts.h"
+layout(std430, binding = TS_FIELD_ROOTS) readonly buffer FieldLeafIndex { uint field_leaf_index[]; };
+
+struct FieldReader {
+  uint unused;  // no cache: a read is one index load and one value load
+};
+
+FieldReader field_reader() { return FieldReader(0u); }
+
+// The value of grid voxel `g` (grid-local integer coordinates) [world units]; off the band +-background,
+// and +background off the grid (which holds the mesh with a margin: outside).
+float field_voxel(inout FieldReader reader, ivec3 g) {
+  ivec3 cells = field_params.root_first.xyz;
+  ivec3 cell = g >> 3;  // >> of a signed int extends the sign: negative coordinates round down
+  float background = field_params.scale.y;
+  if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, cells))) return background;
+  uint entry = field_leaf_index[(cell.z * cells.y + cell.y) * cells.x + cell.x];
+  if (entry >= TS_LEAF_EMPTY) return entry == TS_LEAF_INSIDE ? -background : background;
+  ivec3 local = g & 7;
+  return uintBitsToFloat(pnanovdb_buf_data[entry * 512u + uint((local.z << 6) | (local.y << 3) | local.x)]);
+}
+
+#else  // the NanoVDB field
+
 // A grid larger than one storage block (llvmpipe's is 128 MiB) is uploaded in chunks of 2^TS_FIELD_CHUNK_SHIFT
 // words, TS_FIELD_CHUNKS of them (sdf::SparseField::shader_defines; at most 8): chunk 0 is the block the
 // kernel declares, chunk c > 0 is bound at TS_FIELD_CHUNK_<c>, a slot the kernel's stage header names.
@@ -197,6 +228,8 @@ float field_voxel(inout FieldReader reader, ivec3 g) {
   pnanovdb_buf_t buf = pnanovdb_buf_t(0u);  // unused by the reads (they read the bound blocks): set, so nothing reads an undefined value
   return pnanovdb_read_float(buf, field_value_address(reader.accessor, g + field_params.index_offset.xyz));
 }
+
+#endif  // TS_FIELD_LEAVES
 
 // Trilinear interpolation at grid-local position `x` [voxels], the same weights in the same order
 // as sdf::sparse_trilinear on the host.

@@ -13,6 +13,11 @@
 //   exclusive scan of the flags (common/scan_*.comp): TS_SCAN_VALUES = the flags, scanned in place
 //   band scatter (band_scatter.comp): texture unit TS_SDF_UNIT_SLAB, buffers TS_SDF_BAND_OFFSETS,
 //     TS_SDF_BAND_INDICES, TS_SDF_BAND_VALUES
+//   leaf field, per slab (sdf/leaf_field.h): leaf_flags.comp: unit TS_SDF_UNIT_SLAB, buffers
+//     TS_SDF_LEAF_INDEX, TS_SDF_LEAF_FLAGS, TS_SDF_LEAF_COUNTS; the exclusive scan of the flags;
+//     leaf_assign.comp: TS_SDF_LEAF_INDEX, TS_SDF_LEAF_FLAGS, TS_SDF_LEAF_COUNTS; leaf_fill.comp: unit
+//     TS_SDF_UNIT_SLAB, buffers TS_SDF_LEAF_INDEX, TS_SDF_LEAF_VALUES; after the last slab
+//     leaf_signs.comp: TS_SDF_LEAF_INDEX, TS_SDF_LEAF_VALUES
 //
 // Each pass binds its slots before it runs, so the passes may share slot numbers.
 #ifndef TETRASAND_SDF_BINDINGS_H
@@ -24,6 +29,7 @@
 #define TS_SDF_SCAN_PARAMS 0     // ScanConvertParams: one entry per draw (gpu::ParamArray)
 #define TS_SDF_BAND_PARAMS 0     // BandParams (band_flags.comp, band_scatter.comp)
 #define TS_SDF_COMPUTE_PARAMS 0  // ComputeScanParams (scan_pairs.comp, scan_write.comp)
+#define TS_SDF_LEAF_PARAMS 0     // LeafBuildParams (leaf_*.comp)
 
 #define TS_SDF_TRIANGLES 0     // SdfTriangle[]: the triangles in grid-local voxel units
 #define TS_SDF_PRISMS 1        // SdfPrism[]: each triangle's bounding prism
@@ -41,5 +47,12 @@
 #define TS_SDF_BAND_OFFSETS 0  // uint per slab voxel: exclusive scan of the flags (the same buffer)
 #define TS_SDF_BAND_INDICES 1  // uint per band voxel: its slab index, ascending
 #define TS_SDF_BAND_VALUES 2   // vec4 per band voxel: its value as the slab holds it
+
+// The leaf field (sdf::LeafField; the codes and the leaf layout in common/layouts.h).
+#define TS_SDF_LEAF_INDEX 0    // uint per leaf cell of the grid: slot or TS_LEAF_* code
+#define TS_SDF_LEAF_FLAGS 1    // uint per leaf cell of the slab: 1 for a band leaf, then scanned in place
+#define TS_SDF_LEAF_VALUES 2   // float[512] per slot: the leaf's values [world units]
+#define TS_SDF_LEAF_COUNTS 3   // uvec4: xy slots used before this slab (alternating, LeafBuildParams.cells.w),
+                               // z band voxels, w 1 once a band leaf found no slot (the bound was wrong)
 
 #endif

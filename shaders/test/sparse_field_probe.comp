@@ -45,7 +45,9 @@ void main() {
   if (i >= params.count.x) return;
   FieldReader reader = field_reader();
   vec3 x = points[i].xyz;
+#if !defined(TS_FIELD_LEAVES)  // a leaf field (sdf::LeafField) has no NanoVDB root: modes 0-2 only
   if (mode == 5) reader.accessor.root.address.byte_offset = 0u;
+#endif
   if (mode == 0 || mode == 5) {
     values[i] = vec4(field_voxel(reader, ivec3(round(x))), 0.0, 0.0, 0.0);
   } else if (mode == 1) {
@@ -53,6 +55,7 @@ void main() {
   } else if (mode == 2) {
     values[i] = field_sample(reader, x);
   } else {
+#if !defined(TS_FIELD_LEAVES)
     pnanovdb_buf_t buf = pnanovdb_buf_t(0u);
     pnanovdb_grid_handle_t grid;
     grid.address.byte_offset = 0u;
@@ -70,5 +73,6 @@ void main() {
                                         PNANOVDB_GRID_TYPE_GET(PNANOVDB_GRID_TYPE_FLOAT, root_tile_size),
                                         uint(field_root_find(ijk))));  // int to uint keeps the bits: -1 is 0xffffffff
     }
+#endif
   }
 }

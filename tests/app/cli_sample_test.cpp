@@ -416,6 +416,75 @@ TEST(CliSample, FillCountsTheInteriorParticlesInTheJsonAndThePly) {
   EXPECT_GE(json.at("particle_count").get<int>(), interior + 140);
 }
 
+// The GPU path builds the field on the GPU and relaxes on it there: no byte of it is read back between
+// the scan and the relaxation, and the body still meets its targets. Relaxing on the CPU takes the
+// field through the host, and says so.
+TEST(CliSample, GpuPathRelaxesOnTheFieldItScannedWithNothingReadBack) {
+  const std::string bunny = quoted(test::asset("bunny.obj"));
+  const auto dir = test::temp_dir();
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("-q sample " + bunny + " -o " + quoted(dir) + " --count 400 --probes 20000 "
+                                "--sdf-backend gpu --backend gpu --json", &out),
+            0)
+      << out;
+  auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
+  const auto& run = json.at("run");
+  EXPECT_EQ(run.at("sdf_backend"), "gpu");
+  EXPECT_EQ(run.at("relax_backend"), "gpu");
+  const auto& sdf = run.at("sdf");
+  EXPECT_EQ(sdf.at("readback_bytes").get<std::size_t>(), 0u) << sdf.dump();
+  EXPECT_TRUE(sdf.at("gpu_resident").get<bool>());
+  EXPECT_EQ(sdf.at("host_bytes").get<std::size_t>(), 0u);
+  EXPECT_GT(sdf.at("band_voxels").get<std::size_t>(), 10000u);
+  EXPECT_GT(sdf.at("gpu_bytes").get<std::size_t>(), 4 * sdf.at("band_voxels").get<std::size_t>());
+  const auto& q = json.at("quality");
+  EXPECT_TRUE(q.at("coverage_certified").get<bool>()) << out;
+  EXPECT_TRUE(q.at("converged").get<bool>()) << out;
+  EXPECT_LT(q.at("max_abs_phi_over_r").get<double>(), 1e-3) << out;
+  // The bunny's ears are thinner than 400 particles resolve (a finding of the mesh, from the exact
+  // distance), so the verdict is the host path's, not "body OK".
+  const std::string verdict = json.at("verdict").get<std::string>();
+  EXPECT_NE(verdict, "not usable") << out;
+
+  ASSERT_EQ(test::run_tetrasand("-q sample " + bunny + " -o " + quoted(test::temp_dir()) + " --count 400 "
+                                "--probes 20000 --sdf-backend gpu --backend cpu --json", &out),
+            0)
+      << out;
+  json = nlohmann::json::parse(out.substr(out.find("{\n")));
+  const auto& host = json.at("run").at("sdf");
+  EXPECT_FALSE(host.at("gpu_resident").get<bool>());
+  EXPECT_EQ(host.at("readback_bytes").get<std::size_t>(), 20 * host.at("band_voxels").get<std::size_t>());
+  EXPECT_EQ(json.at("verdict").get<std::string>(), verdict) << out;
+}
+
+// A field that does not fit the GPU's memory (capped here by TETRASAND_GPU_MEMORY_MIB, so llvmpipe meets
+// it with a small mesh) stops before any work with exit 3, writes nothing, and names the finest voxel
+// that fits, which then runs under the same cap.
+TEST(CliSample, AFieldAboveTheGpuMemoryStopsWithExitThreeNamingTheResolutionThatFits) {
+  const std::string sphere = quoted(test::asset("sphere.obj"));
+  const auto dir = test::temp_dir();
+  ::setenv("TETRASAND_GPU_MEMORY_MIB", "0.25", 1);
+  std::string out;
+  const int code = test::run_tetrasand("sample " + sphere + " -o " + quoted(dir) + kFast +
+                                       "--voxel 0.001 --sdf-backend gpu --backend gpu", &out);
+  const bool wrote_nothing = files_in(dir).empty();  // before the rerun: temp_dir() is one folder a test
+  std::smatch voxel;
+  const bool named = std::regex_search(out, voxel, std::regex(R"(largest resolution that fits is a voxel of [0-9.e-]+ m \(\d+ x \d+ x \d+ voxels\): --voxel ([0-9.e-]+))"));
+  std::string rerun;
+  const auto rerun_dir = dir / "rerun";
+  std::filesystem::create_directories(rerun_dir);
+  const int rerun_code = named ? test::run_tetrasand("sample " + sphere + " -o " + quoted(rerun_dir) + kFast +
+                                                         "--voxel " + voxel[1].str() + " --sdf-backend gpu --backend gpu",
+                                                     &rerun)
+                               : -1;
+  ::unsetenv("TETRASAND_GPU_MEMORY_MIB");
+  EXPECT_EQ(code, 3) << out;
+  EXPECT_TRUE(named) << out;
+  EXPECT_NE(out.find("(TETRASAND_GPU_MEMORY_MIB)"), std::string::npos) << out;
+  EXPECT_TRUE(wrote_nothing);
+  EXPECT_EQ(rerun_code, 0) << rerun;
+}
+
 TEST(CliSample, SdfBudgetCapsTheSparseFieldAndNamesWhatFits) {
   const std::string sphere = quoted(test::asset("sphere.obj"));
   {  // a fine voxel on a 10 cm sphere: about 1M band voxels, ~12 MiB of NanoVDB, refused under 8 MiB

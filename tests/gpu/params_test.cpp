@@ -185,6 +185,15 @@ TEST_F(GpuParams, SdfProgramsMatchCpp) {
   check(compute("sdf/scan_pairs.comp"), {compute_scan});
   check(compute("sdf/scan_pairs.comp", {"NEAREST_TRIANGLE 1"}), {compute_scan});
   check(compute("sdf/scan_write.comp"), {compute_scan});
+  const BlockSpec leaf{"LeafBlock",
+                       sizeof(LeafBuildParams),
+                       {TS_MEMBER(params, LeafBuildParams, grid), TS_MEMBER(params, LeafBuildParams, leaves),
+                        TS_MEMBER(params, LeafBuildParams, cells), TS_MEMBER(params, LeafBuildParams, band)}};
+  for (const char* kernel : {"sdf/leaf_flags.comp", "sdf/leaf_assign.comp", "sdf/leaf_fill.comp", "sdf/leaf_signs.comp"}) {
+    check(compute(kernel), {leaf});
+  }
+  // The sampler's kernels compiled for the GPU-resident leaf field read the same FieldParams.
+  check(compute("sampler/project.comp", {"TS_FIELD_LEAVES 1"}), {item_count("ProjectBlock"), field()});
 }
 
 TEST_F(GpuParams, SimKernelsMatchCppInBothPrecisions) {

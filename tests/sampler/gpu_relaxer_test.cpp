@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <random>
 
+#include "sdf/leaf_field.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/sparse_field.h"
 #include "tests/test_meshes.h"
@@ -157,6 +159,41 @@ TEST_F(Relaxer, AFieldCutIntoChunksRelaxesBitwiseAsOneBlock) {
     moved = std::max(moved, static_cast<double>((a[i] - seeds[i]).norm()));
   }
   EXPECT_GT(moved, 0.01);  // the field and the repulsion did move them
+}
+
+// The field the scan conversion builds and keeps on the GPU (sdf::LeafField) reads voxel for voxel as
+// the host's NanoVDB field from the same scan, so relaxing on it must move the particles exactly as on
+// the uploaded field: the sampler's kernels run unchanged on either.
+TEST_F(Relaxer, AFieldKeptOnTheGpuRelaxesBitwiseAsTheUploadedHostField) {
+  const TriangleMesh sphere = test::icosphere(1.0, 2);
+  const sdf::GridSpec spec = grid_around_sphere(1.0, 0.1, 6);
+  sdf::ScanConvertOptions options;
+  options.index_space_grid = true;
+  options.gpu_field = true;
+  auto field = sdf::scan_convert(context, sphere, sdf::compute_pseudonormals(sphere), spec, options);
+  ASSERT_TRUE(field.field.has_value());
+  GpuRelaxer uploaded(context, sdf::SparseField(*field.grid, spec, options.band));
+  GpuRelaxer resident(context, std::make_unique<const sdf::LeafField>(std::move(*field.field)));
+
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> gauss;
+  std::vector<Eigen::Vector3f> seeds(200);
+  for (auto& p : seeds) p = (Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized() - spec.origin).cast<float>();
+  RelaxSettings settings;
+  settings.spacing = 0.2;
+  settings.band_limit = 0.25;
+  settings.max_iterations = 30;
+  auto a = seeds, b = seeds;
+  const RelaxStats sa = uploaded.relax(a, settings);
+  const RelaxStats sb = resident.relax(b, settings);
+  EXPECT_EQ(sa.iterations, sb.iterations);
+  ASSERT_EQ(a.size(), b.size());
+  double moved = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i], b[i]) << i;
+    moved = std::max(moved, static_cast<double>((a[i] - seeds[i]).norm()));
+  }
+  EXPECT_GT(moved, 0.01);
 }
 
 // Iterations between convergence checks read nothing back; each check reads its reduction once, so
