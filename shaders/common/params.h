@@ -88,6 +88,16 @@ TS_PARAMS(BandParams) {
   vec4 band;              // x: half-width [voxels]; yzw unused
 };
 
+// ---- sdf/brick_pairs.comp: the compute scan conversion's triangle/brick pairs, made on the GPU
+// (sdf/compute_scan.h, BrickPairGenerator).
+TS_PARAMS(BrickPairParams) {
+  ivec4 grid;    // xyz: grid dims [voxels]; w: brick side [voxels]
+  ivec4 bricks;  // xyz: bricks along each axis; w unused
+  uvec4 counts;  // x: triangles; yzw unused
+  vec4 reach;    // x: margin [voxels]; y: half the span of a brick's voxel centres, (brick - 1) / 2;
+                 // z: the squared radius a brick centre may lie from the triangle, (margin + y * sqrt 3)^2
+};
+
 // ---- sdf/scan_pairs.comp and sdf/scan_write.comp: the compute scan conversion of one slab
 // (sdf/compute_scan.h).
 TS_PARAMS(ComputeScanParams) {

@@ -185,6 +185,13 @@ TEST_F(GpuParams, SdfProgramsMatchCpp) {
   check(compute("sdf/scan_pairs.comp"), {compute_scan});
   check(compute("sdf/scan_pairs.comp", {"NEAREST_TRIANGLE 1"}), {compute_scan});
   check(compute("sdf/scan_write.comp"), {compute_scan});
+  const BlockSpec brick_pairs{"BrickPairBlock",
+                              sizeof(BrickPairParams),
+                              {TS_MEMBER(params, BrickPairParams, grid), TS_MEMBER(params, BrickPairParams, bricks),
+                               TS_MEMBER(params, BrickPairParams, counts), TS_MEMBER(params, BrickPairParams, reach)}};
+  for (const char* pass : {"ROW_SPANS 1", "COUNT 1", "SCATTER 1"}) {
+    check(compute("sdf/brick_pairs.comp", {pass}), {brick_pairs});
+  }
 }
 
 TEST_F(GpuParams, SimKernelsMatchCppInBothPrecisions) {
