@@ -22,9 +22,9 @@ enum class ScanMethod { Geometry, Compute };
 inline const char* scan_method_name(ScanMethod method) {
   return method == ScanMethod::Compute ? "compute" : "geometry";
 }
-// The --scan spellings "compute", "geometry" and "auto"; nullopt for any other text. Auto takes
-// Compute: a calibration timed once per renderer and driver that would pick Geometry where the raster
-// hardware makes it faster is not built yet (docs/commands/sdf.md).
+// The --scan spellings "compute", "geometry" and "auto"; nullopt for any other text. Auto reads as
+// Compute here; the commands resolve it first by sdf::choose_scan (sdf/scan_calibration.h), which
+// takes Geometry where a calibration on this renderer and driver found it faster.
 inline std::optional<ScanMethod> parse_scan_method(std::string_view text) {
   if (text == "compute" || text == "auto") return ScanMethod::Compute;
   if (text == "geometry") return ScanMethod::Geometry;

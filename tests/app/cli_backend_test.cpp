@@ -165,14 +165,14 @@ TEST(SdfBackend, NamesTheDeviceAndTheTimeAndTheCpuPathGivesTheSameBand) {
                 "sdf " + bunny + " -o " + quoted(dir / "gpu.vdb") + " --resolution 24 --backend gpu", &gpu),
             0)
       << gpu;
-  EXPECT_NE(
-      gpu.find("backend: gpu, scan conversion by compute shaders (asked for; --scan auto takes compute, no "
-               "per-driver calibration yet)\n"),
-      std::string::npos)
+  // --scan auto: whichever method this device's calibration (sdf/scan_calibration.h) found faster.
+  EXPECT_TRUE(std::regex_search(
+      gpu, std::regex(R"(backend: gpu, scan conversion by (compute shaders|geometry shader) \(asked for; )"
+                      R"(--scan auto: calibrated [0-9.e+]+x geometry's speed(, cached)?\)\n)")))
       << gpu;
   EXPECT_TRUE(std::regex_search(
-      gpu, std::regex(R"(\ndevice: .+ \(device \d+(, software)?\); scan conversion \(compute\) )"
-                      R"(\d+\.\d{3} s\n)")))
+      gpu, std::regex(R"(\ndevice: .+ \(device \d+(, software)?\); scan (compute|geometry) \(calibrated )"
+                      R"([0-9.e+]+x geometry's speed(, cached)?\) \d+\.\d{3} s\n)")))
       << gpu;
   ASSERT_EQ(test::run_tetrasand(
                 "sdf " + bunny + " -o " + quoted(dir / "cpu.vdb") + " --resolution 24 --backend cpu", &cpu),
@@ -216,12 +216,12 @@ TEST(SdfBackend, AutoTakesTheExactCpuPathOnASoftwareDeviceAndSaysSo) {
                 *device + "sdf " + bunny + " -o " + quoted(dir / "gpu.vdb") + " --backend gpu", &out),
             0)
       << out;
-  EXPECT_NE(
-      out.find("backend: gpu, scan conversion by compute shaders (asked for; --scan auto takes compute"),
-      std::string::npos)
+  EXPECT_TRUE(std::regex_search(
+      out, std::regex(R"(backend: gpu, scan conversion by (compute shaders|geometry shader) \(asked for; )"
+                      R"(--scan auto: calibrated )")))
       << out;
   EXPECT_TRUE(std::regex_search(
-      out, std::regex(R"(\ndevice: llvmpipe.*; scan conversion \(compute\) \d+\.\d{3} s\n)")))
+      out, std::regex(R"(\ndevice: llvmpipe.*; scan (compute|geometry) \(calibrated .*\) \d+\.\d{3} s\n)")))
       << out;
 }
 
@@ -239,7 +239,7 @@ TEST(SdfBackend, ScanComputeAndGeometryAreNamedEverywhereAndGiveTheSameBand) {
                 "backend: gpu, scan conversion by compute shaders (asked for; --scan compute asked for)\n"),
             std::string::npos)
       << compute;
-  EXPECT_NE(compute.find("; scan conversion (compute) "), std::string::npos) << compute;
+  EXPECT_NE(compute.find("; scan compute (--scan) "), std::string::npos) << compute;
   ASSERT_EQ(
       test::run_tetrasand("sdf " + bunny + " -o " + quoted(dir / "g.vdb") + common + "geometry", &geometry),
       0)
@@ -248,7 +248,7 @@ TEST(SdfBackend, ScanComputeAndGeometryAreNamedEverywhereAndGiveTheSameBand) {
                 "backend: gpu, scan conversion by geometry shader (asked for; --scan geometry asked for)\n"),
             std::string::npos)
       << geometry;
-  EXPECT_NE(geometry.find("; scan conversion (geometry) "), std::string::npos) << geometry;
+  EXPECT_NE(geometry.find("; scan geometry (--scan) "), std::string::npos) << geometry;
   EXPECT_EQ(band_voxels(compute), band_voxels(geometry)) << compute << geometry;
   ASSERT_EQ(test::run_tetrasand("sdf " + bunny + " -o " + quoted(dir / "j.vdb") + common + "geometry --json",
                                 &json),
@@ -330,14 +330,16 @@ TEST(CliSampleBackend, AutoRelaxesOnTheCpuOnASoftwareDeviceAndSaysSoOnTheDeviceL
   EXPECT_EQ(json.at("run").at("software_device"), true) << out;
 }
 
-// --scan picks the method of a field built on the GPU (auto: compute); run.scan names it, null for a
+// --scan picks the method of a field built on the GPU (auto: the calibrated one); run.scan names it, null for a
 // field built on the CPU.
 TEST(CliSampleBackend, ScanPicksTheGpuFieldsMethodAndTheJsonNamesIt) {
   std::string out;
   ASSERT_EQ(run_sample("", "--sdf-backend gpu --scan geometry --json", &out), 0) << out;
   EXPECT_EQ(nlohmann::json::parse(out.substr(out.find("{\n"))).at("run").at("scan"), "geometry") << out;
   ASSERT_EQ(run_sample("", "--sdf-backend gpu", &out), 0) << out;
-  EXPECT_NE(out.find("SDF: by GPU scan conversion (compute, --scan auto), asked for)"), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(
+      out, std::regex(R"(SDF: by GPU scan (compute|geometry) \(calibrated [^)]*\), asked for\))")))
+      << out;
   ASSERT_EQ(run_sample("", "--sdf-backend cpu --backend cpu --json", &out), 0) << out;
   EXPECT_TRUE(nlohmann::json::parse(out.substr(out.find("{\n"))).at("run").at("scan").is_null()) << out;
   EXPECT_EQ(run_sample("", "--scan raster", &out), 2) << out;
