@@ -220,43 +220,63 @@ ComputeScan::ComputeScan(const gpu::ShaderLibrary& library, GpuBrickPairs pairs,
       band_(static_cast<float>(band)),
       brick_(pairs.brick),
       row_begin_(pairs.row_begin),
-      nearest_distance_pass_(
-          gpu::Program::compute(library, "sdf/scan_pairs.comp", {"BRICK " + std::to_string(pairs.brick)})),
-      nearest_triangle_pass_(gpu::Program::compute(
-          library, "sdf/scan_pairs.comp", {"BRICK " + std::to_string(pairs.brick), "NEAREST_TRIANGLE 1"})),
-      write_pass_(gpu::Program::compute(library, "sdf/scan_write.comp")),
+      count_pass_(gpu::Program::compute(library, "sdf/scan_bricks.comp",
+                                        {"BRICK " + std::to_string(pairs.brick), "BRICK_COUNT 1"})),
+      scatter_pass_(gpu::Program::compute(library, "sdf/scan_bricks.comp",
+                                          {"BRICK " + std::to_string(pairs.brick), "BRICK_SCATTER 1"})),
+      brick_pass_(gpu::Program::compute(library, "sdf/scan_bricks.comp", {"BRICK " + std::to_string(pairs.brick)})),
+      scan_(library),
       pairs_(std::move(pairs.pairs)),
-      rows_(gpu::Buffer::from<std::uint32_t>(pairs.row_begin)),
-      nearest_distance_(static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y()) *
-                        static_cast<std::size_t>(slab_layers) * sizeof(std::uint32_t)),
-      nearest_triangle_(nearest_distance_.bytes()) {}
+      rows_(gpu::Buffer::from<std::uint32_t>(pairs.row_begin)) {
+  // A slab of `slab_layers` layers spans at most this many brick rows (it need not start on one).
+  const std::size_t rows = static_cast<std::size_t>((slab_layers + brick_ - 1) / brick_ + 1);
+  const std::size_t per_row = static_cast<std::size_t>((spec.dims.x() + brick_ - 1) / brick_) *
+                              static_cast<std::size_t>((spec.dims.y() + brick_ - 1) / brick_);
+  reserve(rows * per_row, 1);
+}
 
-std::size_t ComputeScan::fill(gpu::Queue& queue, const gpu::Texture& target, int z0, int layers) {
+void ComputeScan::reserve(std::size_t bricks, std::size_t pairs) {
+  if (brick_starts_.bytes() < (bricks + 1) * sizeof(std::uint32_t))
+    brick_starts_ = gpu::Buffer((bricks + 1) * sizeof(std::uint32_t));
+  if (pair_slots_.bytes() < pairs * sizeof(std::uint32_t)) {
+    pair_slots_ = gpu::Buffer(pairs * sizeof(std::uint32_t));
+    brick_triangles_ = gpu::Buffer(pairs * sizeof(std::uint32_t));
+  }
+}
+
+std::size_t ComputeScan::fill(gpu::Queue& queue, const gpu::Buffer& triangles, const gpu::Texture& target,
+                              int z0, int layers) {
   const std::size_t first_row = static_cast<std::size_t>(z0 / brick_);
   const std::size_t last_row = static_cast<std::size_t>((z0 + layers - 1) / brick_);
   const std::uint32_t first = row_begin_[first_row], count = row_begin_[last_row + 1] - first;
-  const std::uint32_t voxels = static_cast<std::uint32_t>(spec_.dims.x()) *
-                               static_cast<std::uint32_t>(spec_.dims.y()) *
-                               static_cast<std::uint32_t>(layers);
   if (count == 0) return 0;  // the target keeps its clear value everywhere
-  // Zero reads "no triangle yet" in both (the kernels store complements).
-  nearest_distance_.fill_zero();
-  nearest_triangle_.fill_zero();
+  const std::uint32_t bricks = static_cast<std::uint32_t>(last_row - first_row + 1) *
+                               static_cast<std::uint32_t>((spec_.dims.x() + brick_ - 1) / brick_) *
+                               static_cast<std::uint32_t>((spec_.dims.y() + brick_ - 1) / brick_);
+  reserve(bricks, count);
+  brick_starts_.fill_zero();  // the counts start at zero, and the entry past the last brick stays 0
   params_.values = {{spec_.dims.x(), spec_.dims.y(), spec_.dims.z(), static_cast<int>(row_begin_.size() - 1)},
-                    {z0, layers, 0, 0},
-                    {first, count, voxels, 0u},
+                    {z0, layers, static_cast<int>(first_row), 0},
+                    {first, count, bricks, 0u},
                     {band_, 0.0f, 0.0f, 0.0f}};
-  params_.bind(TS_SDF_COMPUTE_PARAMS);
-  pairs_.bind(TS_SDF_PAIRS);
-  rows_.bind(TS_SDF_PAIR_ROWS);
-  nearest_distance_.bind(TS_SDF_NEAREST_DISTANCE);
-  nearest_triangle_.bind(TS_SDF_NEAREST_TRIANGLE);
-  queue.dispatch_groups(nearest_distance_pass_, count);
-  queue.dispatch_groups(nearest_triangle_pass_, count);
+  // Each brick's pairs counted, the counts scanned into starts, the triangles listed per brick.
+  auto bind = [&] {
+    params_.bind(TS_SDF_COMPUTE_PARAMS);
+    pairs_.bind(TS_SDF_PAIRS);
+    rows_.bind(TS_SDF_PAIR_ROWS);
+    pair_slots_.bind(TS_SDF_PAIR_SLOTS);
+    brick_starts_.bind(TS_SDF_BRICK_STARTS);
+    brick_triangles_.bind(TS_SDF_BRICK_TRIANGLES);
+  };
+  bind();
+  queue.dispatch_items(count_pass_, count);
+  scan_.run(queue, brick_starts_, bricks + 1);
+  bind();  // the scan took some of the same slots
+  queue.dispatch_items(scatter_pass_, count);
+  triangles.bind(TS_SDF_TRIANGLES);
   const gpu::ImageBinding image(TS_SDF_IMAGE_SLAB, target, GL_WRITE_ONLY);
   // The band compaction reads the target through a sampler.
-  queue.dispatch_items(write_pass_, voxels,
-                       GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  queue.dispatch_groups(brick_pass_, bricks, GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   return count;
 }
 

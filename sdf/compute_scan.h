@@ -78,29 +78,36 @@ class BrickPairGenerator {
   gpu::ParamBlock<gpu::params::BrickPairParams> params_;
 };
 
-// GPU memory the compute path adds per slab voxel: the nearest distance and nearest triangle words.
-inline constexpr std::size_t kComputeScanBytesPerVoxel = 2 * sizeof(std::uint32_t);
+// GPU memory the compute path adds per slab voxel at most: one word per brick of the slab (its first
+// triangle), a brick being at least 2^3 voxels, rounded up to a word a voxel for the brick rows a slab
+// shares with its neighbours. The slab's pair lists (8 bytes a pair) come on top, bounded by the pairs.
+inline constexpr std::size_t kComputeScanBytesPerVoxel = sizeof(std::uint32_t);
 
-// The compute kernels, the pairs on the GPU and the per-voxel minimum buffers of one slab target.
+// The compute kernels, the pairs on the GPU and the per-slab brick lists (shaders/sdf/scan_bricks.comp).
 class ComputeScan {
  public:
   ComputeScan(const gpu::ShaderLibrary& library, GpuBrickPairs pairs, const GridSpec& spec, int slab_layers,
               double band);
   // Writes the value of every voxel of grid layers [z0, z0 + layers) with a triangle closer than the
   // band into layers [0, layers) of `target` (RGBA32F, already cleared to the untouched value);
-  // `triangles` (SdfTriangle[]) must be bound at TS_SDF_TRIANGLES. Returns the pairs it ran.
-  std::size_t fill(gpu::Queue& queue, const gpu::Texture& target, int z0, int layers);
+  // `triangles`: SdfTriangle[], those the pairs were made from. Returns the pairs it ran.
+  std::size_t fill(gpu::Queue& queue, const gpu::Buffer& triangles, const gpu::Texture& target, int z0,
+                   int layers);
   std::size_t gpu_bytes() const {
-    return pairs_.bytes() + rows_.bytes() + nearest_distance_.bytes() + nearest_triangle_.bytes();
+    return pairs_.bytes() + rows_.bytes() + brick_starts_.bytes() + pair_slots_.bytes() + brick_triangles_.bytes();
   }
 
  private:
+  // Grows the per-slab buffers to `bricks` brick starts (+1) and `pairs` slots and list entries.
+  void reserve(std::size_t bricks, std::size_t pairs);
+
   GridSpec spec_;
   float band_;
   int brick_;
   std::vector<std::uint32_t> row_begin_;
-  gpu::Program nearest_distance_pass_, nearest_triangle_pass_, write_pass_;
-  gpu::Buffer pairs_, rows_, nearest_distance_, nearest_triangle_;
+  gpu::Program count_pass_, scatter_pass_, brick_pass_;
+  gpu::PrefixScan scan_;
+  gpu::Buffer pairs_, rows_, brick_starts_, pair_slots_, brick_triangles_;
   gpu::ParamBlock<gpu::params::ComputeScanParams> params_;
 };
 

@@ -399,7 +399,7 @@ int SlabScanner::draw(int z0, int layers) {
   target_.framebuffer.clear_color(0, {0.0f, 0.0f, 0.0f, kUntouched});
   target_.framebuffer.clear_depth(1.0f);
   if (compute_) {
-    brick_pairs_run_ += compute_->fill(queue_, target_.color, z0, layers);
+    brick_pairs_run_ += compute_->fill(queue_, triangles_, target_.color, z0, layers);
     return 0;
   }
   struct Draw {

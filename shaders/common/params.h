@@ -98,13 +98,12 @@ TS_PARAMS(BrickPairParams) {
                  // z: the squared radius a brick centre may lie from the triangle, (margin + y * sqrt 3)^2
 };
 
-// ---- sdf/scan_pairs.comp and sdf/scan_write.comp: the compute scan conversion of one slab
-// (sdf/compute_scan.h).
+// ---- sdf/scan_bricks.comp: the compute scan conversion of one slab (sdf/compute_scan.h).
 TS_PARAMS(ComputeScanParams) {
   ivec4 grid;   // xyz: grid dims [voxels]; w: brick rows (bricks along z) of the whole grid
-  ivec4 slab;   // x: grid z of slab layer 0; y: layers of this slab; zw unused
-  uvec4 pairs;  // x: first triangle/brick pair of this slab; y: its pairs; z: slab voxels
-                // (grid.x * grid.y * slab.y); w unused
+  ivec4 slab;   // x: grid z of slab layer 0; y: layers of this slab; z: its first brick row; w unused
+  uvec4 pairs;  // x: first triangle/brick pair of this slab; y: its pairs; z: bricks of its brick rows;
+                // w unused
   vec4 band;    // x: half-width [voxels]; yzw unused
 };
 

@@ -20,10 +20,10 @@ test -s "$prefix/cube.vdb"
 # Proof that it read the installed copy (the build tree is a fallback): break the installed kernel of
 # the compute scan (asked for: --scan auto may pick either after its calibration), and the same run must
 # now fail with a shader error naming it.
-echo "this line is deliberately not GLSL (install_test);" >> "$prefix/share/tetrasand/shaders/sdf/scan_pairs.comp"
+echo "this line is deliberately not GLSL (install_test);" >> "$prefix/share/tetrasand/shaders/sdf/scan_bricks.comp"
 if "$prefix/bin/tetrasand" sdf "$source/assets/cube.obj" -o "$prefix/cube2.vdb" --resolution 16 --backend gpu \
     --scan compute >"$prefix/log" 2>&1; then
   echo "the installed executable did not read its installed shaders" >&2; exit 1
 fi
-grep -q "scan_pairs.comp" "$prefix/log" || { cat "$prefix/log" >&2; exit 1; }
+grep -q "scan_bricks.comp" "$prefix/log" || { cat "$prefix/log" >&2; exit 1; }
 echo "installed tetrasand ran its shaders from $prefix/share/tetrasand/shaders"

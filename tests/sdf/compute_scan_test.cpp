@@ -359,8 +359,7 @@ TEST(GpuBrickPairs, OrderWithinARowDoesNotChangeOneBitOfTheField) {
         gpu::Texture::create_2d_array(GL_RGBA32F, spec.dims.x(), spec.dims.y(), spec.dims.z(), "test slab");
     target.upload(clear.data(), GL_RGBA, GL_FLOAT);
     ts::sdf::ComputeScan scan(library, std::move(pairs), spec, spec.dims.z(), 3.0);
-    buffer.bind(TS_SDF_TRIANGLES);
-    EXPECT_EQ(scan.fill(queue, target, 0, spec.dims.z()), host.count());
+    EXPECT_EQ(scan.fill(queue, buffer, target, 0, spec.dims.z()), host.count());
     std::vector<float> values(floats);
     target.read(values.data(), values.size() * sizeof(float), GL_RGBA, GL_FLOAT);
     return values;
