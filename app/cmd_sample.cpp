@@ -117,7 +117,8 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
   cmd->add_option(
          "--scan", o.scan,
          "How the GPU scan conversion reaches the voxels (SDF on the GPU): compute (compute shaders), "
-         "geometry (geometry shader and rasteriser) or auto (compute)")
+         "geometry (geometry shader and rasteriser) or auto (compute, unless a calibration cached for "
+         "this renderer and driver found geometry faster)")
       ->check(CLI::IsMember({"auto", "compute", "geometry"}))
       ->capture_default_str();
   cmd->add_option("--sdf-budget-mib", o.sdf_budget_mib,

@@ -74,7 +74,8 @@ void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option("--scan", o.scan,
                   "How the GPU scan conversion reaches the voxels: compute (triangle/brick pairs in compute "
                   "shaders, every core of the GPU), geometry (prisms sliced by a geometry shader and "
-                  "rasterised: the thesis's method) or auto (compute; --backend gpu)")
+                  "rasterised: the thesis's method) or auto (compute, unless a calibration cached for this "
+                  "renderer and driver found geometry faster; --backend gpu)")
       ->check(CLI::IsMember({"auto", "compute", "geometry"}))
       ->capture_default_str();
   cmd->add_option("--sign", o.sign, "Sign method: pseudonormal (closed meshes) or winding (robust to holes)")

@@ -2,12 +2,12 @@
 // The compute-shader scan conversion of one z-slab (ScanMethod::Compute in sdf/scan_convert.h), after
 // the triangle/leaf pairs of NanoVDB's CUDA mesh-to-grid: every usable triangle is paired with the
 // brick^3 voxel bricks its band can reach (made on the GPU by counts, prefix sums and a scatter,
-// grouped by brick row); per slab one work
-// group per pair finds, per voxel, the least distance to any triangle (atomic minimum on the distance
-// bits), a second pass the least triangle index at that distance (ties never depend on arrival order),
-// and a per-voxel pass stores that triangle's value into the same slab target the geometry path draws
-// into. Everything downstream (band compaction, read-back, outputs) is shared. Compute shaders run on
-// every core of a GPU, where geometry and fragment stages run on a few (docs/architecture.md, "sdf").
+// grouped by brick row). Per slab the pairs become a triangle list per brick (count, prefix sum,
+// scatter), and one work group per brick takes, per voxel, the least distance to the brick's triangles
+// and at equal distance the least triangle index (never the list's order, which atomics decide), and
+// stores that triangle's value into the same slab target the geometry path draws into. Everything
+// downstream (band compaction, read-back, outputs) is shared. Compute shaders run on every core of a
+// GPU, where geometry and fragment stages run on a few (docs/architecture.md, "sdf").
 #include <cstddef>
 #include <cstdint>
 #include <span>

@@ -13,8 +13,8 @@ enum class SignMethod {
 
 // How the triangles reach the voxels. Geometry: the thesis's method, each triangle's prism sliced by a
 // geometry shader and rasterised, the depth test keeping the nearest (fast where the raster hardware
-// is). Compute: triangle/brick pairs and atomic minima in compute shaders (sdf/compute_scan.h), which
-// use the whole GPU. Both give every band voxel its exact float distance and the same signs; compute
+// is). Compute: triangle/brick pairs and per-brick triangle lists in compute shaders
+// (sdf/compute_scan.h), which use the whole GPU. Both give every band voxel its exact float distance and the same signs; compute
 // breaks ties by the lower triangle index, so its bytes never depend on the order work runs in.
 enum class ScanMethod { Geometry, Compute };
 
