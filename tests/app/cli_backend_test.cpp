@@ -5,7 +5,9 @@
 // usage errors (exit 2).
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <regex>
 #include <string>
@@ -191,6 +193,51 @@ TEST(SdfBackend, NamesTheDeviceAndTheTimeAndTheCpuPathGivesTheSameBand) {
   EXPECT_NEAR(static_cast<double>(c), static_cast<double>(g), 0.001 * static_cast<double>(g)) << cpu;
 }
 
+// Points TETRASAND_SCAN_CACHE (sdf/scan_calibration.h) at a file of the test's own for its lifetime.
+class ScopedScanCache {
+ public:
+  explicit ScopedScanCache(const std::filesystem::path& file) {
+    if (const char* old = std::getenv("TETRASAND_SCAN_CACHE")) old_ = old;
+    ::setenv("TETRASAND_SCAN_CACHE", file.c_str(), 1);
+  }
+  ~ScopedScanCache() {
+    if (old_) {
+      ::setenv("TETRASAND_SCAN_CACHE", old_->c_str(), 1);
+    } else {
+      ::unsetenv("TETRASAND_SCAN_CACHE");
+    }
+  }
+  ScopedScanCache(const ScopedScanCache&) = delete;
+  ScopedScanCache& operator=(const ScopedScanCache&) = delete;
+
+ private:
+  std::optional<std::string> old_;
+};
+
+// --scan auto end to end: the first run calibrates and writes the cache, the next reads it (", cached"),
+// and a corrupt cache costs a warning and a new calibration, never the run.
+TEST(SdfBackend, ScanAutoCalibratesOnceThenReadsTheCacheAndSurvivesACorruptOne) {
+  const auto dir = test::temp_dir();
+  const std::filesystem::path cache = dir / "calibration" / "scan.json";
+  const ScopedScanCache scoped(cache);
+  const std::string run = "sdf " + quoted(test::asset("cube.obj")) + " -o " + quoted(dir / "c.vdb") +
+                          " --resolution 16 --backend gpu";
+  const std::regex calibrated(R"(\ndevice: .+; scan (compute|geometry) )"
+                              R"(\(calibrated [0-9.e+]+x geometry's speed\) )");
+  const std::regex cached(R"(\ndevice: .+; scan (compute|geometry) )"
+                          R"(\(calibrated [0-9.e+]+x geometry's speed, cached\) )");
+  std::string first, second, third;
+  ASSERT_EQ(test::run_tetrasand(run, &first), 0) << first;
+  EXPECT_TRUE(std::regex_search(first, calibrated)) << first;
+  ASSERT_TRUE(std::filesystem::exists(cache));
+  ASSERT_EQ(test::run_tetrasand(run, &second), 0) << second;
+  EXPECT_TRUE(std::regex_search(second, cached)) << second;
+  std::ofstream(cache, std::ios::trunc) << "not json";
+  ASSERT_EQ(test::run_tetrasand(run, &third), 0) << third;
+  EXPECT_NE(third.find("unreadable scan calibration cache"), std::string::npos) << third;
+  EXPECT_TRUE(std::regex_search(third, calibrated)) << third;
+}
+
 // Issue 42: plain `sdf` follows the rule of every command, so on llvmpipe (where the exact CPU path is 4-7x
 // faster) it takes the CPU path and says why; --backend gpu still runs the scan conversion there.
 TEST(SdfBackend, AutoTakesTheExactCpuPathOnASoftwareDeviceAndSaysSo) {
@@ -330,8 +377,8 @@ TEST(CliSampleBackend, AutoRelaxesOnTheCpuOnASoftwareDeviceAndSaysSoOnTheDeviceL
   EXPECT_EQ(json.at("run").at("software_device"), true) << out;
 }
 
-// --scan picks the method of a field built on the GPU (auto: the calibrated one); run.scan names it, null for a
-// field built on the CPU.
+// --scan picks the method of a field built on the GPU (auto: the calibrated one); run.scan names it,
+// null for a field built on the CPU.
 TEST(CliSampleBackend, ScanPicksTheGpuFieldsMethodAndTheJsonNamesIt) {
   std::string out;
   ASSERT_EQ(run_sample("", "--sdf-backend gpu --scan geometry --json", &out), 0) << out;
