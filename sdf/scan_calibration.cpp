@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <exception>
 #include <nlohmann/json.hpp>
@@ -51,29 +52,38 @@ nlohmann::json read_entries(const std::filesystem::path& cache) {
   return nlohmann::json::array();
 }
 
-// The entry of `entries` for this renderer and driver with both timings positive, if any.
+// Whether cache entry `e` was timed on this renderer and driver (by any build).
+bool same_device(const nlohmann::json& e, const gpu::Context& context) {
+  return e.is_object() && e.value("renderer", "") == context.renderer() &&
+         e.value("version", "") == context.version();
+}
+
+// Whether cache entry `e` was timed by this build on this renderer and driver.
+bool same_setup(const nlohmann::json& e, const gpu::Context& context) {
+  return same_device(e, context) && e.value("build", "") == scan_build_id();
+}
+
+// The entry of `entries` for this build, renderer and driver with both timings positive, if any.
 std::optional<ScanTiming> find_entry(const nlohmann::json& entries, const gpu::Context& context) {
   for (const nlohmann::json& e : entries) {
-    if (!e.is_object() || e.value("renderer", "") != context.renderer() ||
-        e.value("version", "") != context.version())
-      continue;
+    if (!same_setup(e, context)) continue;
     const double compute = e.value("compute_seconds", 0.0), geometry = e.value("geometry_seconds", 0.0);
     if (compute > 0.0 && geometry > 0.0) return ScanTiming{compute, geometry};
   }
   return std::nullopt;
 }
 
-// Stores `timing` for this renderer and driver, keeping the other renderers' entries. A failed
-// write only costs the next run a calibration.
+// Stores `timing` for this build, renderer and driver, keeping the other renderers' entries (another
+// build's entry for this renderer and driver is stale: replaced). A failed write only costs the next
+// run a calibration.
 void store_entry(const std::filesystem::path& cache, nlohmann::json entries, const gpu::Context& context,
                  const ScanTiming& timing) {
   nlohmann::json kept = nlohmann::json::array();
   for (const nlohmann::json& e : entries)
-    if (e.is_object() &&
-        !(e.value("renderer", "") == context.renderer() && e.value("version", "") == context.version()))
-      kept.push_back(e);
+    if (e.is_object() && !same_device(e, context)) kept.push_back(e);
   kept.push_back({{"renderer", context.renderer()},
                   {"version", context.version()},
+                  {"build", scan_build_id()},
                   {"compute_seconds", timing.compute_seconds},
                   {"geometry_seconds", timing.geometry_seconds}});
   const nlohmann::json file = {{"format", kCacheFormat}, {"entries", kept}};
@@ -94,6 +104,19 @@ ScanChoice choice_of(const ScanTiming& timing, bool cached) {
 }
 
 }  // namespace
+
+std::string scan_build_id() {
+  std::error_code error;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error) return "unknown";
+  const std::uintmax_t bytes = std::filesystem::file_size(exe, error);
+  if (error) return "unknown";
+  const auto written = std::filesystem::last_write_time(exe, error);
+  if (error) return "unknown";
+  const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(
+      std::chrono::file_clock::to_sys(written).time_since_epoch());
+  return fmt::format("{} bytes, written at {} s since 1970", bytes, seconds.count());
+}
 
 std::optional<std::filesystem::path> scan_cache_path() {
   if (auto path = environment_path(kScanCacheVariable)) return path;

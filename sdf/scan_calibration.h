@@ -1,9 +1,10 @@
 #pragma once
 // `--scan auto`: the compute scan conversion, unless a short calibration on this GL renderer and
 // driver found the geometry-shader path faster. The calibration (both paths on a small built-in
-// mesh) runs once per renderer and driver; its result is cached in a JSON file, so later runs only
-// read it. A cache that cannot be read, does not parse or holds another renderer's entry is ignored
-// (with a warning when it is unreadable), never fatal. See docs/commands/sdf.md.
+// mesh) runs once per renderer, driver and tetrasand build; its result is cached in a JSON file, so
+// later runs only read it. A cache that cannot be read, does not parse or holds another renderer's or
+// build's entry is ignored (with a warning when it is unreadable), never fatal. See
+// docs/commands/sdf.md.
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -33,13 +34,18 @@ struct ScanChoice {
   }
 };
 
+// The running executable's identity (its size and modification time; "unknown" where the system does
+// not tell): an entry timed by another build is not used, so a rebuilt or upgraded tetrasand, whose
+// scan paths may run at other speeds, times them again.
+std::string scan_build_id();
+
 // $TETRASAND_SCAN_CACHE, else $XDG_CACHE_HOME/tetrasand/scan_calibration.json, else
 // $HOME/.cache/tetrasand/scan_calibration.json; nullopt when none of them is set (nothing cached).
 std::optional<std::filesystem::path> scan_cache_path();
 
 // Times both paths on a built-in icosphere (5120 triangles, 48 voxels along its diameter): tens of
-// milliseconds expected on a GPU (not measured yet), seconds on llvmpipe (10 s with compiling, one llvmpipe
-// thread on 2 loaded cores). Requires a current context.
+// milliseconds expected on a GPU (not measured yet), seconds on llvmpipe (3.5 to 10 s with compiling,
+// on 2 shared cores). Requires a current context.
 ScanTiming calibrate_scan(gpu::Context& context);
 
 // Resolves a --scan spelling ("compute", "geometry", "auto"). Auto reads the entry for this context's

@@ -32,9 +32,11 @@ class ScanCalibration : public ::testing::Test {
     write_file_atomically(
         cache, nlohmann::json{{"format", "tetrasand scan calibration 1"}, {"entries", entries}}.dump());
   }
-  nlohmann::json entry(std::string renderer, std::string version, double compute, double geometry) const {
+  nlohmann::json entry(std::string renderer, std::string version, double compute, double geometry,
+                       std::string build = scan_build_id()) const {
     return {{"renderer", renderer},
             {"version", version},
+            {"build", build},
             {"compute_seconds", compute},
             {"geometry_seconds", geometry}};
   }
@@ -84,6 +86,19 @@ TEST_F(ScanCalibration, EntryOfAnotherRendererOrDriverIsNotUsedButKept) {
   EXPECT_EQ(choice.method, ScanMethod::Compute);  // compute wins a tie
   const nlohmann::json file = nlohmann::json::parse(read_file(cache));
   EXPECT_EQ(file["entries"].size(), 3u);
+}
+
+TEST_F(ScanCalibration, EntryOfAnotherBuildIsNotUsedAndIsReplaced) {
+  // A rebuilt tetrasand may scan at other speeds: its own calibration replaces the stale one.
+  ASSERT_NE(scan_build_id(), "unknown");
+  write_cache(
+      nlohmann::json::array({entry(context.renderer(), context.version(), 2.0, 1.0, "1 bytes, written 0")}));
+  const ScanChoice choice = choose();
+  EXPECT_EQ(calibrations, 1);
+  EXPECT_EQ(choice.method, ScanMethod::Compute);
+  const nlohmann::json file = nlohmann::json::parse(read_file(cache));
+  ASSERT_EQ(file["entries"].size(), 1u);
+  EXPECT_EQ(file["entries"][0]["build"], scan_build_id());
 }
 
 TEST_F(ScanCalibration, ExplicitMethodsNeitherCalibrateNorTouchTheCache) {
