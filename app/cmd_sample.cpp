@@ -23,6 +23,7 @@
 #include "preview/body_preview.h"
 #include "sampler/body_verdict.h"
 #include "sampler/sample_mesh.h"
+#include "sdf/scan_calibration.h"
 
 namespace ts::app {
 
@@ -41,7 +42,8 @@ struct Options {
   std::vector<double> up{0.0, 0.0, 1.0};  // --preview's world up
   bool strict = false;                    // a body short of OK exits 1 (it is still written)
   std::string backend = "auto", sdf_backend = "auto";
-  std::string scan = "auto";     // sdf::parse_scan_method
+  std::string scan = "auto";     // sdf::parse_scan_method; compute or geometry once resolved
+  std::string scan_reason;       // why that method (sdf::ScanChoice::reason), when the SDF is scanned
   double context_seconds = 0.0;  // s, the GPU context's creation (once for a batch)
 };
 
@@ -115,7 +117,8 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
   cmd->add_option(
          "--scan", o.scan,
          "How the GPU scan conversion reaches the voxels (SDF on the GPU): compute (compute shaders), "
-         "geometry (geometry shader and rasteriser) or auto (compute)")
+         "geometry (geometry shader and rasteriser) or auto (compute, unless a calibration cached for "
+         "this renderer and driver found geometry faster)")
       ->check(CLI::IsMember({"auto", "compute", "geometry"}))
       ->capture_default_str();
   cmd->add_option("--sdf-budget-mib", o.sdf_budget_mib,
@@ -244,7 +247,8 @@ int convert_one(const Options& o, gpu::Context* context, BatchRow& row) {
     const gpu::Backend requested = settings.backend;
     const std::string reason =
         gpu::backend_reason(requested, gpu::resolve_backend(requested, context), gpu::describe(context));
-    print_body_report({o.mesh, o.sampling.fill, reason}, result, json, context);
+    const std::string scan = o.scan_reason.empty() ? "" : fmt::format("scan {} ({})", o.scan, o.scan_reason);
+    print_body_report({o.mesh, o.sampling.fill, reason, scan}, result, json, context);
   }
   if (o.sampling.timings) print_timings(result, seconds);
   if (o.preview) write_preview(o, context, mesh, body, name);
@@ -257,6 +261,18 @@ int convert_one(const Options& o, gpu::Context* context, BatchRow& row) {
 // means a CPU field, exact or OpenVDB's), so it works where EGL does not.
 bool needs_gl_context(const Options& o) { return o.backend != "cpu" || o.sdf_backend == "gpu" || o.preview; }
 
+// --scan auto, once for the whole batch, where the SDF is scanned on the GPU: the cached calibration of
+// this renderer and driver, or a calibration now (sdf/scan_calibration.h).
+void resolve_scan(Options& o, gpu::Context* context) {
+  const sampler::SampleSettings settings = settings_of(o);
+  if (context == nullptr || settings.cpu_sdf == sampler::CpuSdfMethod::OpenVdb ||
+      gpu::resolve_backend(settings.sdf_backend, context) != gpu::Backend::Gpu)
+    return;
+  const sdf::ScanChoice scan = sdf::choose_scan(*context, o.scan);
+  o.scan = sdf::scan_method_name(scan.method);
+  o.scan_reason = scan.reason;
+}
+
 // The run's backend line (gpu/backend.h), once for the whole batch: where the relaxation and the certificate
 // run and why, and where the SDF is built. On standard output beside the report; with --json a log line, so
 // standard output stays the JSON.
@@ -266,8 +282,8 @@ void print_backend_line(const Options& o, const gpu::Context* context) {
   const gpu::Backend sdf = gpu::resolve_backend(settings.sdf_backend, context);
   const std::string field =
       settings.cpu_sdf == sampler::CpuSdfMethod::OpenVdb ? "by OpenVDB's meshToVolume on the CPU"
-      : sdf == gpu::Backend::Gpu ? fmt::format("by GPU scan conversion ({}, --scan {})",
-                                               sdf::scan_method_name(settings.scan), o.scan)
+      : sdf == gpu::Backend::Gpu ? fmt::format("by GPU scan {} ({})", sdf::scan_method_name(settings.scan),
+                                               o.scan_reason)
                                  : "by exact distance on the CPU";
   const std::string note = fmt::format("SDF: {}, {}", field, o.sdf_backend == "auto" ? "auto" : "asked for");
   const std::string line = gpu::backend_line(settings.backend, relax, gpu::describe(context), true,
@@ -290,6 +306,7 @@ int run_sample(Options& o, const GlobalOptions& global) {
   std::unique_ptr<gpu::Context> context;  // one context for the whole batch, if any stage needs one
   if (needs_gl_context(o)) context = std::make_unique<gpu::Context>(context_options(global));
   o.context_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  resolve_scan(o, context.get());
   print_backend_line(o, context.get());
   if (o.batch) {
     return run_batch(meshes, o.in, o.json, o.strict, [&](const std::string& mesh, bool first, BatchRow& row) {

@@ -25,6 +25,7 @@
 #include "sdf/grid.h"
 #include "sdf/openvdb_compare.h"
 #include "sdf/pseudonormals.h"
+#include "sdf/scan_calibration.h"
 #include "sdf/scan_convert.h"
 #include "sdf/sparse_field.h"
 #include "sdf/vdb_io.h"
@@ -73,7 +74,8 @@ void add_options(CLI::App* cmd, Options& o) {
   cmd->add_option("--scan", o.scan,
                   "How the GPU scan conversion reaches the voxels: compute (triangle/brick pairs in compute "
                   "shaders, every core of the GPU), geometry (prisms sliced by a geometry shader and "
-                  "rasterised: the thesis's method) or auto (compute; --backend gpu)")
+                  "rasterised: the thesis's method) or auto (compute, unless a calibration cached for this "
+                  "renderer and driver found geometry faster; --backend gpu)")
       ->check(CLI::IsMember({"auto", "compute", "geometry"}))
       ->capture_default_str();
   cmd->add_option("--sign", o.sign, "Sign method: pseudonormal (closed meshes) or winding (robust to holes)")
@@ -201,10 +203,10 @@ std::string scan_words(const std::string& scan) {
              : "scan conversion by geometry shader";
 }
 
-// The backend line's note on the GPU path: why this scan method, and --compare-openvdb's reason.
-std::string scan_note(const Options& o) {
-  std::string note = o.scan == "auto" ? "--scan auto takes compute, no per-driver calibration yet"
-                                      : "--scan " + o.scan + " asked for";
+// The backend line's note on the GPU path: why this scan method (`asked`: the --scan spelling, `o`
+// the resolved run), and --compare-openvdb's reason.
+std::string scan_note(const std::string& asked, const Options& o) {
+  std::string note = asked == "auto" ? "--scan auto: " + o.scan_reason : "--scan " + asked + " asked for";
   if (o.compare && o.backend == "auto") note += "; --compare-openvdb compares the GPU field";
   return note;
 }
@@ -224,17 +226,23 @@ Options choose_backend(const Options& o, const GlobalOptions& global, std::uniqu
   if (o.compare) requested = gpu::Backend::Gpu;
   if (requested != gpu::Backend::Cpu) context = std::make_unique<gpu::Context>(context_options(global));
   const gpu::Backend chosen = gpu::resolve_backend(requested, context.get());
+  Options run = o;
+  run.backend = gpu::backend_name(chosen);
+  if (chosen == gpu::Backend::Gpu) {
+    // --scan auto: the cached calibration of this renderer and driver, or a calibration now.
+    const sdf::ScanChoice scan = sdf::choose_scan(*context, o.scan);
+    run.scan = sdf::scan_method_name(scan.method);
+    run.scan_reason = scan.reason;
+  }
   const std::string line = gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
-                                             chosen == gpu::Backend::Cpu ? "exact SDF" : scan_words(o.scan),
-                                             chosen == gpu::Backend::Cpu ? "" : scan_note(o));
+                                             chosen == gpu::Backend::Cpu ? "exact SDF" : scan_words(run.scan),
+                                             chosen == gpu::Backend::Cpu ? "" : scan_note(o.scan, run));
   if (o.json) {
     log::info("{}", line);
   } else {
     fmt::print("{}\n", line);
   }
   if (chosen == gpu::Backend::Cpu) context.reset();
-  Options run = o;
-  run.backend = gpu::backend_name(chosen);
   return run;
 }
 
@@ -260,7 +268,7 @@ int run_sdf(const Options& options, const GlobalOptions& global) {
   fmt::print("device: {}; {} {:.3f} s\n", device,
              o.backend == "cpu"
                  ? "exact SDF"
-                 : fmt::format("scan conversion ({})", sdf::scan_method_name(result.stats.method)),
+                 : fmt::format("scan {} ({})", sdf::scan_method_name(result.stats.method), o.scan_reason),
              result.stats.seconds);
   if (o.timings) {
     print_sdf_times(o, result.stats, figures);

@@ -232,9 +232,11 @@ void print_body_report(const ReportFacts& facts, const sampler::SampleResult& re
   fmt::print("  on the surface   largest |phi| = {:.2e} r\n", q.max_abs_phi_over_r);
   print_thin_features(result.thin, body.particle_radius);
   const sampler::StageSeconds& t = result.stages;
+  const std::string sdf = result.sdf_path == sampler::SdfPath::Scan && !facts.scan.empty()
+                              ? "by GPU " + facts.scan
+                              : std::string(sdf_path_words(result.sdf_path).device);
   fmt::print("  device           {}: SDF {} {:.2f} s, relaxation {:.2f} s, certificate {:.2f} s; {}\n",
-             device_name(context), sdf_path_words(result.sdf_path).device, t.sdf, t.relaxation, t.certificate,
-             backend_text(result, facts.backend_reason));
+             device_name(context), sdf, t.sdf, t.relaxation, t.certificate, backend_text(result, facts.backend_reason));
   fmt::print(
       "  work             {} iterations, {} hole-closing rounds, {}, {:.2f} s on {} (certificate {:.2f} s in "
       "{} passes, probes {:.2f} s)\n",

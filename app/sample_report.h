@@ -25,6 +25,7 @@ struct ReportFacts {
   std::string mesh;
   bool fill = false;
   std::string backend_reason;
+  std::string scan;  // a field scanned on the GPU: its method and why ("scan compute (--scan)")
 };
 
 // The human report of one mesh, ending before the verdict line.

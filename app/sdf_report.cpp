@@ -82,6 +82,7 @@ void print_sdf_json(const SdfOptions& o, const TriangleMesh& mesh, const sdf::Gr
       {"backend", o.backend},
       {"scan", o.backend == "cpu" ? nlohmann::ordered_json(nullptr)
                                   : nlohmann::ordered_json(sdf::scan_method_name(st.method))},
+      {"scan_reason", o.backend == "cpu" ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.scan_reason)},
       {"brick_pairs", st.brick_pairs},
       {"pipeline", pipeline_json(st.pipeline)},
       {"renderer", device}};

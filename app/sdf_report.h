@@ -21,6 +21,7 @@ struct SdfOptions {
   std::string sign = "pseudonormal";
   std::string backend = "auto";  // gpu: scan conversion; cpu: the exact SDF (sdf/exact_sdf.h); auto: the rule
   std::string scan = "auto";     // the scan method (sdf::parse_scan_method): compute, geometry or auto
+  std::string scan_reason;       // on the GPU path, once auto is resolved: why (sdf::ScanChoice::reason)
   double scale = 1.0;
   double slab_mb = 1024;
   bool timings = false, compare = false, json = false;

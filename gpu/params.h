@@ -89,6 +89,9 @@ static_assert(offsetof(BandParams, voxels) == 16 && offsetof(BandParams, band) =
 static_assert(sizeof(LeafBuildParams) == 64);
 static_assert(offsetof(LeafBuildParams, leaves) == 16 && offsetof(LeafBuildParams, cells) == 32);
 static_assert(offsetof(LeafBuildParams, band) == 48);
+static_assert(sizeof(BrickPairParams) == 64);
+static_assert(offsetof(BrickPairParams, bricks) == 16 && offsetof(BrickPairParams, counts) == 32);
+static_assert(offsetof(BrickPairParams, reach) == 48);
 static_assert(sizeof(ComputeScanParams) == 64);
 static_assert(offsetof(ComputeScanParams, slab) == 16 && offsetof(ComputeScanParams, pairs) == 32);
 static_assert(offsetof(ComputeScanParams, band) == 48);

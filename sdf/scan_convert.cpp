@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <utility>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -286,8 +287,8 @@ struct ScanPlan {
   int slab_layers = 0;  // z-layers per slab (render-target layers)
   int block = 0;        // z-layers per draw
   GpuGeometry geometry;
-  DrawLists lists;   // geometry path
-  BrickPairs pairs;  // compute path
+  DrawLists lists;  // geometry path
+  int brick = 0;    // compute path: the side of a brick [voxels] (its pairs are made on the GPU)
 };
 
 // `brick`: the compute path's brick side (compute_brick_side).
@@ -310,12 +311,8 @@ ScanPlan plan_scan(std::size_t max_items, int max_layers, int brick, const Trian
   plan.slab_layers = choose_slab_layers(spec, per_layer, options.max_slab_bytes, max_items, max_layers);
   if (options.gpu_field) plan.slab_layers = whole_leaf_rows(plan.slab_layers, spec.dims.z());
   plan.block = std::min(kLayersPerDraw, plan.slab_layers);
-  // The same margin as the prisms: the pairs reach every voxel a prism would.
-  if (compute) {
-    plan.pairs = build_brick_pairs(plan.geometry.triangles, plan.geometry.drawn, spec, plan.margin, brick);
-  } else {
-    plan.lists = bucket_by_block(plan.geometry, spec.dims.z(), plan.block);
-  }
+  plan.brick = brick;
+  if (!compute) plan.lists = bucket_by_block(plan.geometry, spec.dims.z(), plan.block);
   return plan;
 }
 
@@ -394,8 +391,16 @@ SlabScanner::SlabScanner(const gpu::ShaderLibrary& library, gpu::Queue& queue, c
       flags_(static_cast<std::size_t>(spec.dims.x()) * static_cast<std::size_t>(spec.dims.y()) *
              static_cast<std::size_t>(plan.slab_layers) * sizeof(std::uint32_t)) {
   target_.color.set_sampling(GL_NEAREST);  // read by texelFetch; a complete texture needs a non-mip filter
-  if (plan.method == ScanMethod::Compute)
-    compute_ = std::make_unique<ComputeScan>(library, plan.pairs, spec, plan.slab_layers, plan.band);
+  if (plan.method == ScanMethod::Compute) {
+    // The same margin as the prisms: the pairs reach every voxel a prism would.
+    BrickPairGenerator generator(library);
+    GpuBrickPairs pairs;
+    queue.timed("sdf/brick_pairs", [&] {
+      pairs = generator.run(queue, triangles_, static_cast<std::uint32_t>(plan.geometry.triangles.size()), spec,
+                            plan.margin, plan.brick);
+    });
+    compute_ = std::make_unique<ComputeScan>(library, std::move(pairs), spec, plan.slab_layers, plan.band);
+  }
   // The compute path draws nothing: no geometry-shader programs to compile.
   for (int invocations : compute_ ? std::span<const int>{} : std::span<const int>{kVariantInvocations}) {
     programs_.push_back(gpu::Program::graphics(library, "sdf/scan_convert.vert", "sdf/scan_convert.geom",
@@ -415,7 +420,7 @@ int SlabScanner::draw(int z0, int layers) {
   target_.framebuffer.clear_color(0, {0.0f, 0.0f, 0.0f, kUntouched});
   target_.framebuffer.clear_depth(1.0f);
   if (compute_) {
-    brick_pairs_run_ += compute_->fill(queue_, target_.color, z0, layers);
+    brick_pairs_run_ += compute_->fill(queue_, triangles_, target_.color, z0, layers);
     return 0;
   }
   struct Draw {

@@ -13,8 +13,8 @@ enum class SignMethod {
 
 // How the triangles reach the voxels. Geometry: the thesis's method, each triangle's prism sliced by a
 // geometry shader and rasterised, the depth test keeping the nearest (fast where the raster hardware
-// is). Compute: triangle/brick pairs and atomic minima in compute shaders (sdf/compute_scan.h), which
-// use the whole GPU. Both give every band voxel its exact float distance and the same signs; compute
+// is). Compute: triangle/brick pairs and per-brick triangle lists in compute shaders
+// (sdf/compute_scan.h), which use the whole GPU. Both give every band voxel its exact float distance and the same signs; compute
 // breaks ties by the lower triangle index, so its bytes never depend on the order work runs in.
 enum class ScanMethod { Geometry, Compute };
 
@@ -22,9 +22,9 @@ enum class ScanMethod { Geometry, Compute };
 inline const char* scan_method_name(ScanMethod method) {
   return method == ScanMethod::Compute ? "compute" : "geometry";
 }
-// The --scan spellings "compute", "geometry" and "auto"; nullopt for any other text. Auto takes
-// Compute: a calibration timed once per renderer and driver that would pick Geometry where the raster
-// hardware makes it faster is not built yet (docs/commands/sdf.md).
+// The --scan spellings "compute", "geometry" and "auto"; nullopt for any other text. Auto reads as
+// Compute here; the commands resolve it first by sdf::choose_scan (sdf/scan_calibration.h), which
+// takes Geometry where a calibration on this renderer and driver found it faster.
 inline std::optional<ScanMethod> parse_scan_method(std::string_view text) {
   if (text == "compute" || text == "auto") return ScanMethod::Compute;
   if (text == "geometry") return ScanMethod::Geometry;

@@ -59,6 +59,10 @@ std::string quoted(const std::filesystem::path& p) {
 }
 
 int run_tetrasand(const std::string& args, std::string* output) {
+  // --scan auto calibrates once per renderer and driver into a cache file: the build tree's, not the
+  // user's, and shared by every CLI test (sdf/scan_calibration.h).
+  const std::filesystem::path cache = std::filesystem::path(TETRASAND_BINARY).parent_path() / "test_scan_calibration.json";
+  ::setenv("TETRASAND_SCAN_CACHE", cache.c_str(), 0);
   const std::string cmd = std::string("'") + TETRASAND_BINARY + "' " + args + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (!pipe) throw std::runtime_error("popen failed");

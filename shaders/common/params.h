@@ -102,13 +102,22 @@ TS_PARAMS(LeafBuildParams) {
                           // [world units]; w unused
 };
 
-// ---- sdf/scan_pairs.comp and sdf/scan_write.comp: the compute scan conversion of one slab
-// (sdf/compute_scan.h).
+// ---- sdf/brick_pairs.comp: the compute scan conversion's triangle/brick pairs, made on the GPU
+// (sdf/compute_scan.h, BrickPairGenerator).
+TS_PARAMS(BrickPairParams) {
+  ivec4 grid;    // xyz: grid dims [voxels]; w: brick side [voxels]
+  ivec4 bricks;  // xyz: bricks along each axis; w unused
+  uvec4 counts;  // x: triangles; yzw unused
+  vec4 reach;    // x: margin [voxels]; y: half the span of a brick's voxel centres, (brick - 1) / 2;
+                 // z: the squared radius a brick centre may lie from the triangle, (margin + y * sqrt 3)^2
+};
+
+// ---- sdf/scan_bricks.comp: the compute scan conversion of one slab (sdf/compute_scan.h).
 TS_PARAMS(ComputeScanParams) {
   ivec4 grid;   // xyz: grid dims [voxels]; w: brick rows (bricks along z) of the whole grid
-  ivec4 slab;   // x: grid z of slab layer 0; y: layers of this slab; zw unused
-  uvec4 pairs;  // x: first triangle/brick pair of this slab; y: its pairs; z: slab voxels
-                // (grid.x * grid.y * slab.y); w unused
+  ivec4 slab;   // x: grid z of slab layer 0; y: layers of this slab; z: its first brick row; w unused
+  uvec4 pairs;  // x: first triangle/brick pair of this slab; y: its pairs; z: bricks of its brick rows;
+                // w unused
   vec4 band;    // x: half-width [voxels]; yzw unused
 };
 

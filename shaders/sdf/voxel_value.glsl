@@ -1,7 +1,7 @@
 // The value one triangle gives a voxel centre: the exact distance to its closest point and the sign of
 // the angle-weighted pseudonormal of the feature that holds that point (Baerentzen & Aanaes 2005).
 // The one definition for both scan conversions (scan_convert.frag and the compute path's
-// scan_pairs.comp / scan_write.comp), so they agree to the bit on every voxel they both reach.
+// scan_bricks.comp), so they agree to the bit on every voxel they both reach.
 #ifndef TETRASAND_SDF_VOXEL_VALUE_GLSL
 #define TETRASAND_SDF_VOXEL_VALUE_GLSL
 

@@ -5,7 +5,9 @@
 // usage errors (exit 2).
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <regex>
 #include <string>
@@ -165,14 +167,14 @@ TEST(SdfBackend, NamesTheDeviceAndTheTimeAndTheCpuPathGivesTheSameBand) {
                 "sdf " + bunny + " -o " + quoted(dir / "gpu.vdb") + " --resolution 24 --backend gpu", &gpu),
             0)
       << gpu;
-  EXPECT_NE(
-      gpu.find("backend: gpu, scan conversion by compute shaders (asked for; --scan auto takes compute, no "
-               "per-driver calibration yet)\n"),
-      std::string::npos)
+  // --scan auto: whichever method this device's calibration (sdf/scan_calibration.h) found faster.
+  EXPECT_TRUE(std::regex_search(
+      gpu, std::regex(R"(backend: gpu, scan conversion by (compute shaders|geometry shader) \(asked for; )"
+                      R"(--scan auto: calibrated [0-9.e+]+x geometry's speed(, cached)?\)\n)")))
       << gpu;
   EXPECT_TRUE(std::regex_search(
-      gpu, std::regex(R"(\ndevice: .+ \(device \d+(, software)?\); scan conversion \(compute\) )"
-                      R"(\d+\.\d{3} s\n)")))
+      gpu, std::regex(R"(\ndevice: .+ \(device \d+(, software)?\); scan (compute|geometry) \(calibrated )"
+                      R"([0-9.e+]+x geometry's speed(, cached)?\) \d+\.\d{3} s\n)")))
       << gpu;
   ASSERT_EQ(test::run_tetrasand(
                 "sdf " + bunny + " -o " + quoted(dir / "cpu.vdb") + " --resolution 24 --backend cpu", &cpu),
@@ -189,6 +191,51 @@ TEST(SdfBackend, NamesTheDeviceAndTheTimeAndTheCpuPathGivesTheSameBand) {
   const long g = band_voxels(gpu), c = band_voxels(cpu);
   ASSERT_GT(g, 1000) << gpu;
   EXPECT_NEAR(static_cast<double>(c), static_cast<double>(g), 0.001 * static_cast<double>(g)) << cpu;
+}
+
+// Points TETRASAND_SCAN_CACHE (sdf/scan_calibration.h) at a file of the test's own for its lifetime.
+class ScopedScanCache {
+ public:
+  explicit ScopedScanCache(const std::filesystem::path& file) {
+    if (const char* old = std::getenv("TETRASAND_SCAN_CACHE")) old_ = old;
+    ::setenv("TETRASAND_SCAN_CACHE", file.c_str(), 1);
+  }
+  ~ScopedScanCache() {
+    if (old_) {
+      ::setenv("TETRASAND_SCAN_CACHE", old_->c_str(), 1);
+    } else {
+      ::unsetenv("TETRASAND_SCAN_CACHE");
+    }
+  }
+  ScopedScanCache(const ScopedScanCache&) = delete;
+  ScopedScanCache& operator=(const ScopedScanCache&) = delete;
+
+ private:
+  std::optional<std::string> old_;
+};
+
+// --scan auto end to end: the first run calibrates and writes the cache, the next reads it (", cached"),
+// and a corrupt cache costs a warning and a new calibration, never the run.
+TEST(SdfBackend, ScanAutoCalibratesOnceThenReadsTheCacheAndSurvivesACorruptOne) {
+  const auto dir = test::temp_dir();
+  const std::filesystem::path cache = dir / "calibration" / "scan.json";
+  const ScopedScanCache scoped(cache);
+  const std::string run = "sdf " + quoted(test::asset("cube.obj")) + " -o " + quoted(dir / "c.vdb") +
+                          " --resolution 16 --backend gpu";
+  const std::regex calibrated(R"(\ndevice: .+; scan (compute|geometry) )"
+                              R"(\(calibrated [0-9.e+]+x geometry's speed\) )");
+  const std::regex cached(R"(\ndevice: .+; scan (compute|geometry) )"
+                          R"(\(calibrated [0-9.e+]+x geometry's speed, cached\) )");
+  std::string first, second, third;
+  ASSERT_EQ(test::run_tetrasand(run, &first), 0) << first;
+  EXPECT_TRUE(std::regex_search(first, calibrated)) << first;
+  ASSERT_TRUE(std::filesystem::exists(cache));
+  ASSERT_EQ(test::run_tetrasand(run, &second), 0) << second;
+  EXPECT_TRUE(std::regex_search(second, cached)) << second;
+  std::ofstream(cache, std::ios::trunc) << "not json";
+  ASSERT_EQ(test::run_tetrasand(run, &third), 0) << third;
+  EXPECT_NE(third.find("unreadable scan calibration cache"), std::string::npos) << third;
+  EXPECT_TRUE(std::regex_search(third, calibrated)) << third;
 }
 
 // Issue 42: plain `sdf` follows the rule of every command, so on llvmpipe (where the exact CPU path is 4-7x
@@ -216,12 +263,12 @@ TEST(SdfBackend, AutoTakesTheExactCpuPathOnASoftwareDeviceAndSaysSo) {
                 *device + "sdf " + bunny + " -o " + quoted(dir / "gpu.vdb") + " --backend gpu", &out),
             0)
       << out;
-  EXPECT_NE(
-      out.find("backend: gpu, scan conversion by compute shaders (asked for; --scan auto takes compute"),
-      std::string::npos)
+  EXPECT_TRUE(std::regex_search(
+      out, std::regex(R"(backend: gpu, scan conversion by (compute shaders|geometry shader) \(asked for; )"
+                      R"(--scan auto: calibrated )")))
       << out;
   EXPECT_TRUE(std::regex_search(
-      out, std::regex(R"(\ndevice: llvmpipe.*; scan conversion \(compute\) \d+\.\d{3} s\n)")))
+      out, std::regex(R"(\ndevice: llvmpipe.*; scan (compute|geometry) \(calibrated .*\) \d+\.\d{3} s\n)")))
       << out;
 }
 
@@ -239,7 +286,7 @@ TEST(SdfBackend, ScanComputeAndGeometryAreNamedEverywhereAndGiveTheSameBand) {
                 "backend: gpu, scan conversion by compute shaders (asked for; --scan compute asked for)\n"),
             std::string::npos)
       << compute;
-  EXPECT_NE(compute.find("; scan conversion (compute) "), std::string::npos) << compute;
+  EXPECT_NE(compute.find("; scan compute (--scan) "), std::string::npos) << compute;
   ASSERT_EQ(
       test::run_tetrasand("sdf " + bunny + " -o " + quoted(dir / "g.vdb") + common + "geometry", &geometry),
       0)
@@ -248,7 +295,7 @@ TEST(SdfBackend, ScanComputeAndGeometryAreNamedEverywhereAndGiveTheSameBand) {
                 "backend: gpu, scan conversion by geometry shader (asked for; --scan geometry asked for)\n"),
             std::string::npos)
       << geometry;
-  EXPECT_NE(geometry.find("; scan conversion (geometry) "), std::string::npos) << geometry;
+  EXPECT_NE(geometry.find("; scan geometry (--scan) "), std::string::npos) << geometry;
   EXPECT_EQ(band_voxels(compute), band_voxels(geometry)) << compute << geometry;
   ASSERT_EQ(test::run_tetrasand("sdf " + bunny + " -o " + quoted(dir / "j.vdb") + common + "geometry --json",
                                 &json),
@@ -330,14 +377,16 @@ TEST(CliSampleBackend, AutoRelaxesOnTheCpuOnASoftwareDeviceAndSaysSoOnTheDeviceL
   EXPECT_EQ(json.at("run").at("software_device"), true) << out;
 }
 
-// --scan picks the method of a field built on the GPU (auto: compute); run.scan names it, null for a
-// field built on the CPU.
+// --scan picks the method of a field built on the GPU (auto: the calibrated one); run.scan names it,
+// null for a field built on the CPU.
 TEST(CliSampleBackend, ScanPicksTheGpuFieldsMethodAndTheJsonNamesIt) {
   std::string out;
   ASSERT_EQ(run_sample("", "--sdf-backend gpu --scan geometry --json", &out), 0) << out;
   EXPECT_EQ(nlohmann::json::parse(out.substr(out.find("{\n"))).at("run").at("scan"), "geometry") << out;
   ASSERT_EQ(run_sample("", "--sdf-backend gpu", &out), 0) << out;
-  EXPECT_NE(out.find("SDF: by GPU scan conversion (compute, --scan auto), asked for)"), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(
+      out, std::regex(R"(SDF: by GPU scan (compute|geometry) \(calibrated [^)]*\), asked for\))")))
+      << out;
   ASSERT_EQ(run_sample("", "--sdf-backend cpu --backend cpu --json", &out), 0) << out;
   EXPECT_TRUE(nlohmann::json::parse(out.substr(out.find("{\n"))).at("run").at("scan").is_null()) << out;
   EXPECT_EQ(run_sample("", "--scan raster", &out), 2) << out;

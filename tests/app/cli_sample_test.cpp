@@ -364,7 +364,8 @@ TEST(CliSample, ReportNamesTheDeviceAndTheStageTimes) {
   EXPECT_TRUE(std::regex_search(
       out,
       std::regex(
-          R"(  device           .*\(device \d+, (software|hardware)\): SDF by GPU scan conversion [0-9.]+ s, )"
+          R"(  device           .*\(device \d+, (software|hardware)\): SDF by GPU scan (compute|geometry) )"
+          R"(\(calibrated [^)]*\) [0-9.]+ s, )"
           R"(relaxation [0-9.]+ s, certificate [0-9.]+ s)")))
       << out;
   EXPECT_TRUE(std::regex_search(out, std::regex(R"(relaxation \(all rounds\) +[0-9.]+ +[0-9.]+%)"))) << out;

@@ -14,14 +14,16 @@ test -x "$prefix/bin/tetrasand"
 test -f "$prefix/share/tetrasand/shaders/sdf/scan_convert.geom"
 # --backend gpu: the scan conversion reads the kernels (plain sdf takes the exact CPU path on a software
 # renderer).
-"$prefix/bin/tetrasand" sdf "$source/assets/cube.obj" -o "$prefix/cube.vdb" --resolution 16 --backend gpu
+"$prefix/bin/tetrasand" sdf "$source/assets/cube.obj" -o "$prefix/cube.vdb" --resolution 16 --backend gpu \
+    --scan compute
 test -s "$prefix/cube.vdb"
 # Proof that it read the installed copy (the build tree is a fallback): break the installed kernel of
-# the default scan (--scan auto: compute), and the same run must now fail with a shader error naming it.
-echo "this line is deliberately not GLSL (install_test);" >> "$prefix/share/tetrasand/shaders/sdf/scan_pairs.comp"
+# the compute scan (asked for: --scan auto may pick either after its calibration), and the same run must
+# now fail with a shader error naming it.
+echo "this line is deliberately not GLSL (install_test);" >> "$prefix/share/tetrasand/shaders/sdf/scan_bricks.comp"
 if "$prefix/bin/tetrasand" sdf "$source/assets/cube.obj" -o "$prefix/cube2.vdb" --resolution 16 --backend gpu \
-    >"$prefix/log" 2>&1; then
+    --scan compute >"$prefix/log" 2>&1; then
   echo "the installed executable did not read its installed shaders" >&2; exit 1
 fi
-grep -q "scan_pairs.comp" "$prefix/log" || { cat "$prefix/log" >&2; exit 1; }
+grep -q "scan_bricks.comp" "$prefix/log" || { cat "$prefix/log" >&2; exit 1; }
 echo "installed tetrasand ran its shaders from $prefix/share/tetrasand/shaders"

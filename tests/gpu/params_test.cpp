@@ -182,9 +182,16 @@ TEST_F(GpuParams, SdfProgramsMatchCpp) {
                        sizeof(ComputeScanParams),
                        {TS_MEMBER(params, ComputeScanParams, grid), TS_MEMBER(params, ComputeScanParams, slab),
                         TS_MEMBER(params, ComputeScanParams, pairs), TS_MEMBER(params, ComputeScanParams, band)}};
-  check(compute("sdf/scan_pairs.comp"), {compute_scan});
-  check(compute("sdf/scan_pairs.comp", {"NEAREST_TRIANGLE 1"}), {compute_scan});
-  check(compute("sdf/scan_write.comp"), {compute_scan});
+  check(compute("sdf/scan_bricks.comp"), {compute_scan});
+  check(compute("sdf/scan_bricks.comp", {"BRICK_COUNT 1"}), {compute_scan});
+  check(compute("sdf/scan_bricks.comp", {"BRICK_SCATTER 1"}), {compute_scan});
+  const BlockSpec brick_pairs{"BrickPairBlock",
+                              sizeof(BrickPairParams),
+                              {TS_MEMBER(params, BrickPairParams, grid), TS_MEMBER(params, BrickPairParams, bricks),
+                               TS_MEMBER(params, BrickPairParams, counts), TS_MEMBER(params, BrickPairParams, reach)}};
+  for (const char* pass : {"ROW_SPANS 1", "COUNT 1", "SCATTER 1"}) {
+    check(compute("sdf/brick_pairs.comp", {pass}), {brick_pairs});
+  }
   const BlockSpec leaf{"LeafBlock",
                        sizeof(LeafBuildParams),
                        {TS_MEMBER(params, LeafBuildParams, grid), TS_MEMBER(params, LeafBuildParams, leaves),

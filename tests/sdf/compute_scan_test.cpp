@@ -6,8 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <random>
 #include <set>
 #include <tuple>
 
@@ -15,10 +17,12 @@
 #include "core/mesh_report.h"
 #include "core/primitives.h"
 #include "gpu/context.h"
+#include "gpu/shader_library.h"
 #include "sdf/exact_sdf.h"
 #include "sdf/grid.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
+#include "shaders/sdf/bindings.h"
 #include "tests/test_meshes.h"
 #include "tests/test_support.h"
 
@@ -237,6 +241,139 @@ void expect_every_band_brick_paired(const TriangleMesh& sphere, const GridSpec& 
         }
   EXPECT_GT(needed, 10000u);
   EXPECT_EQ(missing, 0u);
+}
+
+// The mesh's triangles as the scan conversion uploads them: grid-local voxel units, pseudonormals,
+// face_normal.w 0 for a degenerate one; `usable` receives the others.
+std::vector<gpu::layout::SdfTriangle> grid_triangles(const TriangleMesh& mesh, const GridSpec& spec,
+                                                     std::vector<std::uint32_t>& usable) {
+  const Pseudonormals normals = compute_pseudonormals(mesh);
+  auto to_vec4 = [](const Eigen::Vector3d& v, double w = 0.0) {
+    return gpu::layout::vec4{static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()),
+                             static_cast<float>(w)};
+  };
+  std::vector<gpu::layout::SdfTriangle> triangles(mesh.triangle_count());
+  usable.clear();
+  for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+    Eigen::Vector3d v[3];
+    for (int k = 0; k < 3; ++k) {
+      v[k] = spec.to_voxel(mesh.vertices[mesh.triangles[t][k]]);
+      triangles[t].vertex[k] = to_vec4(v[k]);
+      triangles[t].edge_normal[k] = to_vec4(normals.edge[t][static_cast<std::size_t>(k)]);
+      triangles[t].vertex_normal[k] = to_vec4(normals.vertex[t][static_cast<std::size_t>(k)]);
+    }
+    const bool degenerate = !((v[1] - v[0]).cross(v[2] - v[0]).norm() > 1e-9);
+    triangles[t].face_normal = to_vec4(normals.face[t], degenerate ? 0.0 : 1.0);
+    if (!degenerate) usable.push_back(t);
+  }
+  return triangles;
+}
+
+// The pairs of one brick row as a sorted list of (triangle, brick x | brick y << 16).
+std::vector<std::uint64_t> row_set(const BrickPairs& pairs, std::size_t row) {
+  std::vector<std::uint64_t> out;
+  for (std::uint32_t p = pairs.row_begin[row]; p < pairs.row_begin[row + 1]; ++p)
+    out.push_back(std::uint64_t{pairs.words[2 * p]} << 32 | pairs.words[2 * p + 1]);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(GpuBrickPairs, AreTheHostPairsAsASetInEveryBrickRow) {
+  gpu::Context context;
+  const gpu::ShaderLibrary library;
+  gpu::Queue queue;
+  BrickPairGenerator generator(library);
+  TriangleMesh cube = box_mesh({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
+  cube.triangles.push_back({0, 0, 1});  // degenerate: no pairs on either side
+  struct Case {
+    const char* name;
+    TriangleMesh mesh;
+    int resolution;
+  };
+  const Case cases[] = {{"knot1", load_mesh(test::cgal_mesh("knot1")), 40},
+                        {"fandisk", load_mesh(test::cgal_mesh("fandisk")), 32},
+                        {"cube", cube, 24}};
+  for (const Case& c : cases) {
+    SdfSettings settings;
+    settings.resolution = c.resolution;
+    const GridSpec spec = make_grid(bounding_box(c.mesh), settings);
+    std::vector<std::uint32_t> usable;
+    const auto triangles = grid_triangles(c.mesh, spec, usable);
+    const gpu::Buffer buffer = gpu::Buffer::from<gpu::layout::SdfTriangle>(triangles);
+    for (int side : {2, 4}) {
+      SCOPED_TRACE(std::string(c.name) + " brick " + std::to_string(side));
+      const BrickPairs host = build_brick_pairs(triangles, usable, spec, 3.25, side);
+      const BrickPairs device =
+          generator.run(queue, buffer, static_cast<std::uint32_t>(triangles.size()), spec, 3.25, side).download();
+      EXPECT_GT(host.count(), 1000u);
+      EXPECT_EQ(device.brick, side);
+      ASSERT_EQ(device.row_begin, host.row_begin);
+      std::size_t different_rows = 0;
+      for (std::size_t r = 0; r + 1 < host.row_begin.size(); ++r)
+        different_rows += row_set(device, r) == row_set(host, r) ? 0 : 1;
+      EXPECT_EQ(different_rows, 0u);
+    }
+  }
+}
+
+// Pairs with each row's order changed (`order`: 0 as given, 1 reversed, 2 shuffled) on the GPU.
+GpuBrickPairs reorder_rows(const BrickPairs& pairs, int order) {
+  std::vector<std::uint32_t> words = pairs.words;
+  std::mt19937 random(7);
+  for (std::size_t r = 0; r + 1 < pairs.row_begin.size(); ++r) {
+    std::vector<std::uint64_t> row;
+    for (std::uint32_t p = pairs.row_begin[r]; p < pairs.row_begin[r + 1]; ++p)
+      row.push_back(std::uint64_t{words[2 * p]} << 32 | words[2 * p + 1]);
+    if (order == 1) std::reverse(row.begin(), row.end());
+    if (order == 2) std::shuffle(row.begin(), row.end(), random);
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      words[2 * (pairs.row_begin[r] + k)] = static_cast<std::uint32_t>(row[k] >> 32);
+      words[2 * (pairs.row_begin[r] + k) + 1] = static_cast<std::uint32_t>(row[k]);
+    }
+  }
+  GpuBrickPairs out;
+  out.brick = pairs.brick;
+  out.row_begin = pairs.row_begin;
+  out.pairs = gpu::Buffer::from<std::uint32_t>(words);
+  return out;
+}
+
+TEST(GpuBrickPairs, OrderWithinARowDoesNotChangeOneBitOfTheField) {
+  // The GPU's atomics hand out places within a row in whatever order invocations run; the passes
+  // keep the least distance, then the least triangle index, so any order must give the same bytes.
+  gpu::Context context;
+  const gpu::ShaderLibrary library;
+  gpu::Queue queue;
+  const TriangleMesh mesh = load_mesh(test::cgal_mesh("knot1"));
+  SdfSettings settings;
+  settings.resolution = 24;
+  const GridSpec spec = make_grid(bounding_box(mesh), settings);
+  std::vector<std::uint32_t> usable;
+  const auto triangles = grid_triangles(mesh, spec, usable);
+  const gpu::Buffer buffer = gpu::Buffer::from<gpu::layout::SdfTriangle>(triangles);
+  const BrickPairs host = build_brick_pairs(triangles, usable, spec, 3.25, 2);
+  const std::size_t floats = 4 * static_cast<std::size_t>(spec.voxel_count());
+  auto field = [&](GpuBrickPairs pairs) {
+    const std::vector<float> clear(floats, 0.0f);
+    gpu::Texture target =
+        gpu::Texture::create_2d_array(GL_RGBA32F, spec.dims.x(), spec.dims.y(), spec.dims.z(), "test slab");
+    target.upload(clear.data(), GL_RGBA, GL_FLOAT);
+    ts::sdf::ComputeScan scan(library, std::move(pairs), spec, spec.dims.z(), 3.0);
+    EXPECT_EQ(scan.fill(queue, buffer, target, 0, spec.dims.z()), host.count());
+    std::vector<float> values(floats);
+    target.read(values.data(), values.size() * sizeof(float), GL_RGBA, GL_FLOAT);
+    return values;
+  };
+  const std::vector<float> ascending = field(reorder_rows(host, 0));
+  std::size_t reached = 0;
+  for (std::size_t v = 0; v < floats; v += 4) reached += ascending[v + 3] != 0.0f ? 1 : 0;
+  EXPECT_GT(reached, 3000u);
+  BrickPairGenerator generator(library);
+  const std::vector<float> fields[] = {
+      field(reorder_rows(host, 1)), field(reorder_rows(host, 2)),
+      field(generator.run(queue, buffer, static_cast<std::uint32_t>(triangles.size()), spec, 3.25, 2))};
+  for (const std::vector<float>& other : fields)
+    EXPECT_EQ(std::memcmp(other.data(), ascending.data(), floats * sizeof(float)), 0);
 }
 
 TEST(BrickPairs, EveryBrickWithAVoxelInATrianglesBandIsPairedWithItAndRowsAreSorted) {
