@@ -25,33 +25,11 @@
 #include "sdf/sparse_field.h"
 #include "shaders/common/layouts.h"
 #include "shaders/test/bindings.h"
+#include "tests/sdf/field_probe.h"
 #include "tests/test_support.h"
 
 namespace ts::sdf {
 namespace {
-
-// Runs the probe kernel (shaders/test/sparse_field_probe.comp) on `field` at grid-local `points`.
-std::vector<Eigen::Vector4f> probe(const GpuField& field, const std::vector<Eigen::Vector4f>& points, int mode) {
-  gpu::ShaderLibrary library;
-  std::vector<std::string> defines = field.shader_defines();
-  defines.push_back("TS_PROBE_MODE " + std::to_string(mode));
-  gpu::Program program = gpu::Program::compute(library, "test/sparse_field_probe.comp", defines);
-  gpu::Buffer in = gpu::Buffer::from<Eigen::Vector4f>(points);
-  gpu::Buffer out(points.size() * sizeof(Eigen::Vector4f));
-  field.bind({TS_TEST_FIELD_GRID,
-              {TS_TEST_FIELD_CHUNK_1, TS_TEST_FIELD_CHUNK_2, TS_TEST_FIELD_CHUNK_3, TS_TEST_FIELD_CHUNK_4,
-               TS_TEST_FIELD_CHUNK_5, TS_TEST_FIELD_CHUNK_6, TS_TEST_FIELD_CHUNK_7},
-              TS_TEST_FIELD_PARAMS, TS_TEST_FIELD_ROOTS});
-  in.bind(TS_TEST_FIELD_POINTS);
-  out.bind(TS_TEST_FIELD_VALUES);
-  gpu::ParamBlock<gpu::params::FieldProbeParams> params;
-  params.values.count.x = static_cast<unsigned>(points.size());
-  params.values.mode.x = mode;
-  params.bind(TS_TEST_PARAMS);
-  gpu::Queue queue(false, true);
-  queue.dispatch_items(program, points.size(), GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  return out.read<Eigen::Vector4f>(points.size());
-}
 
 struct Case {
   std::string mesh;  // assets/<mesh>.obj, or cgal:<name> for libcgal-demo's
@@ -119,8 +97,8 @@ TEST_P(LeafFieldTest, GlslReadsTheSameValueAsTheHostFieldAtEveryVoxelOnAndOffThe
   EXPECT_EQ(leaves.background(), result.grid->background());
 
   const std::vector<Eigen::Vector4f> points = every_voxel();
-  const auto expected = probe(host, points, 0);
-  const auto actual = probe(leaves, points, 0);
+  const auto expected = test::probe_field(host, points, 0);
+  const auto actual = test::probe_field(leaves, points, 0);
   std::size_t differ = 0, inside = 0, band = 0;
   for (std::size_t n = 0; n < points.size(); ++n) {
     const float e = expected[n].x(), a = actual[n].x();
@@ -145,8 +123,8 @@ TEST_P(LeafFieldTest, SampledValuesAndGradientsMatchTheHostFieldBitForBit) {
   for (int n = 0; n < 4000; ++n)
     points.emplace_back(u(rng) * static_cast<float>(spec_.dims.x() - 1), u(rng) * static_cast<float>(spec_.dims.y() - 1),
                         u(rng) * static_cast<float>(spec_.dims.z() - 1), 0.0f);
-  const auto expected = probe(host, points, 2);
-  const auto actual = probe(*result.field, points, 2);
+  const auto expected = test::probe_field(host, points, 2);
+  const auto actual = test::probe_field(*result.field, points, 2);
   ASSERT_EQ(expected.size(), actual.size());
   EXPECT_EQ(std::memcmp(expected.data(), actual.data(), expected.size() * sizeof(Eigen::Vector4f)), 0);
 }

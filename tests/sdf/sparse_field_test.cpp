@@ -27,35 +27,13 @@
 #include "sdf/scan_convert.h"
 #include "shaders/test/bindings.h"
 #include "tests/test_meshes.h"
+#include "tests/sdf/field_probe.h"
 #include "tests/test_support.h"
 
 namespace ts::sdf {
 namespace {
 
 using test::grid_around;
-
-// Runs the probe kernel (shaders/test/sparse_field_probe.comp) at grid-local `points`.
-std::vector<Eigen::Vector4f> probe_field(const SparseField& field, const std::vector<Eigen::Vector4f>& points, int mode) {
-  gpu::ShaderLibrary library;
-  std::vector<std::string> defines = field.shader_defines();
-  defines.push_back("TS_PROBE_MODE " + std::to_string(mode));
-  gpu::Program program = gpu::Program::compute(library, "test/sparse_field_probe.comp", defines);
-  gpu::Buffer in = gpu::Buffer::from<Eigen::Vector4f>(points);
-  gpu::Buffer out(points.size() * sizeof(Eigen::Vector4f));
-  field.bind({TS_TEST_FIELD_GRID,
-              {TS_TEST_FIELD_CHUNK_1, TS_TEST_FIELD_CHUNK_2, TS_TEST_FIELD_CHUNK_3, TS_TEST_FIELD_CHUNK_4,
-               TS_TEST_FIELD_CHUNK_5, TS_TEST_FIELD_CHUNK_6, TS_TEST_FIELD_CHUNK_7},
-              TS_TEST_FIELD_PARAMS, TS_TEST_FIELD_ROOTS});
-  in.bind(TS_TEST_FIELD_POINTS);
-  out.bind(TS_TEST_FIELD_VALUES);
-  gpu::ParamBlock<gpu::params::FieldProbeParams> params;
-  params.values.count.x = static_cast<unsigned>(points.size());
-  params.values.mode.x = mode;
-  params.bind(TS_TEST_PARAMS);
-  gpu::Queue queue(false, true);
-  queue.dispatch_items(program, points.size(), GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  return out.read<Eigen::Vector4f>(points.size());
-}
 
 class SparseFieldTest : public ::testing::Test {
  protected:
@@ -73,7 +51,7 @@ class SparseFieldTest : public ::testing::Test {
   }
 
   std::vector<Eigen::Vector4f> probe(const SparseField& field, const std::vector<Eigen::Vector4f>& points, int mode) {
-    return probe_field(field, points, mode);
+    return test::probe_field(field, points, mode);
   }
 
   // Band voxels of the torus at random, grid-local.
@@ -472,7 +450,7 @@ TEST_F(SparseFieldPast4096Test, GlslReadsEveryBandVoxelAndTheBackgroundOffItBitF
   for (const auto& entry : field.root_table().entries) held += entry.address.z;
   EXPECT_EQ(held, 9u);
   const auto points = band_and_off_band_points();
-  const auto values = probe_field(field, points, 0);
+  const auto values = test::probe_field(field, points, 0);
   std::size_t in_band = 0, inside = 0, outside = 0;
   for (std::size_t p = 0; p < points.size(); ++p) {
     const float expected = host_value(points[p]);
@@ -491,7 +469,7 @@ TEST_F(SparseFieldPast4096Test, GlslReadsEveryBandVoxelAndTheBackgroundOffItBitF
 TEST_F(SparseFieldPast4096Test, ReadsNeverDependOnPnanovdbsRootWalkAndInterpolateAcrossRootTiles) {
   const SparseField field(*grid_, spec_, 3.0);
   const auto points = band_and_off_band_points();
-  const auto values = probe_field(field, points, 5);
+  const auto values = test::probe_field(field, points, 5);
   for (std::size_t p = 0; p < points.size(); ++p) {
     ASSERT_EQ(values[p].x(), host_value(points[p])) << "grid-local voxel " << points[p].transpose();
   }
@@ -500,7 +478,7 @@ TEST_F(SparseFieldPast4096Test, ReadsNeverDependOnPnanovdbsRootWalkAndInterpolat
   std::uniform_real_distribution<float> u(-9.0f, 9.0f);
   const Eigen::Vector3f meet = (Eigen::Vector3i(0, 4096, 0) - spec_.index_offset).cast<float>();
   for (int n = 0; n < 5000; ++n) between.emplace_back(meet.x() + u(rng), meet.y() + u(rng), meet.z() + u(rng), 0.0f);
-  const auto trilinear = probe_field(field, between, 1);
+  const auto trilinear = test::probe_field(field, between, 1);
   auto accessor = grid_->getConstAccessor();
   double worst = 0.0;
   for (std::size_t p = 0; p < between.size(); ++p) {
