@@ -92,12 +92,8 @@ def findings(rows):
            f"{num(vdb_p99, 'openvdb_p99'):.3f} voxel ({vdb_p99['mesh']} at {vdb_p99['resolution']}), with "
            f"{min(vdb_signs)} to {max(vdb_signs)} wrong signs per run. The geometry path's field is closer to exact than "
            f"OpenVDB's (mean and max) in {closer} of {len(rows)} runs."]
-    speed = []
-    for mesh in dict.fromkeys(r["mesh"] for r in rows):
-        rs = [r for r in rows if r["mesh"] == mesh]
-        ratios = ", ".join(f"{num(r, 'exact_s') / num(r, 'gpu_s'):.2f} at {r['resolution']}" for r in rs)
-        vdb = ", ".join(f"{num(r, 'openvdb_s') / num(r, 'gpu_s'):.2f}" for r in rs)
-        speed.append(f"{mesh} ({rs[0]['triangles']} triangles): exact / geometry {ratios}; OpenVDB / geometry {vdb}")
+    speed = [f"{mesh} ({rs[0]['triangles']} triangles): exact / geometry {time_ratios(rs, 'exact_s', 'gpu_s')}; "
+             f"OpenVDB / geometry {time_ratios(rs, 'openvdb_s', 'gpu_s', at=False)}" for mesh, rs in rows_by_mesh(rows)]
     out.append("- **Speed** (time ratios; above 1 the geometry path is faster): " + "; ".join(speed) + ".")
     if has_compute(rows):
         out += compute_findings(rows)
@@ -111,6 +107,17 @@ def findings(rows):
     return out
 
 
+def rows_by_mesh(rows):
+    """(mesh, its rows) in the order the meshes first appear."""
+    for mesh in dict.fromkeys(r["mesh"] for r in rows):
+        yield mesh, [r for r in rows if r["mesh"] == mesh]
+
+
+def time_ratios(rs, top, bottom, at=True):
+    """"a / b at R, ..." of two time columns over rows `rs`."""
+    return ", ".join(f"{float(r[top]) / float(r[bottom]):.2f}" + (f" at {r['resolution']}" if at else "") for r in rs)
+
+
 def compute_findings(rows):
     """The compute scan conversion's bullets (issue 43), every number from `rows`."""
     num = lambda r, k: float(r[k])
@@ -120,12 +127,8 @@ def compute_findings(rows):
     out = [f"- **Compute path.** Largest error against exact {num(worst, 'compute_max'):.1e} voxel ({worst['mesh']} at "
            f"{worst['resolution']}), {signs} wrong signs over all {len(rows)} runs; the same band voxel count as the "
            f"geometry path in {same} of {len(rows)} runs."]
-    speed = []
-    for mesh in dict.fromkeys(r["mesh"] for r in rows):
-        rs = [r for r in rows if r["mesh"] == mesh]
-        geometry = ", ".join(f"{num(r, 'gpu_s') / num(r, 'compute_s'):.2f} at {r['resolution']}" for r in rs)
-        vdb = ", ".join(f"{num(r, 'openvdb_s') / num(r, 'compute_s'):.2f}" for r in rs)
-        speed.append(f"{mesh}: geometry / compute {geometry}; OpenVDB / compute {vdb}")
+    speed = [f"{mesh}: geometry / compute {time_ratios(rs, 'gpu_s', 'compute_s')}; "
+             f"OpenVDB / compute {time_ratios(rs, 'openvdb_s', 'compute_s', at=False)}" for mesh, rs in rows_by_mesh(rows)]
     out.append("- **Compute speed** (above 1 the compute path is faster): " + "; ".join(speed) + ".")
     return out
 
