@@ -1,4 +1,4 @@
-// `tetrasand preview (MESH | SDF.vdb) [--particles FILE] -o OUT.png`: off-screen ray-cast preview.
+// `tetrasand preview (MESH | SDF.vdb | SDF.nvdb) [--particles FILE] -o OUT.png`: off-screen ray-cast preview.
 #include <fmt/format.h>
 
 #include <cctype>
@@ -49,7 +49,7 @@ Eigen::Vector2i parse_size(const std::string& text) {
 bool is_vdb(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".vdb";
+  return ext == ".vdb" || ext == ".nvdb";
 }
 
 // OUT.png -> OUT_007.png for turntable frame 7.
@@ -81,7 +81,7 @@ preview::Camera make_camera(const Options& o, const Aabb& box, double aspect) {
 
 // Options are registered in the order --help lists them.
 void add_input_options(CLI::App* cmd, Options& o) {
-  cmd->add_option("INPUT", o.input, "Mesh (any format assimp reads; scan-converted here) or SDF.vdb level set");
+  cmd->add_option("INPUT", o.input, "Mesh (any format assimp reads; scan-converted here) or a level set SDF.vdb or SDF.nvdb");
   cmd->add_option("-o,--output", o.output, "Output PNG")->required();
   cmd->add_option("--particles", o.particles, "Particles over the surface: NAME.body.json or a PLY of centres");
   cmd->add_option("--particle-radius", o.particle_radius,
@@ -166,7 +166,7 @@ void add_lighting_options(CLI::App* cmd, Options& o) {
 
 // Combinations CLI11 cannot check by itself.
 void check_options(const Options& o) {
-  if (o.input.empty() && o.particles.empty()) throw Error(ExitCode::Usage, "preview: give a MESH or an SDF.vdb, or --particles");
+  if (o.input.empty() && o.particles.empty()) throw Error(ExitCode::Usage, "preview: give a MESH or an SDF.vdb / SDF.nvdb, or --particles");
   if (o.backend == "cpu") {
     throw Error(ExitCode::Usage,
                 "--backend cpu: the preview has only a GPU path for now (no CPU renderer); --backend auto or gpu "
@@ -356,7 +356,7 @@ int run_preview(const Options& o, const GlobalOptions& global) {
 
 Runner add_preview_command(CLI::App& app, const GlobalOptions& global) {
   return add_command<Options>(app, global, "preview",
-                              "Off-screen preview: ray-cast SDF (of a mesh or a .vdb level set) with particles as sphere "
+                              "Off-screen preview: ray-cast SDF (of a mesh or a .vdb or .nvdb level set) with particles as sphere "
                               "impostors, to PNG",
                               run_preview, add_input_options, add_camera_options, add_colour_options, add_sdf_options,
                               add_lighting_options);

@@ -140,7 +140,7 @@ std::size_t write_level_set(const Options& o, const sdf::ScanConvertResult& resu
     *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   if (is_nanovdb_path(o.output)) {
-    const sdf::NanoGrid nano = sdf::to_nanovdb(*result.grid);
+    sdf::NanoGrid nano = sdf::to_nanovdb(*result.grid);
     sdf::write_nvdb(o.output, nano, {o.mesh});
     lap();
     return nano.size();

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <nanovdb/util/GridChecksum.h>
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 
@@ -167,7 +168,10 @@ void SparseField::bind(const FieldSlots& slots) const {
   params_.bind(slots.params);
 }
 
-void write_nvdb(const std::filesystem::path& file, const NanoGrid& grid, const std::vector<std::filesystem::path>& inputs) {
+void write_nvdb(const std::filesystem::path& file, NanoGrid& grid, const std::vector<std::filesystem::path>& inputs) {
+  // A full checksum (a CRC over the whole grid), so a damaged file is told by tetrasand's reader and by
+  // NanoVDB's own validator instead of being read as another field.
+  nanovdb::updateChecksum(*grid.grid<float>(), nanovdb::ChecksumMode::Full);
   // Through the checked stream of core/atomic_file.h: NanoVDB's writer by name never checks its writes.
   write_stream_atomically(
       file,

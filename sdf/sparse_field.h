@@ -100,7 +100,8 @@ class SparseField final : public GpuField {
 };
 
 // Writes `grid` as a NanoVDB file (uncompressed, readable by nanovdb_print / nanovdb_validate),
-// atomically; `inputs` are never overwritten (core/atomic_file.h).
-void write_nvdb(const std::filesystem::path& file, const NanoGrid& grid, const std::vector<std::filesystem::path>& inputs);
+// atomically, with a full checksum set in `grid` first (so damage is told on reading); `inputs` are never
+// overwritten (core/atomic_file.h).
+void write_nvdb(const std::filesystem::path& file, NanoGrid& grid, const std::vector<std::filesystem::path>& inputs);
 
 }  // namespace ts::sdf

@@ -1,6 +1,9 @@
 #include "sdf/vdb_io.h"
 
 #include <fmt/format.h>
+#include <nanovdb/util/GridValidator.h>
+#include <nanovdb/util/IO.h>
+#include <nanovdb/util/NanoToOpenVDB.h>
 #include <openvdb/io/Stream.h>
 
 #include <ext/stdio_filebuf.h>
@@ -113,6 +116,37 @@ openvdb::GridPtrVecPtr detail::read_grids_in_this_process(const std::filesystem:
   }
 }
 
+openvdb::GridPtrVecPtr detail::read_nanovdb_grid_in_this_process(const std::filesystem::path& path) {
+  require_regular_file(path);
+  std::error_code ec;
+  // As for .vdb: no allocation of a sound read is far above the file's size (an uncompressed grid is
+  // the file less its headers), so a grid size beyond it is a length the reader would trust.
+  const std::uintmax_t file_bytes = std::filesystem::file_size(path, ec);
+  const std::size_t cap = static_cast<std::size_t>(ec ? 0 : file_bytes) * 4 + (std::size_t{64} << 20);
+  nanovdb::GridHandle<nanovdb::HostBuffer> handle;
+  try {
+    const AllocationCap allocation_cap(cap);
+    handle = nanovdb::io::readGrid<nanovdb::HostBuffer>(path.string());
+  } catch (const std::bad_alloc&) {
+    throw InputError(path, fmt::format("is not a readable NanoVDB file (its grid size asks for more than {} MiB, more "
+                                       "than a file of {} bytes can hold)",
+                                       cap >> 20, file_bytes));
+  } catch (const std::exception& e) {
+    throw InputError(path, fmt::format("is not a readable NanoVDB file ({})", e.what()));
+  }
+  const nanovdb::NanoGrid<float>* grid = handle.grid<float>();
+  if (!grid) throw InputError(path, "holds no float grid first (a level set is a float grid)");
+  // Every node offset is followed when the grid is converted: a grid whose own size or nodes lie
+  // outside what was read is refused before that.
+  if (grid->gridSize() > handle.size())
+    throw InputError(path, "is a damaged NanoVDB file (its grid claims more bytes than the file holds)");
+  if (const std::string problem = nanovdb::GridValidator<float>::check(*grid, /*detailed=*/true); !problem.empty())
+    throw InputError(path, "is a damaged NanoVDB file (NanoVDB's validator: " + problem + ")");
+  auto grids = std::make_shared<openvdb::GridPtrVec>();
+  grids->push_back(nanovdb::nanoToOpenVDB(*grid));
+  return grids;
+}
+
 namespace {
 
 void write_all(int fd, std::string_view bytes) {
@@ -123,6 +157,13 @@ void write_all(int fd, std::string_view bytes) {
   }
 }
 
+// NanoVDB files start with the bytes "NanoVDB0" (nanovdb::io's file header magic), whatever their name.
+bool is_nanovdb_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[8] = {};
+  return in.read(magic, sizeof magic) && std::string_view(magic, sizeof magic) == "NanoVDB0";
+}
+
 // The reader process: reads the file, streams its float grids back through `data_fd` as OpenVDB
 // writes them (uncompressed, no statistics: nothing that needs TBB's threads, which a forked
 // process does not have), and says what went wrong through `message_fd`. Never returns.
@@ -130,7 +171,8 @@ void write_all(int fd, std::string_view bytes) {
   int code = kGridsStreamed;
   std::string message;
   try {
-    const openvdb::GridPtrVecPtr grids = detail::read_grids_in_this_process(path);
+    const openvdb::GridPtrVecPtr grids = is_nanovdb_file(path) ? detail::read_nanovdb_grid_in_this_process(path)
+                                                               : detail::read_grids_in_this_process(path);
     openvdb::GridCPtrVec floats;
     for (const auto& grid : *grids)
       if (openvdb::gridPtrCast<openvdb::FloatGrid>(grid)) floats.push_back(grid);

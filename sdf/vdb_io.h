@@ -17,7 +17,8 @@ void write_vdb(const std::filesystem::path& path, const openvdb::FloatGrid::Ptr&
                const std::map<std::string, std::string>& metadata = {},
                const std::vector<std::filesystem::path>& inputs = {});
 
-// The first float level-set grid of a file. ts::InputError for: a missing file, a file that is not
+// The first float level-set grid of an OpenVDB file (.vdb), or the grid of a NanoVDB file (.nvdb, told
+// by its first bytes), as an OpenVDB grid. ts::InputError for: a missing file, a file that is not
 // a VDB, no float grid, a grid that is not a level set, an empty grid, and a file that crashes
 // OpenVDB's reader: the file is read in a forked child process (OpenVDB 10 writes past its buffers
 // on some broken files), which streams the float grids back. Call it while no other thread holds a
@@ -36,6 +37,11 @@ enum class UncheckedGrids { Read, Refuse };
 // OpenVDB unchecked. fuzz_vdb, which needs the reader's coverage in its own process, refuses them.
 openvdb::GridPtrVecPtr read_grids_in_this_process(const std::filesystem::path& path,
                                                   UncheckedGrids unchecked = UncheckedGrids::Read);
+
+// The same for a NanoVDB file: its first grid read (no allocation far above the file's size), checked
+// by NanoVDB's validator, converted to OpenVDB. Run in the reader's child process: the conversion follows
+// the node offsets the file holds.
+openvdb::GridPtrVecPtr read_nanovdb_grid_in_this_process(const std::filesystem::path& path);
 }  // namespace detail
 
 }  // namespace ts::sdf

@@ -72,6 +72,44 @@ TEST(CliPreview, RendersLevelSetsParticlesAndTurntables) {
   EXPECT_EQ(sheet.height, 60);
 }
 
+// `sdf -o X.nvdb` writes what `preview` reads: the same level set as the .vdb of the same run, so the
+// same picture to the pixel. A damaged or cut-short .nvdb is an error naming the file, not a crash.
+TEST(CliPreview, ANanoVdbLevelSetPreviewsAsItsVdbAndABrokenOneIsAClearError) {
+  const auto dir = test::temp_dir();
+  const std::string sdf_args = q(test::asset("bunny.obj")) + " --resolution 32 --backend cpu -o ";
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sdf " + sdf_args + q(dir / "b.vdb"), &out), 0) << out;
+  ASSERT_EQ(test::run_tetrasand("sdf " + sdf_args + q(dir / "b.nvdb"), &out), 0) << out;
+  for (const char* name : {"b.vdb", "b.nvdb"}) {
+    ASSERT_EQ(test::run_tetrasand("preview " + q(dir / name) + " -o " + q(dir / (std::string(name) + ".png")) +
+                                      " --size 64x48",
+                                  &out),
+              0)
+        << name << "\n"
+        << out;
+  }
+  const preview::Image vdb = preview::read_png(dir / "b.vdb.png");
+  const preview::Image nvdb = preview::read_png(dir / "b.nvdb.png");
+  ASSERT_EQ(vdb.rgba.size(), nvdb.rgba.size());
+  EXPECT_TRUE(vdb.rgba == nvdb.rgba);
+  EXPECT_TRUE(std::any_of(vdb.rgba.begin(), vdb.rgba.end(), [&](std::uint8_t c) { return c != vdb.rgba.front(); }));
+
+  const std::string nano = read_file(dir / "b.nvdb");
+  write_file_atomically(dir / "cut.nvdb", nano.substr(0, nano.size() / 2));
+  std::string damaged = nano;
+  for (std::size_t i = damaged.size() / 2; i < damaged.size(); i += 97) damaged[i] = static_cast<char>(0xA5);
+  write_file_atomically(dir / "damaged.nvdb", damaged);
+  write_file_atomically(dir / "magic-only.nvdb", std::string("NanoVDB0") + std::string(300, '\x7f'));
+  for (const char* name : {"cut.nvdb", "damaged.nvdb", "magic-only.nvdb"}) {
+    EXPECT_EQ(test::run_tetrasand("preview " + q(dir / name) + " -o " + q(dir / "x.png") + " --size 8x8", &out), 1)
+        << name << "\n"
+        << out;
+    EXPECT_NE(out.find(name), std::string::npos) << out;
+    EXPECT_EQ(out.find("crashed"), std::string::npos) << name << ": the reader should refuse it, not crash\n" << out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+}
+
 TEST(CliPreview, BadInputsExitWithClearMessages) {
   const auto dir = test::temp_dir();
   sdf::ensure_openvdb_initialized();

@@ -371,7 +371,8 @@ TEST_F(SparseFieldTest, GpuMemoryFollowsTheBandNotTheBox) {
 TEST_F(SparseFieldTest, NanoVdbFilesPassNanovdbValidate) {
   const auto dir = test::temp_dir();
   const auto file = dir / "torus.nvdb";
-  write_nvdb(file, to_nanovdb(*result_.grid), {});
+  NanoGrid nano = to_nanovdb(*result_.grid);
+  write_nvdb(file, nano, {});
   const NanoGrid back = nanovdb::io::readGrid(file.string());
   ASSERT_TRUE(back.grid<float>());
   EXPECT_EQ(back.grid<float>()->activeVoxelCount(), result_.grid->activeVoxelCount());
