@@ -161,10 +161,17 @@ void CpuStepper::check_stability(const World& world, double mechanical_energy, c
                                                   world.time, k));
     }
   }
+  // A finite state can still hold a NaN energy (an inertia that overflows); the growth test below would
+  // pass it, as every comparison with NaN is false.
+  if (!std::isfinite(mechanical_energy) || !std::isfinite(stats.energy.total())) {
+    throw Error(ExitCode::Unstable, fmt::format("simulation unstable at t = {:.6g} s: the mechanical energy is not "
+                                                "finite (reduce dt; see the time-step bound)",
+                                                world.time));
+  }
   if (stats.penetration.count > 0) throw WallPenetration(world.time, stats.penetration);
   if (!settings_.check_energy || any_kinematic) return;  // kinematic bodies do work on the system
   const double growth = mechanical_energy - energy_reference_;
-  if (growth > settings_.energy_growth_tolerance * energy_scale_) {
+  if (!(growth <= settings_.energy_growth_tolerance * energy_scale_)) {
     throw Error(ExitCode::Unstable,
                 fmt::format("simulation unstable at t = {:.6g} s: mechanical energy grew by {:.3g} J with no work "
                             "done (allowed {:.3g} J); reduce dt (see the time-step bound)",

@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
@@ -168,6 +170,23 @@ class ValueCheck {
   ByteReader& r_;
 };
 
+// What a fresh body's inverse inertia always is: symmetric positive definite, with an inertia (its
+// inverse) that is finite too. A crafted one that is finite but not invertible in doubles (1e308 on the
+// diagonal, found by fuzz_checkpoint) made the rotational energy NaN while the state stayed finite.
+std::string inverse_inertia_problem(const Eigen::Matrix3d& inverse_inertia) {
+  const double scale = inverse_inertia.cwiseAbs().maxCoeff();
+  if (!((inverse_inertia - inverse_inertia.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale))
+    return "not symmetric";
+  const Eigen::Vector3d eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inverse_inertia,
+                                                                                     Eigen::EigenvaluesOnly)
+                                          .eigenvalues();
+  if (!(eigenvalues.minCoeff() > 0)) return fmt::format("not positive definite (eigenvalue {:.3g})", eigenvalues.minCoeff());
+  // The inertia, and the rotational energy through it, must come out finite.
+  if (!eigenvalues.cwiseInverse().allFinite() || !inverse_inertia.inverse().allFinite())
+    return "its inverse, the inertia, is not finite";
+  return {};
+}
+
 void check_body_values(const Bodies& b, const ValueCheck& check, ByteReader& r) {
   for (std::size_t k = 0; k < b.size(); ++k) {
     check.finite(b.position[k], "body position", k);
@@ -187,9 +206,12 @@ void check_body_values(const Bodies& b, const ValueCheck& check, ByteReader& r) 
     // A dynamic body moves by its forces times its inverse mass: 0 would freeze it, inf fling it.
     if (b.motion[k] == MotionType::Dynamic) {
       check.positive(b.inverse_mass[k], "body inverse_mass (dynamic)", k);
-    } else if (b.inverse_mass[k] != 0) {
-      r.fail(fmt::format("body inverse_mass of entry {} is {} (must be 0 for a kinematic or static body)", k,
-                         b.inverse_mass[k]));
+      if (const std::string problem = inverse_inertia_problem(b.inverse_inertia[k]); !problem.empty())
+        r.fail(fmt::format("body inverse_inertia of entry {}: {}", k, problem));
+    } else if (b.inverse_mass[k] != 0 || !b.inverse_inertia[k].isZero(0.0)) {
+      r.fail(fmt::format("body inverse_mass or inverse_inertia of entry {} is not 0 (must be for a kinematic or "
+                         "static body)",
+                         k));
     }
   }
 }

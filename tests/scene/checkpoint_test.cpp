@@ -278,6 +278,12 @@ TEST(Checkpoint, CraftedCheckpointsWithNonFiniteOrMeaninglessValuesAreRefusedNam
          s.world.bodies.position[s.world.particles.body[0]].x() = 1e38 * 2 * s.world.particles.radius[0];
        }},
       {"faster than light", [&](RunState& s) { s.world.bodies.linear_velocity[dynamic].x() = 1e300; }},
+      // Found by fuzz_checkpoint: a finite inverse inertia whose inverse is not, which resumed to exit 0
+      // with a NaN rotational energy.
+      {"body inverse_inertia of entry",
+       [&](RunState& s) { s.world.bodies.inverse_inertia[dynamic](1, 1) = 1e308; }},
+      {"not positive definite", [&](RunState& s) { s.world.bodies.inverse_inertia[dynamic](2, 2) = -1.0; }},
+      {"not symmetric", [&](RunState& s) { s.world.bodies.inverse_inertia[dynamic](0, 1) += 1.0; }},
   };
   int n = 0;
   for (const auto& [field, craft] : crafted) {
