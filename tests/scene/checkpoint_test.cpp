@@ -284,6 +284,7 @@ TEST(Checkpoint, CraftedCheckpointsWithNonFiniteOrMeaninglessValuesAreRefusedNam
        [&](RunState& s) { s.world.bodies.inverse_inertia[dynamic](1, 1) = 1e308; }},
       {"not positive definite", [&](RunState& s) { s.world.bodies.inverse_inertia[dynamic](2, 2) = -1.0; }},
       {"not symmetric", [&](RunState& s) { s.world.bodies.inverse_inertia[dynamic](0, 1) += 1.0; }},
+      {"a mass of 1e-308 kg, outside", [&](RunState& s) { s.world.bodies.inverse_mass[dynamic] = 1e308; }},
   };
   int n = 0;
   for (const auto& [field, craft] : crafted) {
