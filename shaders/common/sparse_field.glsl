@@ -20,7 +20,9 @@ layout(std140, binding = TS_FIELD_PARAMS) uniform FieldBlock { FieldParams field
 // common/layouts.h), and field_params.root_first.xyz the leaf cells along x, y, z. The same
 // field_voxel/field_trilinear/field_sample as the NanoVDB reader, the same values voxel for voxel.
 #include "common/layouts.h"
-layout(std430, binding = TS_FIELD_ROOTS) readonly buffer FieldLeafIndex { uint field_leaf_index[]; };
+// One block name, FieldIndex, in both variants (the leaf index here, the root table below): the slot holds
+// one or the other, as tests/gpu/bindings_test.cpp checks a slot of a pass holds one block.
+layout(std430, binding = TS_FIELD_ROOTS) readonly buffer FieldIndex { uint field_leaf_index[]; };
 
 struct FieldReader {
   uint unused;  // no cache: a read is one index load and one value load
@@ -129,7 +131,7 @@ uvec2 pnanovdb_buf_read_uint64(pnanovdb_buf_t buf, uint byte_offset) {
 // background; llvmpipe computed it right. No read here goes through that walk
 // (tests/sdf/sparse_field_test.cpp, tests/gpu/shader_audit.py). No search loop either: each read is
 // inlined, and llvmpipe's compile time follows what the reads inline.
-layout(std430, binding = TS_FIELD_ROOTS) readonly buffer FieldRootTable { FieldRootTile field_roots[]; };
+layout(std430, binding = TS_FIELD_ROOTS) readonly buffer FieldIndex { FieldRootTile field_roots[]; };
 
 // One accessor per invocation: it caches the last leaf, lower and upper node, so neighbouring reads
 // skip the tree walk, and a read in the cached upper node skips the root table too.

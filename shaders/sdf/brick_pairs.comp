@@ -27,13 +27,15 @@ layout(std430, binding = TS_SDF_PAIR_SPANS) writeonly buffer Spans { uint spans[
 #else
 layout(std430, binding = TS_SDF_PAIR_SPANS) readonly buffer Spans { uint spans[]; };
 #endif
+// RowTotals: per brick row, the counts COUNT adds, then (scanned on the host) the starts SCATTER reads;
+// one block name for the one buffer in both variants (tests/gpu/bindings_test.cpp).
 #ifdef COUNT
 layout(std430, binding = TS_SDF_PAIR_TRIANGLE_ROWS) writeonly buffer TriangleRows { uint triangle_rows[]; };
-layout(std430, binding = TS_SDF_PAIR_ROW_COUNTS) coherent buffer RowCounts { uint row_counts[]; };
+layout(std430, binding = TS_SDF_PAIR_ROW_COUNTS) coherent buffer RowTotals { uint row_counts[]; };
 #endif
 #ifdef SCATTER
 layout(std430, binding = TS_SDF_PAIR_TRIANGLE_ROWS) readonly buffer TriangleRows { uint triangle_rows[]; };
-layout(std430, binding = TS_SDF_PAIR_ROW_COUNTS) readonly buffer RowStarts { uint row_starts[]; };
+layout(std430, binding = TS_SDF_PAIR_ROW_COUNTS) readonly buffer RowTotals { uint row_starts[]; };
 layout(std430, binding = TS_SDF_PAIRS_OUT) writeonly buffer Pairs { uvec2 pairs[]; };
 #endif
 #include "common/params.h"

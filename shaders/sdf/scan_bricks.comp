@@ -24,18 +24,20 @@
 layout(local_size_x = 64) in;
 layout(std430, binding = TS_SDF_PAIRS) readonly buffer Pairs { uvec2 pairs[]; };
 layout(std430, binding = TS_SDF_PAIR_ROWS) readonly buffer PairRows { uint pair_rows[]; };
+// BrickTotals: per brick, the counts BRICK_COUNT adds, then (scanned) the starts the other passes read;
+// one block name for the one buffer in every variant (tests/gpu/bindings_test.cpp).
 #ifdef BRICK_COUNT
 layout(std430, binding = TS_SDF_PAIR_SLOTS) writeonly buffer PairSlots { uint pair_slots[]; };
-layout(std430, binding = TS_SDF_BRICK_STARTS) coherent buffer BrickCounts { uint brick_counts[]; };
+layout(std430, binding = TS_SDF_BRICK_STARTS) coherent buffer BrickTotals { uint brick_counts[]; };
 #else
 layout(std430, binding = TS_SDF_PAIR_SLOTS) readonly buffer PairSlots { uint pair_slots[]; };
-layout(std430, binding = TS_SDF_BRICK_STARTS) readonly buffer BrickStarts { uint brick_starts[]; };
+layout(std430, binding = TS_SDF_BRICK_STARTS) readonly buffer BrickTotals { uint brick_starts[]; };
 layout(std430, binding = TS_SDF_BRICK_TRIANGLES) writeonly buffer BrickTriangles { uint brick_triangles[]; };
 #endif
 #else
 layout(local_size_x = BRICK, local_size_y = BRICK, local_size_z = BRICK) in;
 layout(std430, binding = TS_SDF_TRIANGLES) readonly buffer Triangles { SdfTriangle triangles[]; };
-layout(std430, binding = TS_SDF_BRICK_STARTS) readonly buffer BrickStarts { uint brick_starts[]; };
+layout(std430, binding = TS_SDF_BRICK_STARTS) readonly buffer BrickTotals { uint brick_starts[]; };
 layout(std430, binding = TS_SDF_BRICK_TRIANGLES) readonly buffer BrickTriangles { uint brick_triangles[]; };
 layout(binding = TS_SDF_IMAGE_SLAB, rgba32f) writeonly uniform image2DArray slab;
 #endif
