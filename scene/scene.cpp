@@ -607,6 +607,7 @@ void read_simulation(TableReader& root, const fs::path& file, Scene& scene) {
       r.choice("integrator", {"euler", "symplectic"}, static_cast<std::size_t>(s.step.integrator)));
   s.step.tangential = static_cast<TangentialModel>(r.choice("tangential", {"viscous", "spring"}, 0));
   s.step.resort_every = r.integer("resort_every", s.step.resort_every, 0);
+  s.step.skin = r.non_negative("skin", 0.0);
   s.step.cfl = r.non_negative("cfl", s.step.cfl);
   s.step.max_overlap_ratio = r.non_negative("max_overlap_ratio", s.step.max_overlap_ratio);
   s.step.angular_damping_rate = r.non_negative("angular_damping_rate", 0.0);

@@ -308,6 +308,7 @@ void SceneRun::prepare(const World& initial) {
   check_scene_forces(scene_, initial, sources_, result_.dt);
   StepSettings settings = scene_.simulation.step;
   settings.dt = result_.dt;
+  settings.design_speed = scene_design_speed(scene_, initial).speed;  // picks the contact lists' skin
   stepper_ = make_stepper_ ? make_stepper_(settings) : std::make_unique<CpuStepper>(settings);
   emit_every_ = scene_.output.every;
   for (const Emitter& e : scene_.emitters) {

@@ -58,6 +58,10 @@ struct StepSettings {
   // (Morton order), so neighbours sit near each other in memory; 0 = never. Results stay
   // deterministic; forces change only by the order of float sums.
   std::int64_t resort_every = 100;
+  // Contact candidate lists (sim/contact_lists.h): the skin (m) added to each pair's contact distance
+  // when the lists are built; 0 = choose_skin() from the largest diameter, `design_speed` and dt.
+  double skin = 0;
+  double design_speed = 0;  // m/s: the fastest the scene expects a particle to move (its impact speed)
 };
 
 // Dynamic particles found wholly behind a smooth wall's surface (StepSettings::check_penetration).
