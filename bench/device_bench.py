@@ -42,8 +42,11 @@ SIZES = {
         "selftest": "full",
         "sdf": {"meshes": ["knot1", "armadillo", "icosphere:8"], "resolutions": [256, 512, 1024, 2048]},
         "sampler": {"mesh": "bunny", "counts": [10_000, 100_000, 1_000_000]},
+        # bench/sim_step_criteria.md: at least 10 timed GPU steps a size; 4M once more in the other
+        # precision order ("repeat"), so a one-off stall shows as two 4M rows that disagree.
         "sim": {"grains": [64_000, 1_000_000, 4_000_000], "precisions": ["float", "double"], "seconds": 1.0,
-                "kernel_grains": [1_000_000, 4_000_000], "kernel_seconds": 0.5},
+                "min_steps": 10, "cpu_min_steps": 2, "repeat": {"grains": [4_000_000], "precisions": ["double", "float"]},
+                "kernel_grains": [64_000, 1_000_000, 4_000_000], "kernel_seconds": 0.5},
         "preview": {"mesh": "bunny", "size": 1024, "resolution": 1024, "particles": 1_000_000, "repeat": 3},
     },
     "quick": {
@@ -51,6 +54,7 @@ SIZES = {
         "sdf": {"meshes": ["knot1", "icosphere:2"], "resolutions": [16, 24]},
         "sampler": {"mesh": "bunny", "counts": [400, 600]},
         "sim": {"grains": [1000], "precisions": ["float", "double"], "seconds": 0.1,
+                "min_steps": 10, "cpu_min_steps": 2, "repeat": {"grains": [1000], "precisions": ["double", "float"]},
                 "kernel_grains": [1000], "kernel_seconds": 0.05},
         "preview": {"mesh": "bunny", "size": 96, "resolution": 32, "particles": 2000, "repeat": 1},
     },
@@ -122,6 +126,8 @@ def kernel_tables(text):
     tables, grains = {}, None
     for line in text.splitlines():
         head = re.match(r"^(\d+) grains:$", line)
+        if re.match(r"^\d+ grains, CPU reference:$", line):
+            grains = None  # the CPU reference's report (lists, no kernels) is not a GPU table
         row = re.match(r"^(\S+)\s+(\d+)\s+([\d.]+)\s+([\d.]+)%$", line)
         if head:
             grains = head.group(1)
@@ -239,10 +245,20 @@ class Run:
         # pipeline is timed on every device, whatever `tetrasand sim --backend auto` would pick there.
         s = self.sizes["sim"]
         table = os.path.join(self.work, "sim.csv")
+        steps = ["--seconds", str(s["seconds"]), "--min-steps", str(s["min_steps"]), "--cpu-min-steps", str(s["cpu_min_steps"])]
         cmd = [self.exe("sim"), "--grains", ",".join(map(str, s["grains"])), "--precision", ",".join(s["precisions"]),
-               "--seconds", str(s["seconds"]), "--csv", table]
+               *steps, "--csv", table]
         rc, secs, _, err = run_capped(cmd, cap, os.path.join(self.work, "sim"))
         result = {"command": cmd, "planned_grains": s["grains"], "rows": csv_rows(table)}
+        left = cap - secs
+        if rc == 0 and left > 5:
+            again = os.path.join(self.work, "sim-repeat.csv")
+            rcmd = [self.exe("sim"), "--grains", ",".join(map(str, s["repeat"]["grains"])), "--precision",
+                    ",".join(s["repeat"]["precisions"]), *steps, "--csv", again]
+            rrc, rsecs, _, rerr = run_capped(rcmd, left, os.path.join(self.work, "sim-repeat"))
+            status, error = outcome(rrc, rerr)
+            result["repeat"] = {"command": rcmd, "status": status, "error": error, "rows": csv_rows(again)}
+            secs += rsecs
         # Then, with what the cap leaves, where a float step's GPU time goes (timer queries, read at the
         # end) at the large sizes: a separate run, so the queries do not touch the rates above. On the
         # first device run 4M grains stepped 130x slower than 1M; this names the kernel.
@@ -444,11 +460,15 @@ def sim_section(res):
     if rows:
         lines += ["| grains | GPU precision | contacts / grain | GPU grain-steps/s | CPU grain-steps/s | GPU / CPU "
                   "| timed steps GPU / CPU | GPU bytes / grain |", "|---|---|---|---|---|---|---|---|"]
-    for r in rows:
+    repeat = p.get("repeat", {})
+    for r in rows + [dict(x, precision=x["precision"] + " (repeat, other order)") for x in repeat.get("rows", [])]:
         lines.append(f"| {r['grains']} | {r['precision']} | {float(r['contacts_per_grain']):.1f} "
                      f"| {float(r['gpu_grain_steps_per_s']):.3g} | {float(r['cpu_grain_steps_per_s']):.3g} "
                      f"| {float(r['gpu_over_cpu']):.2f} | {r['gpu_steps']} / {r['cpu_steps']} "
                      f"| {float(r['gpu_bytes_per_grain']):.0f} |")
+    if repeat and repeat.get("status") != "ok":
+        lines += ["", f"The repeat run in the other precision order: {repeat.get('status')}"
+                  + (f": {repeat['error']}" if repeat.get("error") else "") + "."]
     done = {int(r["grains"]) // 1000 for r in rows}
     gone = [g for g in p.get("planned_grains", []) if g // 1000 not in done]
     if gone:

@@ -1,7 +1,10 @@
 // Cundall number (grain time steps per second) of the GPU pipeline and of the CPU reference on the
 // same scenes, in one run, as ratios, from 1k to 1M grains; memory per grain of both. Usage:
 //   tetrasand_bench_sim [--grains 1000,8000,64000,512000,1000000] [--seconds 2] [--min-steps 2]
-//                       [--precision float|double|float,double] [--csv FILE] [--timings]
+//                       [--cpu-min-steps N] [--precision float|double|float,double] [--csv FILE] [--timings]
+// --cpu-min-steps: the CPU reference's own minimum (default --min-steps), so a device run can time 10 GPU
+// steps a size without spending its time cap on 10 CPU steps of 4M grains. --timings prints each engine's
+// timing_report() (per-kernel GPU times, the contact lists' skin, builds and candidates) on stderr.
 // The scene of every size is the settled bed of bench/bench_scenes.h (reference/bed_tile.toml copied
 // side by side), so each size sees the same contacts per grain. scripts/bench.sh sim plots the CSV.
 // With two precisions the CPU reference is measured once per size and each GPU precision gets a row.
@@ -31,6 +34,7 @@ struct Options {
   std::vector<std::uint32_t> grains{1000, 8000, 64000, 512000, 1000000};
   double seconds = 2.0;  // wall time per measurement (at least min_steps steps)
   int min_steps = 2;
+  int cpu_min_steps = 0;  // 0: min_steps
   std::vector<ts::sim::Precision> precisions{ts::sim::Precision::Float};
   std::string csv;
   bool timings = false;  // per-kernel GPU times and host round trips of each size, on stderr
@@ -52,6 +56,8 @@ Options parse(int argc, char** argv) {
       o.seconds = std::stod(next());
     } else if (arg == "--min-steps") {
       o.min_steps = std::max(1, std::stoi(next()));
+    } else if (arg == "--cpu-min-steps") {
+      o.cpu_min_steps = std::max(1, std::stoi(next()));
     } else if (arg == "--precision") {
       o.precisions.clear();
       std::stringstream list(next());
@@ -131,7 +137,9 @@ Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Optio
         [&](int n) {
           for (int s = 0; s < n; ++s) stats = cpu.step(world);
         },
-        [] {}, options.seconds, options.min_steps, std::max(1, batch / 10));
+        [] {}, options.seconds, options.cpu_min_steps > 0 ? options.cpu_min_steps : options.min_steps,
+        std::max(1, batch / 10));
+    if (options.timings) fmt::print(stderr, "{} grains, CPU reference:\n{}", row.grains, cpu.timing_report());
     row.cpu_bytes_per_grain = (resident_bytes() - before) / static_cast<double>(row.grains);
     row.contacts_per_grain = static_cast<double>(stats.contacts + stats.wall_contacts) / static_cast<double>(row.grains);
   }
