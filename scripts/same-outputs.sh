@@ -10,6 +10,9 @@
 #   --out DIR    where the builds and outputs go (default build-same/)
 #   --no-build   reuse the builds already in DIR
 #   --binaries A B   compare these two tetrasand executables instead of building (A = base)
+#   --sim-tolerance  a sim output folder (sim_*) whose bytes differ is then compared by
+#                    scripts/sim_outputs_agree.py: same layout and numbering, values within the round-off
+#                    of a changed summation order (its criteria); for changes that reorder float sums
 #
 # What is masked, because it changes from run to run whatever the code: the 36-character UUID that
 # OpenVDB writes into every .vdb header, and body.json's quality.seconds (wall time). Standard output
@@ -22,13 +25,15 @@ out="$root/build-same"
 build=1
 bin_base=""
 bin_head=""
+sim_tolerance=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --base) base=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --no-build) build=0; shift ;;
     --binaries) bin_base=$(realpath "$2"); bin_head=$(realpath "$3"); build=0; shift 3 ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    --sim-tolerance) sim_tolerance=1; shift ;;
+    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
     *) echo "same-outputs.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -144,17 +149,34 @@ done
 cd "$out"
 different=0
 files=0
+agreeing=()  # sim folders compared within tolerance (--sim-tolerance)
 while IFS= read -r f; do
   files=$((files + 1))
   if [ ! -f "out-head/$f" ]; then echo "missing in head: $f"; different=1; continue; fi
-  if ! cmp -s "out-base/$f" "out-head/$f"; then echo "differs: $f"; different=1; fi
+  cmp -s "out-base/$f" "out-head/$f" && continue
+  folder=${f#./}
+  folder=${folder%%/*}
+  if [ "$sim_tolerance" = 1 ] && [[ "$folder" == sim_* ]]; then
+    [[ " ${agreeing[*]} " == *" $folder "* ]] && continue
+    agreeing+=("$folder")
+    if python3 "$root/scripts/sim_outputs_agree.py" "out-base/$folder" "out-head/$folder"; then
+      echo "agrees within tolerance: $folder"
+    else
+      different=1
+    fi
+    continue
+  fi
+  echo "differs: $f"
+  different=1
 done < <(cd out-base && find . -type f | sort)
 while IFS= read -r f; do
   if [ ! -f "out-base/$f" ]; then echo "only in head: $f"; different=1; fi
 done < <(cd out-head && find . -type f | sort)
 what="$base and the working tree"
 [ -n "$given_binaries" ] && what="$bin_base and $bin_head"
-if [ "$different" = 0 ]; then
+if [ "$different" = 0 ] && [ ${#agreeing[@]} -gt 0 ]; then
+  echo "same outputs: all $files files byte-identical between $what, but for ${agreeing[*]}, within the tolerance of scripts/sim_outputs_agree.py"
+elif [ "$different" = 0 ]; then
   echo "same outputs: all $files files byte-identical between $what"
 else
   echo "outputs differ between $what (trees in $out/out-base and $out/out-head)"
