@@ -21,6 +21,7 @@
 #include "scene/checkpoint.h"
 #include "scene/scene_checks.h"
 #include "scene/scene_world.h"
+#include "scene/vtk_files.h"
 #include "scene/servo.h"
 #include "sim/cpu_stepper.h"
 
@@ -82,30 +83,6 @@ void write_particles_ply(const World& world, const std::filesystem::path& file) 
     bytes.append(reinterpret_cast<const char*>(&body), sizeof body);
   }
   write_file_atomically(file, bytes);
-}
-
-void write_particles_vtp(const World& world, const std::filesystem::path& file) {
-  const std::vector<Eigen::Vector3d> positions = particle_positions(world);
-  std::string points, radii, bodies, connectivity, offsets;
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    points += fmt::format("{:.9g} {:.9g} {:.9g}\n", positions[i].x(), positions[i].y(), positions[i].z());
-    radii += fmt::format("{:.9g}\n", world.particles.radius[i]);
-    bodies += fmt::format("{}\n", world.particles.body[i]);
-    connectivity += fmt::format("{}\n", i);
-    offsets += fmt::format("{}\n", i + 1);
-  }
-  const std::string xml = fmt::format(
-      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      "<PolyData>\n<Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{0}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
-      "NumberOfPolys=\"0\">\n"
-      "<PointData Scalars=\"radius\">\n<DataArray type=\"Float64\" Name=\"radius\" format=\"ascii\">\n{1}</DataArray>\n"
-      "<DataArray type=\"UInt32\" Name=\"body\" format=\"ascii\">\n{2}</DataArray>\n</PointData>\n"
-      "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n{3}</DataArray>\n</Points>\n"
-      "<Verts>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n{4}</DataArray>\n"
-      "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n{5}</DataArray>\n</Verts>\n"
-      "</Piece>\n</PolyData>\n</VTKFile>\n",
-      positions.size(), radii, bodies, points, connectivity, offsets);
-  write_file_atomically(file, xml);
 }
 
 void write_contacts_csv(const std::vector<ContactRecord>& contacts, const std::filesystem::path& file) {
@@ -195,7 +172,10 @@ class OutputWriter {
       write_file_atomically(dir_ / "metrics.csv", csv_);  // whole file each time: valid after any interruption
     }
     if (scene_.output.ply) write_particles_ply(world, dir_ / ("particles_" + index + ".ply"));
-    if (scene_.output.vtp) write_particles_vtp(world, dir_ / ("particles_" + index + ".vtp"));
+    if (scene_.output.vtp) {
+      write_particles_vtp(world, dir_ / ("particles_" + index + ".vtp"));
+      vtp_collection_.add("particles_" + index + ".vtp", world.time);
+    }
     if (scene_.output.contacts)
       write_contacts_csv(stepper.contacts(world), dir_ / ("contacts_" + index + ".csv"));
     if (scene_.output.frames) {
@@ -218,6 +198,7 @@ class OutputWriter {
     if (scene_.output.csv) files.push_back({"metrics.csv", frame_, "rows"});
     if (scene_.output.ply) files.push_back({"particles_NNNNNN.ply", frame_, "files"});
     if (scene_.output.vtp) files.push_back({"particles_NNNNNN.vtp", frame_, "files"});
+    if (scene_.output.vtp) files.push_back({"particles.pvd", frame_, "entries"});
     if (scene_.output.contacts) files.push_back({"contacts_NNNNNN.csv", frame_, "files"});
     if (scene_.output.frames && hooks_.write_frame) files.push_back({"frame_NNNNNN.png", frame_, "files"});
     return files;
@@ -230,6 +211,7 @@ class OutputWriter {
     check_metrics_csv(csv, scene_.output.csv ? frames : 0);
     csv_ = std::move(csv);
     frame_ = frames;
+    if (scene_.output.vtp) vtp_collection_.restore(frames);
   }
 
  private:
@@ -238,6 +220,7 @@ class OutputWriter {
   const RunHooks& hooks_;
   std::string csv_;
   std::int64_t frame_ = 0;
+  VtpCollection vtp_collection_{dir_ / "particles.pvd"};
 };
 
 using Clock = std::chrono::steady_clock;

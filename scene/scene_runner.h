@@ -5,7 +5,9 @@
 //   metrics.csv                one row per output (energies, contacts, overlap, clamp and spring-slot
 //                              overflow counts since the previous row)
 //   particles_NNNNNN.ply       binary little-endian: float x y z radius, uint body
-//   particles_NNNNNN.vtp       VTK XML PolyData (ASCII): points, radius and body per particle
+//   particles_NNNNNN.vtp       VTK XML PolyData, binary (scene/vtk_files.h): a vertex per particle with
+//                              radius, body, velocity, angular velocity, orientation, body centre
+//   particles.pvd              the .vtp files with their times, for ParaView's time series
 //   contacts_NNNNNN.csv        one row per contact (CPU reference: recomputed for the output state)
 //   frames                     through the write_frame hook (the preview renderer lives in the app)
 //   checkpoint_STEP.tsck       with [output] checkpoint_every / checkpoint_seconds: the complete state
@@ -64,7 +66,7 @@ BodyCounts count_bodies(const Scene& scene, const World& world);
 struct OutputRecord {
   std::string pattern;
   std::int64_t count = 0;
-  std::string unit;  // "rows" or "files"
+  std::string unit;  // "rows", "files" or "entries" (of a collection)
 };
 
 struct RunResult {
@@ -90,9 +92,8 @@ double resolve_time_step(const Scene& scene, const World& world, std::string* wa
 RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir, const RunHooks& hooks = {},
                     const StepperFactory& make_stepper = {}, const RunControl& control = {});
 
-// Output writers (atomic), usable on their own.
+// Output writers (atomic), usable on their own (the .vtp writer: scene/vtk_files.h).
 void write_particles_ply(const World& world, const std::filesystem::path& file);
-void write_particles_vtp(const World& world, const std::filesystem::path& file);
 void write_contacts_csv(const std::vector<ContactRecord>& contacts, const std::filesystem::path& file);
 
 }  // namespace ts::scene

@@ -14,6 +14,7 @@ PACKAGES=(
   libgtest-dev googletest
   libcgal-demo assimp-testmodels
   lammps python3
+  python3-vtk9
 )
 
 missing=()

@@ -52,7 +52,10 @@ z_max = 0.2
 material = "sand"
 )";
   p.simulation = engine_keys;
-  return test::poured_scene(p);
+  // With the .vtp files, whose .pvd collection a resumed run must take up where the stopped one left it.
+  std::string text = test::poured_scene(p);
+  const std::size_t ply = text.find("ply = true\n");
+  return ply == std::string::npos ? text : text.insert(ply, "vtp = true\n");
 }
 
 Scene write_scene(const fs::path& dir, const std::string& engine_keys = "",

@@ -146,9 +146,10 @@ TEST(Props, RunSummaryCountsThePropApartFromTheGrainsAndListsEveryOutput) {
   EXPECT_EQ(r.bodies.dynamic_props, 1u);
   EXPECT_EQ(r.bodies.kinematic_props + r.bodies.static_props + r.bodies.rough_walls, 0u);
   EXPECT_EQ(r.bodies.smooth_planes, 5u);
-  ASSERT_EQ(r.files.size(), 3u);  // metrics.csv and the ply and vtp particles
+  ASSERT_EQ(r.files.size(), 4u);  // metrics.csv, the ply and vtp particles and the vtp files' collection
   for (const OutputRecord& f : r.files) EXPECT_EQ(f.count, r.outputs) << f.pattern;
   EXPECT_EQ(r.files[2].pattern, "particles_NNNNNN.vtp");
+  EXPECT_EQ(r.files[3].pattern, "particles.pvd");
   std::ifstream csv(dir / "metrics.csv");
   std::string header, row;
   std::getline(csv, header);
