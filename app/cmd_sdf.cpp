@@ -78,6 +78,11 @@ void add_options(CLI::App* cmd, Options& o) {
                   "renderer and driver found geometry faster; --backend gpu)")
       ->check(CLI::IsMember({"auto", "compute", "geometry"}))
       ->capture_default_str();
+  cmd->add_option("--nvdb-codec", o.nvdb_codec,
+                  "Compression of a .nvdb output: zip (smallest), blosc or none; NanoVDB's own codecs, read by "
+                  "nanovdb_validate and tetrasand alike")
+      ->check(CLI::IsMember({"none", "zip", "blosc"}))
+      ->capture_default_str();
   cmd->add_option("--sign", o.sign, "Sign method: pseudonormal (closed meshes) or winding (robust to holes)")
       ->check(CLI::IsMember({"pseudonormal", "winding"}))
       ->capture_default_str();
@@ -141,7 +146,7 @@ std::size_t write_level_set(const Options& o, const sdf::ScanConvertResult& resu
   };
   if (is_nanovdb_path(o.output)) {
     sdf::NanoGrid nano = sdf::to_nanovdb(*result.grid);
-    sdf::write_nvdb(o.output, nano, {o.mesh});
+    sdf::write_nvdb(o.output, nano, {o.mesh}, sdf::parse_nvdb_codec(o.nvdb_codec).value());
     lap();
     return nano.size();
   }

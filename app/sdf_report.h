@@ -24,6 +24,7 @@ struct SdfOptions {
   std::string scan_reason;       // on the GPU path, once auto is resolved: why (sdf::ScanChoice::reason)
   double scale = 1.0;
   double slab_mb = 1024;
+  std::string nvdb_codec = "zip";  // .nvdb output only: sdf::parse_nvdb_codec
   bool timings = false, compare = false, json = false;
 };
 

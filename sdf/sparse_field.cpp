@@ -168,7 +168,18 @@ void SparseField::bind(const FieldSlots& slots) const {
   params_.bind(slots.params);
 }
 
-void write_nvdb(const std::filesystem::path& file, NanoGrid& grid, const std::vector<std::filesystem::path>& inputs) {
+std::optional<NvdbCodec> parse_nvdb_codec(std::string_view name) {
+  if (name == "none") return NvdbCodec::None;
+  if (name == "zip") return NvdbCodec::Zip;
+  if (name == "blosc") return NvdbCodec::Blosc;
+  return std::nullopt;
+}
+
+void write_nvdb(const std::filesystem::path& file, NanoGrid& grid, const std::vector<std::filesystem::path>& inputs,
+                NvdbCodec codec) {
+  const nanovdb::io::Codec nano_codec = codec == NvdbCodec::Zip     ? nanovdb::io::Codec::ZIP
+                                        : codec == NvdbCodec::Blosc ? nanovdb::io::Codec::BLOSC
+                                                                    : nanovdb::io::Codec::NONE;
   // A full checksum (a CRC over the whole grid), so a damaged file is told by tetrasand's reader and by
   // NanoVDB's own validator instead of being read as another field.
   nanovdb::updateChecksum(*grid.grid<float>(), nanovdb::ChecksumMode::Full);
@@ -177,7 +188,7 @@ void write_nvdb(const std::filesystem::path& file, NanoGrid& grid, const std::ve
       file,
       [&](std::ostream& out) {
         try {
-          nanovdb::io::writeGrid(out, grid, nanovdb::io::Codec::NONE);
+          nanovdb::io::writeGrid(out, grid, nano_codec);
         } catch (const std::exception& e) {
           throw InputError(file, fmt::format("cannot write the NanoVDB file: {}", e.what()));
         }

@@ -14,7 +14,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <array>
+#include <map>
 #include <random>
+#include <string>
 #include <set>
 
 #include "core/error.h"
@@ -368,15 +370,25 @@ TEST_F(SparseFieldTest, GpuMemoryFollowsTheBandNotTheBox) {
   EXPECT_LT(fine_share, 0.35);
 }
 
-TEST_F(SparseFieldTest, NanoVdbFilesPassNanovdbValidate) {
+TEST_F(SparseFieldTest, NanoVdbFilesInEveryCodecPassNanovdbValidateAndReadBackTheSameGrid) {
   const auto dir = test::temp_dir();
-  const auto file = dir / "torus.nvdb";
-  NanoGrid nano = to_nanovdb(*result_.grid);
-  write_nvdb(file, nano, {});
-  const NanoGrid back = nanovdb::io::readGrid(file.string());
-  ASSERT_TRUE(back.grid<float>());
-  EXPECT_EQ(back.grid<float>()->activeVoxelCount(), result_.grid->activeVoxelCount());
-  EXPECT_EQ(std::system(("nanovdb_validate " + file.string() + " > " + (dir / "validate.txt").string() + " 2>&1").c_str()), 0);
+  std::map<std::string, std::uintmax_t> sizes;
+  for (const char* name : {"none", "zip", "blosc"}) {
+    const auto file = dir / (std::string("torus_") + name + ".nvdb");
+    NanoGrid nano = to_nanovdb(*result_.grid);
+    write_nvdb(file, nano, {}, parse_nvdb_codec(name).value());
+    sizes[name] = std::filesystem::file_size(file);
+    const NanoGrid back = nanovdb::io::readGrid(file.string());
+    ASSERT_TRUE(back.grid<float>()) << name;
+    EXPECT_EQ(back.grid<float>()->activeVoxelCount(), result_.grid->activeVoxelCount()) << name;
+    EXPECT_EQ(back.size(), nano.size()) << name;
+    EXPECT_EQ(std::memcmp(back.data(), nano.data(), nano.size()), 0) << name << ": not the grid written";
+    EXPECT_EQ(std::system(("nanovdb_validate " + file.string() + " > " + (dir / "validate.txt").string() + " 2>&1").c_str()), 0)
+        << name;
+  }
+  EXPECT_LT(sizes["zip"], sizes["none"] / 3);  // the default codec pays
+  EXPECT_LT(sizes["blosc"], sizes["none"]);
+  EXPECT_FALSE(parse_nvdb_codec("gzip"));
 }
 
 // A sparse grid past 4096 voxels a side (5300), in index space that runs negative on two axes: sphere
