@@ -8,7 +8,7 @@ set -euo pipefail
 PACKAGES=(
   cmake g++ make pkg-config git ca-certificates xz-utils
   libeigen3-dev libtbb-dev libassimp-dev libcgal-dev libgmp-dev libmpfr-dev
-  libopenvdb-dev libopenvdb-tools libnanovdb-dev libnanovdb-tools libboost-iostreams-dev libimath-dev libblosc-dev
+  libopenvdb-dev libopenvdb-tools libnanovdb-dev libnanovdb-tools libboost-iostreams-dev libimath-dev libblosc-dev zlib1g-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libopengl-dev libglew-dev glslang-tools
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfmt-dev libstb-dev libssl-dev
   libgtest-dev googletest
