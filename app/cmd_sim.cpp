@@ -2,6 +2,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <nlohmann/json.hpp>
+
 #include <chrono>
 #include <filesystem>
 #include <tuple>
@@ -31,6 +33,7 @@ struct Options {
   bool cpu = false;              // --cpu: the alias of --backend cpu
   std::string precision;         // float or double; empty: not given (float on the GPU)
   bool timings = false;
+  bool json = false;   // the run's summary as JSON on standard output (the human lines then go to the log)
   std::string resume;  // DIR: go on from its latest checkpoint, writing there
 };
 
@@ -56,6 +59,9 @@ void add_options(CLI::App* cmd, Options& o) {
          "double, so --backend cpu refuses it")
       ->check(CLI::IsMember({"float", "double"}));
   cmd->add_flag("--timings", o.timings, "Print per-kernel GPU times and host-GPU round trips at the end");
+  cmd->add_flag("--json", o.json,
+                "Print the run's summary (engine, steps, rate, bodies, clamps, outputs, last step's energies; "
+                "--timings' report as a string) as JSON on standard output");
   cmd->add_option(
          "--resume", o.resume,
          "Go on from the latest checkpoint in DIR (written with [output] checkpoint_every or "
@@ -124,12 +130,17 @@ gpu::Backend choose_backend(const Options& o, const GlobalOptions& global, bool 
   const gpu::Backend chosen = gpu::resolve_backend(requested, context.get());
   const bool cpu = chosen == gpu::Backend::Cpu;
   const bool precision_ignored = cpu && !o.precision.empty();  // auto only: --cpu with it is refused
-  fmt::print("{}\n", gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
-                                       cpu ? "the CPU reference" : "the GPU pipeline",
-                                       precision_ignored ? "--precision applies to the GPU pipeline only, the "
-                                                           "CPU reference computes in double"
-                                                         : ""));
-  std::fflush(stdout);
+  const std::string line = gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
+                                             cpu ? "the CPU reference" : "the GPU pipeline",
+                                             precision_ignored ? "--precision applies to the GPU pipeline only, "
+                                                                 "the CPU reference computes in double"
+                                                               : "");
+  if (o.json) {
+    log::info("{}", line);  // standard output stays the JSON
+  } else {
+    fmt::print("{}\n", line);
+    std::fflush(stdout);
+  }
   if (cpu && !frames) context.reset();
   return chosen;
 }
@@ -160,6 +171,49 @@ void print_summary(const Options& o, const scene::Scene& scene, const scene::Run
                                 f.count, f.unit));
   fmt::print("outputs: {}\n", files.empty() ? std::string("none ([output] writes nothing)")
                                             : fmt::format("{}", fmt::join(files, ", ")));
+}
+
+// The summary of print_summary, and the last step's state, as one JSON object (--json).
+void print_json(const Options& o, const scene::RunResult& result, double seconds, const std::string& engine,
+                const std::string& timing_report) {
+  const auto stepped = static_cast<double>(result.steps - std::max<std::int64_t>(result.resumed_from, 0));
+  const scene::BodyCounts& b = result.bodies;
+  nlohmann::ordered_json outputs = nlohmann::ordered_json::array();
+  for (const scene::OutputRecord& f : result.files) {
+    outputs.push_back({{"pattern", f.pattern},
+                       {"path", (std::filesystem::path(output_dir(o)) / f.pattern).string()},
+                       {"count", f.count},
+                       {"unit", f.unit}});
+  }
+  const sim::StepStats& last = result.last;
+  const nlohmann::ordered_json out = {
+      {"scene", o.scene},
+      {"output", output_dir(o)},
+      {"engine", engine},
+      {"steps", result.steps},
+      {"resumed_from", result.resumed_from >= 0 ? nlohmann::ordered_json(result.resumed_from) : nullptr},
+      {"dt_s", result.dt},
+      {"time_step_warning", result.time_step_warning.empty() ? nlohmann::ordered_json(nullptr)
+                                                             : nlohmann::ordered_json(result.time_step_warning)},
+      {"grains", result.grains},
+      {"wall_seconds", seconds},
+      {"grain_steps_per_second", seconds > 0 ? stepped * static_cast<double>(result.grains) / seconds : 0.0},
+      {"bodies",
+       {{"grains", b.grains}, {"dynamic_props", b.dynamic_props}, {"kinematic_props", b.kinematic_props},
+        {"static_props", b.static_props}, {"rough_walls", b.rough_walls}, {"smooth_planes", b.smooth_planes},
+        {"smooth_cylinders", b.smooth_cylinders}}},
+      {"clamps", {{"velocity", last.velocity_clamps}, {"angular_velocity", last.angular_velocity_clamps},
+                  {"overlap", last.overlap_clamps}}},
+      {"spring_overflows", result.spring_overflows},
+      {"last_step",
+       {{"kinetic_translational_J", last.energy.translational}, {"kinetic_rotational_J", last.energy.rotational},
+        {"potential_J", last.energy.potential}, {"contacts", last.contacts}, {"wall_contacts", last.wall_contacts},
+        {"max_overlap_ratio", last.max_overlap_ratio}}},
+      {"checkpoints", result.checkpoints},
+      {"outputs", outputs},
+      {"timings", timing_report.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(timing_report)},
+  };
+  fmt::print("{}\n", out.dump(2));
 }
 
 int run_sim(const Options& o, const GlobalOptions& global) {
@@ -193,15 +247,23 @@ int run_sim(const Options& o, const GlobalOptions& global) {
     report_progress(progress, duration, world, stats, step, start, first_step, first_time);
   };
   std::string timing_report;
-  if (o.timings) hooks.on_finish = [&](sim::Stepper& stepper) { timing_report = stepper.timing_report(); };
+  std::string engine = backend == gpu::Backend::Cpu ? "cpu reference" : "gpu " + (o.precision.empty() ? std::string("float") : o.precision);
+  hooks.on_finish = [&](sim::Stepper& stepper) {
+    engine = stepper.engine();
+    if (o.timings) timing_report = stepper.timing_report();
+  };
   scene::RunControl control;
   control.resume = !o.resume.empty();
   control.duration = o.duration;
   const scene::RunResult result = scene::run_scene(scene, output_dir(o), hooks, make_stepper, control);
   progress.end();
   if (!result.time_step_warning.empty()) log::warn("{}", result.time_step_warning);
-  print_summary(o, scene, result, std::chrono::duration<double>(Clock::now() - start).count(), backend,
-                context.get());
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (o.json) {
+    print_json(o, result, seconds, engine, timing_report);
+    return 0;
+  }
+  print_summary(o, scene, result, seconds, backend, context.get());
   if (!timing_report.empty()) fmt::print("{}", timing_report);
   return 0;
 }

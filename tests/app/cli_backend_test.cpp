@@ -74,6 +74,27 @@ TEST(SimBackend, BackendGpuForcesTheGpuPipelineOnASoftwareDevice) {
   }
 }
 
+// --json: standard output is one JSON object (the backend line and progress go to standard error, the
+// log), naming the engine, the steps and every output kind with its count.
+TEST(SimBackend, JsonSummaryIsAllOfStandardOutputAndNamesTheEngineAndTheOutputs) {
+  const auto dir = test::temp_dir();
+  test::run_tetrasand("sim " + quoted(test::asset("scenes/two_grain_collision.toml")) + " -o " + quoted(dir / "out") +
+                      " --duration 0.0002 --backend cpu --json 2> " + quoted(dir / "log.txt") + " | cat > " +
+                      quoted(dir / "summary.json"));
+  const std::string log = read_file(dir / "log.txt");
+  std::ifstream in(dir / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
+  ASSERT_FALSE(summary.is_discarded()) << "standard output is not one JSON object; the log:\n" << log;
+  EXPECT_EQ(summary.at("engine"), "cpu reference");
+  EXPECT_GT(summary.at("steps").get<int>(), 0);
+  EXPECT_TRUE(summary.at("resumed_from").is_null());
+  EXPECT_EQ(summary.at("bodies").at("grains"), 2);
+  ASSERT_FALSE(summary.at("outputs").empty());
+  EXPECT_EQ(summary.at("outputs")[0].at("pattern"), "metrics.csv");
+  EXPECT_GT(summary.at("outputs")[0].at("count").get<int>(), 0);
+  EXPECT_TRUE(summary.at("last_step").contains("kinetic_translational_J"));
+}
+
 TEST(SimBackend, CpuFlagIsAnAliasOfBackendCpu) {
   for (const std::string flags : {"--cpu", "--backend cpu"}) {
     std::string out;
