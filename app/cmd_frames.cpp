@@ -2,6 +2,7 @@
 // film (OUT.mp4, through ffmpeg when it is on PATH) or as a contact sheet (OUT.png, or instead of the
 // film when ffmpeg is not installed: Debian's package `ffmpeg`).
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <spawn.h>
 #include <sys/wait.h>
 
@@ -27,6 +28,7 @@ struct Options {
   std::string output;
   double fps = 30;
   preview::SheetSettings sheet;
+  bool json = false;
 };
 
 void add_options(CLI::App* cmd, Options& o) {
@@ -46,6 +48,7 @@ void add_options(CLI::App* cmd, Options& o) {
       ->check(CLI::Range(16, 4096))
       ->capture_default_str();
   cmd->add_flag("!--no-labels", o.sheet.labels, "No frame numbers on a contact sheet's tiles");
+  cmd->add_flag("--json", o.json, "Print what was written (file, kind, frames) as JSON instead of text");
 }
 
 // Runs ffmpeg on DIR/frame_*.png into `target` (written atomically); ts::Error when it fails.
@@ -87,6 +90,19 @@ void run_ffmpeg(const fs::path& ffmpeg, const Options& o, const fs::path& target
   });
 }
 
+// What run_frames wrote: one line of text, or with --json one object.
+void report(const Options& o, const std::string& text, const fs::path& file, const std::string& kind,
+            std::size_t frames, std::size_t shown, const std::string& note) {
+  if (!o.json) {
+    fmt::print("{}\n", text);
+    return;
+  }
+  const nlohmann::ordered_json out = {{"output", file.string()}, {"kind", kind}, {"frames", frames},
+                                      {"shown", shown},          {"fps", kind == "film" ? nlohmann::ordered_json(o.fps) : nullptr},
+                                      {"note", note.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(note)}};
+  fmt::print("{}\n", out.dump(2));
+}
+
 int run_frames(const Options& o, const GlobalOptions&) {
   const fs::path out(o.output);
   const std::string ext = out.extension().string();
@@ -97,8 +113,9 @@ int run_frames(const Options& o, const GlobalOptions&) {
     const char* path = std::getenv("PATH");
     if (const auto ffmpeg = preview::find_program("ffmpeg", path ? path : "")) {
       run_ffmpeg(*ffmpeg, o, out);
-      fmt::print("{}: {} frames at {} frames/s (ffmpeg: {})\n", out.string(), frames.size(), o.fps,
-                 ffmpeg->string());
+      report(o, fmt::format("{}: {} frames at {} frames/s (ffmpeg: {})", out.string(), frames.size(), o.fps,
+                            ffmpeg->string()),
+             out, "film", frames.size(), frames.size(), "");
       return 0;
     }
   }
@@ -109,13 +126,15 @@ int run_frames(const Options& o, const GlobalOptions&) {
   for (const auto& f : frames) inputs.push_back(f.path);
   preview::write_png(sheet, image, inputs);
   if (ext == ".mp4") {
-    fmt::print(
-        "ffmpeg not found on PATH (Debian: apt install ffmpeg): wrote a contact sheet of {} of {} frames to "
-        "{} "
-        "instead\n",
-        shown, frames.size(), sheet.string());
+    const std::string note = "ffmpeg not found on PATH (Debian: apt install ffmpeg): a contact sheet instead";
+    report(o,
+           fmt::format("ffmpeg not found on PATH (Debian: apt install ffmpeg): wrote a contact sheet of {} of {} "
+                       "frames to {} instead",
+                       shown, frames.size(), sheet.string()),
+           sheet, "contact sheet", frames.size(), shown, note);
   } else {
-    fmt::print("{}: contact sheet of {} of {} frames\n", sheet.string(), shown, frames.size());
+    report(o, fmt::format("{}: contact sheet of {} of {} frames", sheet.string(), shown, frames.size()), sheet,
+           "contact sheet", frames.size(), shown, "");
   }
   return 0;
 }

@@ -6,7 +6,10 @@
 #include <sys/stat.h>
 
 #include <cstdlib>
+#include <fstream>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
 #include "preview/image.h"
@@ -87,6 +90,16 @@ TEST(CliFrames, PngOutputIsASheetShrunkToTheTileWidth) {
             0)
       << out;
   EXPECT_EQ(lit(preview::read_png(dir / "plain.png")), 0u) << "no label with --no-labels";
+  // --json: standard output is one object saying what was written.
+  ASSERT_EQ(test::run_tetrasand("frames " + q(dir) + " -o " + q(dir / "j.png") + " --json 2>/dev/null | cat > " +
+                                q(dir / "frames.json")),
+            0);
+  std::ifstream json_in(dir / "frames.json");
+  const nlohmann::json report = nlohmann::json::parse(json_in, nullptr, false);
+  ASSERT_FALSE(report.is_discarded()) << "standard output is not one JSON object";
+  EXPECT_EQ(report.at("kind"), "contact sheet");
+  EXPECT_EQ(report.at("frames"), 7);
+  EXPECT_EQ(report.at("output"), (dir / "j.png").string());
 }
 
 TEST(CliFrames, FfmpegOnThePathMakesTheFilm) {

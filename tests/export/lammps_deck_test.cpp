@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -271,6 +272,16 @@ TEST(ExportLammps, CommandWritesDeckAndFailsOnBadScene) {
             0)
       << out;
   EXPECT_TRUE(fs::exists(dir / "d" / "in.tetrasand")) << out;
+  // --json: standard output is one object naming every file written, each there.
+  ASSERT_EQ(test::run_tetrasand("export lammps '" + (dir / "scene.toml").string() + "' -o '" + (dir / "j").string() +
+                                    "' --json 2>/dev/null | cat > '" + (dir / "deck.json").string() + "'"),
+            0);
+  std::ifstream json_in(dir / "deck.json");
+  const nlohmann::json deck = nlohmann::json::parse(json_in, nullptr, false);
+  ASSERT_FALSE(deck.is_discarded()) << "standard output is not one JSON object";
+  EXPECT_GT(deck.at("dynamic_bodies").get<int>(), 0);
+  ASSERT_FALSE(deck.at("files").empty());
+  for (const auto& f : deck.at("files")) EXPECT_TRUE(fs::exists(f.get<std::string>())) << f;
   write_file_atomically(dir / "bad.toml", "[simulation]\nduration = -1\n");
   EXPECT_EQ(test::run_tetrasand("export lammps '" + (dir / "bad.toml").string() + "' -o '" + (dir / "e").string() + "'",
                                 &out),
