@@ -14,7 +14,7 @@ PACKAGES=(
   libgtest-dev googletest
   libcgal-demo assimp-testmodels
   lammps python3
-  python3-vtk9
+  python3-vtk9 python3-jsonschema
 )
 
 missing=()

@@ -1,0 +1,85 @@
+#!/usr/bin/env python3
+"""The published JSON Schemas (docs/schemas/) hold for what tetrasand writes: a body from `sample`, the
+bundled bodies `sample` made, and the `--json` reports of `sim`, `export lammps` and `frames`; a body
+with a key missing or a wrong unit fails its schema (so the check can fail). Debian's python3-jsonschema.
+
+  schemas_test.py TETRASAND_BINARY SOURCE_DIR      exit 0 when every check holds
+"""
+import copy
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import jsonschema
+
+
+def check(ok, what):
+    if not ok:
+        raise SystemExit(f"schemas_test: {what}")
+
+
+def validator(source, name):
+    schema = json.load(open(os.path.join(source, "docs", "schemas", name)))
+    jsonschema.Draft202012Validator.check_schema(schema)
+    return jsonschema.Draft202012Validator(schema)
+
+
+def expect_valid(v, document, what):
+    errors = sorted(v.iter_errors(document), key=lambda e: list(e.path))
+    check(not errors, f"{what}: " + "; ".join(f"{list(e.path)}: {e.message}" for e in errors[:5]))
+
+
+def run_json(binary, args, cwd):
+    res = subprocess.run([binary] + args, capture_output=True, text=True, cwd=cwd)
+    check(res.returncode == 0, f"tetrasand {' '.join(args)} exits 0 (got {res.returncode}): {res.stderr[-600:]}")
+    return json.loads(res.stdout)
+
+
+def check_bodies(binary, source, work):
+    v = validator(source, "body.schema.json")
+    res = subprocess.run([binary, "sample", os.path.join(source, "assets", "sphere.obj"), "-o", "body", "--count", "150",
+                          "--probes", "20000", "--backend", "cpu"], capture_output=True, text=True, cwd=work)
+    check(res.returncode == 0, f"sample exits 0: {res.stderr[-600:]}")
+    body = json.load(open(os.path.join(work, "body", "sphere.body.json")))
+    expect_valid(v, body, "sample's sphere.body.json")
+    for name in ("cube", "plate"):  # made by sample; piston.body.json is a hand-written prop
+        expect_valid(v, json.load(open(os.path.join(source, "assets", "bodies", f"{name}.body.json"))), name)
+    for broken, what in ((lambda b: b.pop("mass"), "without its mass"),
+                         (lambda b: b["units"].update(length="mm"), "in millimetres"),
+                         (lambda b: b["quality"].pop("coverage_certified"), "format 3 without its certificate")):
+        damaged = copy.deepcopy(body)
+        broken(damaged)
+        check(not v.is_valid(damaged), f"a body {what} fails the schema")
+
+
+def check_reports(binary, source, work):
+    scenes = os.path.join(source, "assets", "scenes")
+    sim = run_json(binary, ["sim", os.path.join(scenes, "two_grain_collision.toml"), "-o", "sim", "--duration",
+                            "0.0002", "--backend", "cpu", "--json"], work)
+    expect_valid(validator(source, "sim-report.schema.json"), sim, "sim --json")
+    deck = run_json(binary, ["export", "lammps", os.path.join(scenes, "prop_drop.toml"), "-o", "deck", "--json"], work)
+    expect_valid(validator(source, "export-report.schema.json"), deck, "export lammps --json")
+    frames = os.path.join(work, "frames")
+    os.makedirs(frames)
+    res = subprocess.run([binary, "preview", os.path.join(source, "assets", "cube.obj"), "-o",
+                          os.path.join(frames, "frame_000000.png"), "--size", "48x32", "--resolution", "16"],
+                         capture_output=True, text=True, cwd=work)
+    check(res.returncode == 0, f"preview exits 0: {res.stderr[-600:]}")
+    shutil.copy(os.path.join(frames, "frame_000000.png"), os.path.join(frames, "frame_000001.png"))
+    sheet = run_json(binary, ["frames", frames, "-o", os.path.join(work, "sheet.png"), "--json"], work)
+    expect_valid(validator(source, "frames-report.schema.json"), sheet, "frames --json")
+
+
+def main():
+    binary, source = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    with tempfile.TemporaryDirectory() as work:
+        check_bodies(binary, source, work)
+        check_reports(binary, source, work)
+    print("schemas_test: body.json and the sim, export and frames reports meet docs/schemas/")
+
+
+if __name__ == "__main__":
+    main()
