@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The published JSON Schemas (docs/schemas/) hold for what tetrasand writes: a body from `sample`, the
-bundled bodies `sample` made, and the `--json` reports of `sim`, `export lammps` and `frames`; a body
-with a key missing or a wrong unit fails its schema (so the check can fail). Debian's python3-jsonschema.
+bundled bodies `sample` made, and the `--json` reports of `info`, `sdf`, `sample`, `sim`, `export lammps`
+and `frames`; a body with a key missing or a wrong unit fails its schema, and so does a report with a key
+it does not define (so the check can fail). Debian's python3-jsonschema.
 
   schemas_test.py TETRASAND_BINARY SOURCE_DIR      exit 0 when every check holds
 """
@@ -22,9 +23,15 @@ def check(ok, what):
 
 
 def validator(source, name):
-    schema = json.load(open(os.path.join(source, "docs", "schemas", name)))
-    jsonschema.Draft202012Validator.check_schema(schema)
-    return jsonschema.Draft202012Validator(schema)
+    folder = os.path.join(source, "docs", "schemas")
+    store = {}
+    for f in os.listdir(folder):  # the schemas refer to each other by $id
+        s = json.load(open(os.path.join(folder, f)))
+        jsonschema.Draft202012Validator.check_schema(s)
+        store[s["$id"]] = s
+    schema = json.load(open(os.path.join(folder, name)))
+    resolver = jsonschema.RefResolver(schema["$id"], schema, store=store)
+    return jsonschema.Draft202012Validator(schema, resolver=resolver)
 
 
 def expect_valid(v, document, what):
@@ -40,9 +47,11 @@ def run_json(binary, args, cwd):
 
 def check_bodies(binary, source, work):
     v = validator(source, "body.schema.json")
-    res = subprocess.run([binary, "sample", os.path.join(source, "assets", "sphere.obj"), "-o", "body", "--count", "150",
-                          "--probes", "20000", "--backend", "cpu"], capture_output=True, text=True, cwd=work)
-    check(res.returncode == 0, f"sample exits 0: {res.stderr[-600:]}")
+    report = run_json(binary, ["sample", os.path.join(source, "assets", "sphere.obj"), "-o", "body", "--count", "150",
+                               "--probes", "20000", "--backend", "cpu", "--json"], work)
+    sample = validator(source, "sample-report.schema.json")
+    expect_valid(sample, report, "sample --json")
+    check(not sample.is_valid(dict(report, surprise=1)), "a sample report with an unknown key fails its schema")
     body = json.load(open(os.path.join(work, "body", "sphere.body.json")))
     expect_valid(v, body, "sample's sphere.body.json")
     for name in ("cube", "plate"):  # made by sample; piston.body.json is a hand-written prop
@@ -57,6 +66,14 @@ def check_bodies(binary, source, work):
 
 def check_reports(binary, source, work):
     scenes = os.path.join(source, "assets", "scenes")
+    info = run_json(binary, ["info", os.path.join(source, "assets", "bunny.obj"), "--json"], work)
+    expect_valid(validator(source, "info-report.schema.json"), info, "info --json")
+    sdf = run_json(binary, ["sdf", os.path.join(source, "assets", "cube.obj"), "-o", "cube.nvdb", "--resolution", "16",
+                            "--backend", "cpu", "--json"], work)
+    expect_valid(validator(source, "sdf-report.schema.json"), sdf, "sdf --json (CPU)")
+    sdf = run_json(binary, ["sdf", os.path.join(source, "assets", "cube.obj"), "-o", "cube.vdb", "--resolution", "16",
+                            "--backend", "gpu", "--json"], work)
+    expect_valid(validator(source, "sdf-report.schema.json"), sdf, "sdf --json (GPU)")
     sim = run_json(binary, ["sim", os.path.join(scenes, "two_grain_collision.toml"), "-o", "sim", "--duration",
                             "0.0002", "--backend", "cpu", "--json"], work)
     expect_valid(validator(source, "sim-report.schema.json"), sim, "sim --json")
@@ -78,7 +95,7 @@ def main():
     with tempfile.TemporaryDirectory() as work:
         check_bodies(binary, source, work)
         check_reports(binary, source, work)
-    print("schemas_test: body.json and the sim, export and frames reports meet docs/schemas/")
+    print("schemas_test: body.json and the info, sdf, sample, sim, export and frames reports meet docs/schemas/")
 
 
 if __name__ == "__main__":
