@@ -15,6 +15,7 @@
 #include "core/atomic_file.h"
 #include "core/checked_values.h"
 #include "core/error.h"
+#include "core/vtk_polydata.h"
 
 namespace ts::body {
 namespace {
@@ -36,13 +37,14 @@ fs::path journal_of(const fs::path& json_path) {
 }
 
 // The files a replacement of the body `json_path` writes: the JSON and, for NAME.body.json, the
-// NAME.particles.ply that write_body writes beside it.
+// NAME.particles.ply and NAME.particles.vtp that write_body writes beside it.
 std::vector<fs::path> replaced_with(const fs::path& json_path) {
   const std::string name = json_path.filename().string();
   constexpr std::string_view kSuffix = ".body.json";
   if (!name.ends_with(kSuffix) || name.size() == kSuffix.size()) return {json_path};
-  return {json_path,
-          json_path.parent_path() / (name.substr(0, name.size() - kSuffix.size()) + ".particles.ply")};
+  const std::string stem = name.substr(0, name.size() - kSuffix.size());
+  return {json_path, json_path.parent_path() / (stem + ".particles.ply"),
+          json_path.parent_path() / (stem + ".particles.vtp")};
 }
 
 // Writes `bytes` into a replacement's checked stream (core/atomic_file.h reports a failed write).
@@ -418,6 +420,28 @@ void read_particles(const Fields& f, const fs::path& dir, const fs::path& ply, c
 
 }  // namespace
 
+namespace {
+
+// NAME.particles.vtp: the particles as vertex cells for ParaView and VTK (whose PLY reader gives points
+// without cells, which show nothing until a Glyph filter), with radius, normal and surface (1) or
+// interior (0) per particle.
+std::string particles_vtp_bytes(const ParticleBody& body) {
+  std::vector<double> points;
+  std::vector<float> normals;
+  for (const Eigen::Vector3f& p : body.positions) points.insert(points.end(), {p.x(), p.y(), p.z()});
+  for (const Eigen::Vector3f& n : body.normals) normals.insert(normals.end(), {n.x(), n.y(), n.z()});
+  const std::size_t n = body.positions.size();
+  std::vector<std::uint8_t> surface(n, 1);
+  for (std::size_t i = n - std::min(body.interior_count, n); i < n; ++i) surface[i] = 0;
+  VtpPoints vtp(std::move(points));
+  vtp.add("radius", 1, std::vector<double>(n, body.particle_radius));
+  if (normals.size() == 3 * n) vtp.add("normal", 3, normals);
+  vtp.add("surface", 1, surface);
+  return vtp.bytes();
+}
+
+}  // namespace
+
 fs::path write_body(const fs::path& dir, const std::string& name, const ParticleBody& body) {
   if (name.empty() || name.find_first_of("/\\") != std::string::npos || name == "." || name == "..") {
     throw InputError(dir / name, "a body name must be a plain file name");
@@ -430,8 +454,10 @@ fs::path write_body(const fs::path& dir, const std::string& name, const Particle
   // the new one.
   const std::string json_text = body_json(body, ply_name).dump(2) + "\n";
   const std::string ply_bytes = particles_ply_bytes(body.positions, body.normals);
-  write_files_atomically(journal_of(json_path),
-                         {{dir / ply_name, bytes_writer(ply_bytes)}, {json_path, bytes_writer(json_text)}});
+  const std::string vtp_bytes = particles_vtp_bytes(body);
+  write_files_atomically(journal_of(json_path), {{dir / ply_name, bytes_writer(ply_bytes)},
+                                                 {dir / (name + ".particles.vtp"), bytes_writer(vtp_bytes)},
+                                                 {json_path, bytes_writer(json_text)}});
   return json_path;
 }
 

@@ -9,38 +9,16 @@
 
 #include "core/atomic_file.h"
 #include "core/log.h"
+#include "core/vtk_polydata.h"
 
 namespace ts::scene {
 namespace {
-
-// The arrays of one file in VTK's appended raw encoding: each array's bytes, after a UInt64 byte
-// count, in one block at the end of the file; its DataArray element names its offset in that block.
-class AppendedArrays {
- public:
-  template <typename T>
-  std::string array(const char* type, const char* name, int components, const std::vector<T>& values) {
-    const std::uint64_t bytes = values.size() * sizeof(T);
-    const std::string element = fmt::format(
-        "<DataArray type=\"{}\"{} NumberOfComponents=\"{}\" NumberOfTuples=\"{}\" format=\"appended\" "
-        "offset=\"{}\"/>\n",
-        type, name[0] ? fmt::format(" Name=\"{}\"", name) : std::string(), components, values.size() / components,
-        block_.size());
-    block_.append(reinterpret_cast<const char*>(&bytes), sizeof bytes);
-    block_.append(reinterpret_cast<const char*>(values.data()), bytes);
-    return element;
-  }
-  const std::string& block() const { return block_; }
-
- private:
-  std::string block_;
-};
 
 // Per-particle values of the body each particle belongs to, and the particles' own.
 struct ParticleArrays {
   std::vector<double> points, radius, velocity, angular_velocity, orientation, body_centre;
   std::vector<std::uint32_t> body, body_particles;
   std::vector<std::uint8_t> motion;
-  std::vector<std::int64_t> connectivity, offsets;
 };
 
 ParticleArrays particle_arrays(const World& world) {
@@ -63,8 +41,6 @@ ParticleArrays particle_arrays(const World& world) {
     a.body.push_back(k);
     a.body_particles.push_back(b.particle_count[k]);
     a.motion.push_back(static_cast<std::uint8_t>(b.motion[k]));
-    a.connectivity.push_back(static_cast<std::int64_t>(i));
-    a.offsets.push_back(static_cast<std::int64_t>(i + 1));
   }
   return a;
 }
@@ -73,31 +49,17 @@ ParticleArrays particle_arrays(const World& world) {
 
 void write_particles_vtp(const World& world, const std::filesystem::path& file) {
   const ParticleArrays a = particle_arrays(world);
-  AppendedArrays data;
-  const std::string time = data.array("Float64", "TimeValue", 1, std::vector<double>{world.time});
-  std::string point_data = data.array("Float64", "radius", 1, a.radius);
-  point_data += data.array("UInt32", "body", 1, a.body);
-  point_data += data.array("UInt8", "motion", 1, a.motion);
-  point_data += data.array("UInt32", "body_particles", 1, a.body_particles);
-  point_data += data.array("Float64", "velocity", 3, a.velocity);
-  point_data += data.array("Float64", "angular_velocity", 3, a.angular_velocity);
-  point_data += data.array("Float64", "orientation", 4, a.orientation);
-  point_data += data.array("Float64", "body_centre", 3, a.body_centre);
-  const std::string points = data.array("Float64", "", 3, a.points);
-  const std::string connectivity = data.array("Int64", "connectivity", 1, a.connectivity);
-  const std::string offsets = data.array("Int64", "offsets", 1, a.offsets);
-  std::string bytes = fmt::format(
-      "<?xml version=\"1.0\"?>\n"
-      "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-      "<PolyData>\n<FieldData>\n{0}</FieldData>\n"
-      "<Piece NumberOfPoints=\"{1}\" NumberOfVerts=\"{1}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
-      "NumberOfPolys=\"0\">\n<PointData Scalars=\"radius\" Vectors=\"velocity\">\n{2}</PointData>\n"
-      "<Points>\n{3}</Points>\n<Verts>\n{4}{5}</Verts>\n</Piece>\n</PolyData>\n"
-      "<AppendedData encoding=\"raw\">\n_",
-      time, a.radius.size(), point_data, points, connectivity, offsets);
-  bytes += data.block();
-  bytes += "\n</AppendedData>\n</VTKFile>\n";
-  write_file_atomically(file, bytes);
+  VtpPoints vtp(a.points);
+  vtp.set_time(world.time);
+  vtp.add("radius", 1, a.radius);
+  vtp.add("body", 1, a.body);
+  vtp.add("motion", 1, a.motion);
+  vtp.add("body_particles", 1, a.body_particles);
+  vtp.add("velocity", 3, a.velocity);
+  vtp.add("angular_velocity", 3, a.angular_velocity);
+  vtp.add("orientation", 4, a.orientation);
+  vtp.add("body_centre", 3, a.body_centre);
+  write_file_atomically(file, vtp.bytes());
 }
 
 void VtpCollection::add(const std::string& vtp, double time) {

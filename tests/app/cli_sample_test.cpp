@@ -158,7 +158,7 @@ TEST(CliSample, AFailedRunLeavesThePreviousBodyWholeAndARerunReplacesIt) {
   ASSERT_EQ(test::run_tetrasand(base, &log), 0) << log;
   const std::string ply = read_text(out / "sphere.particles.ply"), json = read_text(out / "sphere.body.json");
   ASSERT_GT(json.size(), ply.size() + 1000) << "the JSON must be the larger file";
-  const std::set<std::string> pair = {"sphere.body.json", "sphere.particles.ply"};
+  const std::set<std::string> pair = {"sphere.body.json", "sphere.particles.ply", "sphere.particles.vtp"};  // and the PLY as VTK points
 
   EXPECT_NE(test::run_tetrasand(base + "--radius 1", &log), 0) << log;  // refused: radius too large
   EXPECT_EQ(read_text(out / "sphere.particles.ply"), ply);
@@ -226,7 +226,7 @@ TEST(CliSample, JsonPrintsTheBodyAndOnlyFinishedFilesRemain) {
   EXPECT_FALSE(json.at("verdict_reasons").empty());
   EXPECT_EQ(json.at("thin_features").at("triangles").get<int>(), 0);
   EXPECT_FALSE(nlohmann::json::parse(read_text(dir / "sphere.body.json")).contains("verdict"));
-  EXPECT_EQ(files_in(dir), (std::set<std::string>{"sphere.body.json", "sphere.particles.ply"}));
+  EXPECT_EQ(files_in(dir), (std::set<std::string>{"sphere.body.json", "sphere.particles.ply", "sphere.particles.vtp"}));
 }
 
 std::string last_line(const std::string& text) {
@@ -261,7 +261,7 @@ TEST(CliSample, StrictExitsOneOnABodyWithHolesAndZeroOnAnOkBody) {
   const auto json = nlohmann::json::parse(strict.substr(strict.find("{\n")));
   EXPECT_EQ(json.at("verdict").get<std::string>(), "usable with caveats");
   EXPECT_EQ(files_in(dir),
-            (std::set<std::string>{"sphereWithHole.body.json", "sphereWithHole.particles.ply"}));
+            (std::set<std::string>{"sphereWithHole.body.json", "sphereWithHole.particles.ply", "sphereWithHole.particles.vtp"}));
 }
 
 // The bundled 2 mm plate at 150 particles (r about 7 mm): all of it is thinner than the spacing, one

@@ -45,14 +45,17 @@ ParticleBody random_body(std::size_t count, std::uint64_t seed) {
   return body;
 }
 
+// A body's files (the name says pair: the .vtp, ParaView's copy of the particles, goes with them).
 struct Pair {
-  std::string json, ply;
+  std::string json, ply, vtp;
   bool operator==(const Pair&) const = default;
 };
 
 Pair read_pair(const fs::path& dir) {
-  return {read_file(dir / "b.body.json"), read_file(dir / "b.particles.ply")};
+  return {read_file(dir / "b.body.json"), read_file(dir / "b.particles.ply"), read_file(dir / "b.particles.vtp")};
 }
+
+constexpr std::size_t kBodyFiles = 3;  // json, ply, vtp
 
 void write_bytes(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
@@ -149,16 +152,17 @@ TEST(BodyReplacement, AWriterKilledAtRandomLeavesTheOldPairOrTheNewOneByteForByt
     fs::create_directories(dir);
     write_bytes(dir / "b.body.json", old_pair.json);
     write_bytes(dir / "b.particles.ply", old_pair.ply);
+    write_bytes(dir / "b.particles.vtp", old_pair.vtp);
     const long delay = std::uniform_int_distribution<long>(early, std::max(early, late))(rng);
     const bool ended = write_and_kill(dir, new_body, std::chrono::microseconds(delay));
-    const bool left_files = entries(dir) != 2;  // temporary files or a journal were left behind
+    const bool left_files = entries(dir) != kBodyFiles;  // temporary files or a journal were left behind
     const ParticleBody read = read_body(dir / "b.body.json");  // completes or removes what was left
     const Pair found = read_pair(dir);
     if (found == old_pair) ++old_found;
     if (found == new_pair) ++new_found;
     ASSERT_TRUE(found == old_pair || found == new_pair) << "trial " << trial << ": a mixed pair";
     EXPECT_EQ(read.positions.size(), found == old_pair ? 5000u : 40000u);
-    ASSERT_EQ(entries(dir), 2u) << "trial " << trial << ": leftovers after the next read";
+    ASSERT_EQ(entries(dir), kBodyFiles) << "trial " << trial << ": leftovers after the next read";
     if (left_files) ++interrupted;
     if (ended) {
       ++ended_first;
@@ -188,15 +192,17 @@ TEST(BodyReplacement, ADeadWritersPublishedJournalIsCompletedByTheNextWrite) {
   ::waitpid(dead, nullptr, 0);
   const std::string tmp_ply = format_temporary_name({"b.particles.ply", dead, 0, 7});
   const std::string tmp_json = format_temporary_name({"b.body.json", dead, 0, 8});
+  const std::string tmp_vtp = format_temporary_name({"b.particles.vtp", dead, 0, 9});
   const fs::path other = test::temp_dir();
   write_body(other, "b", random_body(300, 2));
   fs::copy_file(other / "b.particles.ply", dir / tmp_ply);
   fs::copy_file(other / "b.body.json", dir / tmp_json);
+  fs::copy_file(other / "b.particles.vtp", dir / tmp_vtp);
   write_bytes(dir / ".b.body.json.journal",
-              fmt::format("tetrasand journal 1\npid {}\n{}\tb.particles.ply\n{}\tb.body.json\n", dead,
-                          tmp_ply, tmp_json));
+              fmt::format("tetrasand journal 1\npid {}\n{}\tb.particles.ply\n{}\tb.particles.vtp\n{}\tb.body.json\n",
+                          dead, tmp_ply, tmp_vtp, tmp_json));
   EXPECT_EQ(read_body(dir / "b.body.json").positions.size(), 300u);
-  EXPECT_EQ(entries(dir), 2u);
+  EXPECT_EQ(entries(dir), kBodyFiles);
   EXPECT_EQ(read_pair(dir), read_pair(other));
 }
 
@@ -217,7 +223,7 @@ TEST(BodyReplacement, StaleTemporaryFilesOfADeadProcessAreRemovedByTheNextRun) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
   std::sort(names.begin(), names.end());
-  EXPECT_EQ(names, (std::vector<std::string>{live, "b.body.json", "b.particles.ply"}));
+  EXPECT_EQ(names, (std::vector<std::string>{live, "b.body.json", "b.particles.ply", "b.particles.vtp"}));
 }
 
 TEST(BodyReplacement, AJournalOfALiveWriterIsRefusedNamingIt) {

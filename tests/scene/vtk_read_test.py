@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""VTK's own readers (Debian python3-vtk9) open what `tetrasand sim` writes for ParaView: a short prop drop
-with [output] vtp, its particles.pvd listing every .vtp with its time, each .vtp read by
-vtkXMLPolyDataReader with a vertex per particle and the point arrays of scene/vtk_files.h.
+"""VTK's own readers (Debian python3-vtk9) open what tetrasand writes for ParaView: a short prop drop with
+[output] vtp, its particles.pvd listing every .vtp with its time, each .vtp read by vtkXMLPolyDataReader
+with a vertex per particle and the point arrays of scene/vtk_files.h; and a body's NAME.particles.vtp
+from `sample` (--fill, so surface and interior), its points those of the PLY.
 
   vtk_read_test.py TETRASAND_BINARY SOURCE_DIR      exit 0 when every check holds
 """
@@ -58,6 +59,26 @@ def check_vtp(path, time):
     return max(speeds), sizes
 
 
+def check_body_vtp(binary, source, work):
+    res = subprocess.run([binary, "sample", os.path.join(source, "assets", "sphere.obj"), "-o", "body", "--count", "150",
+                          "--probes", "20000", "--backend", "cpu", "--fill"], capture_output=True, text=True, cwd=work)
+    check(res.returncode == 0, f"sample exits 0: {res.stderr[-600:]}")
+    vtp = vtk.vtkXMLPolyDataReader()
+    vtp.SetFileName(os.path.join(work, "body", "sphere.particles.vtp"))
+    vtp.Update()
+    ply = vtk.vtkPLYReader()
+    ply.SetFileName(os.path.join(work, "body", "sphere.particles.ply"))
+    ply.Update()
+    body, points = vtp.GetOutput(), ply.GetOutput()
+    n = body.GetNumberOfPoints()
+    check(n == points.GetNumberOfPoints() and body.GetNumberOfVerts() == n, f"the body's .vtp: {n} vertex cells")
+    check(all(body.GetPoint(i) == points.GetPoint(i) for i in range(n)), "the .vtp's points are the PLY's")
+    surface = body.GetPointData().GetArray("surface")
+    flags = {int(surface.GetValue(i)) for i in range(n)}
+    check(flags == {0, 1}, f"surface and interior particles marked: {flags}")
+    check(body.GetPointData().GetArray("normal").GetNumberOfComponents() == 3, "normals")
+
+
 def main():
     binary, source = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     with tempfile.TemporaryDirectory() as work:
@@ -74,6 +95,7 @@ def main():
             fastest, sizes = max(fastest, speed), sizes | body_sizes
         check(fastest > 0, "some particle moves")
         check(4 in sizes and any(s > 4 for s in sizes), f"grains (4 particles) and a prop (more): {sorted(sizes)}")
+        check_body_vtp(binary, source, work)
     print(f"vtk_read_test: {len(entries)} outputs read by VTK {vtk.vtkVersion.GetVTKVersion()}")
 
 
