@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/mesh.h"
@@ -71,11 +72,33 @@ struct RenderResult {
   double seconds = 0.0;                 // wall time of render()
 };
 
-class Renderer {
+// What a preview renderer does, on the GL device (Renderer) or on the CPU (CpuRenderer,
+// preview/cpu_renderer.h): the commands load the scene and draw views through this, whichever runs.
+class ImageRenderer {
+ public:
+  virtual ~ImageRenderer() = default;
+  // The SDF to ray-cast; ts::InputError for an empty one or one under 2 voxels a side.
+  virtual void load_volume(SdfVolume volume) = 0;
+  // ts::InputError for a radius count other than 1 or n, a colour count other than 0 or n, or a
+  // particle with a non-finite centre or a radius that is not positive.
+  virtual void set_particles(const Particles& particles) = 0;
+  // The box of what is drawn: the SDF's surface and the particle spheres; invalid when empty.
+  virtual Aabb content_box() const = 0;
+  // ts::InputError for a side below 1 pixel or above what the renderer can draw.
+  virtual void check_image_size(int width, int height) const = 0;
+  // ts::InputError for a bad image size, a bad camera, or nothing to draw.
+  virtual RenderResult render(const RenderSettings& settings) = 0;
+  // Per-pass times so far (when constructed with timings).
+  virtual std::string timing_report() = 0;
+  // What draws: "llvmpipe (...)", "the CPU (16 TBB threads)".
+  virtual std::string device() const = 0;
+};
+
+class Renderer final : public ImageRenderer {
  public:
   // Compiles the preview shaders. Requires a current context; GpuError when a pass cannot run.
   explicit Renderer(gpu::Context& context, bool timings = false);
-  ~Renderer();
+  ~Renderer() override;
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
@@ -84,24 +107,26 @@ class Renderer {
   // (`field_block_bytes` when not 0: tests cut a small grid into chunks); GpuError naming the size when
   // even 8 cannot hold it.
   void set_volume(SdfVolume volume, std::size_t field_block_bytes = 0);
-  void set_particles(const Particles& particles);
+  void load_volume(SdfVolume volume) override { set_volume(std::move(volume)); }
+  void set_particles(const Particles& particles) override;
   // The storage blocks the SDF occupies on the GPU: 1, up to 8 when chunked, 0 before set_volume.
   int field_chunks() const;
 
   // The box of what is drawn: the SDF's surface (voxels at or inside the zero level) and the
   // particle spheres. Invalid when nothing is loaded.
-  Aabb content_box() const;
+  Aabb content_box() const override;
   // The largest image the device renders (GL_MAX_VIEWPORT_DIMS, GL_MAX_TEXTURE_SIZE, framebuffer).
   Eigen::Vector2i max_image_size() const;
 
   // ts::InputError for a side below 1 pixel or above max_image_size().
-  void check_image_size(int width, int height) const;
+  void check_image_size(int width, int height) const override;
 
   // ts::InputError for a bad image size (check_image_size), a bad camera, or nothing to draw.
-  RenderResult render(const RenderSettings& settings);
+  RenderResult render(const RenderSettings& settings) override;
 
   // Per-pass GPU times so far (when constructed with timings).
-  std::string timing_report();
+  std::string timing_report() override;
+  std::string device() const override;  // the context's summary
 
  private:
   struct Impl;
