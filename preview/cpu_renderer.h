@@ -14,7 +14,7 @@
 #include <memory>
 #include <string>
 
-#include "preview/renderer.h"
+#include "preview/image_renderer.h"
 
 namespace ts::preview {
 

@@ -8,7 +8,7 @@
 
 #include "core/mesh.h"
 #include "preview/camera.h"
-#include "preview/renderer.h"
+#include "preview/image_renderer.h"
 
 namespace ts::preview {
 
@@ -47,6 +47,10 @@ struct Frame {
 // for a radius count other than 1 or n, a colour count other than 0 or n, or a particle with a
 // non-finite centre or a radius that is not positive.
 Aabb particle_box(const Particles& particles);
+
+// The key light's default direction: from the upper left, behind the camera, about 50 degrees above
+// the ground plane, turning with the camera about `up`.
+Eigen::Vector3d default_light(const Camera& camera, const Eigen::Vector3d& up);
 
 // Checks the settings (ts::InputError for a bad camera, up vector, light or colour map, or an
 // invalid `content`, nothing to draw) and plans the frame of `content` (the surface and the

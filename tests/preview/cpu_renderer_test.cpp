@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/mesh_io.h"
 #include "preview/colors.h"
+#include "preview/renderer.h"
 #include "sdf/vdb_io.h"
 #include "tests/test_support.h"
 
