@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <cctype>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <regex>
@@ -15,6 +16,7 @@
 #include "core/mesh_report.h"
 #include "gpu/backend.h"
 #include "preview/camera.h"
+#include "preview/cpu_renderer.h"
 #include "preview/image.h"
 #include "preview/inputs.h"
 #include "preview/renderer.h"
@@ -28,7 +30,7 @@ namespace {
 
 struct Options {
   std::string input, output, particles, size = "800x800", view = "iso", color_by = "none";
-  std::string backend = "auto";  // there is no CPU renderer yet: auto takes the GPU, cpu is refused
+  std::string backend = "auto";  // where the picture is drawn (gpu/backend.h's rule)
   std::vector<double> eye, target, up{0.0, 0.0, 1.0}, light;
   double fov = 30.0, particle_radius = 0.0, color_max = 0.0, voxel = 0.0, band = 3.0, scale = 1.0;
   int resolution = 192, turntable = 1;
@@ -89,8 +91,9 @@ void add_input_options(CLI::App* cmd, Options& o) {
       ->check(positive());
   cmd->add_option("--size", o.size, "Image size WIDTHxHEIGHT [pixels]")->capture_default_str();
   cmd->add_option("--backend", o.backend,
-                  "auto or gpu: the GL renderer (the preview has no CPU path yet, so auto takes the GPU on a "
-                  "software renderer too and cpu is refused)")
+                  "gpu: the GL renderer; cpu: OpenVDB's level-set ray intersector and a sphere splatter on every "
+                  "core, the field of a MESH by the exact SDF (no GL context); auto: cpu on a software renderer "
+                  "such as llvmpipe, else gpu")
       ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
       ->capture_default_str();
 }
@@ -161,17 +164,12 @@ void add_lighting_options(CLI::App* cmd, Options& o) {
       ->check(finite());
   cmd->add_flag("--no-ground", o.no_ground, "No ground plane");
   cmd->add_flag("--no-shadows", o.no_shadows, "No shadow map");
-  cmd->add_flag("--timings", o.timings, "Per-pass GPU times");
+  cmd->add_flag("--timings", o.timings, "Per-pass times (GPU timer queries, or wall time on the CPU)");
 }
 
 // Combinations CLI11 cannot check by itself.
 void check_options(const Options& o) {
   if (o.input.empty() && o.particles.empty()) throw Error(ExitCode::Usage, "preview: give a MESH or an SDF.vdb / SDF.nvdb, or --particles");
-  if (o.backend == "cpu") {
-    throw Error(ExitCode::Usage,
-                "--backend cpu: the preview has only a GPU path for now (no CPU renderer); --backend auto or gpu "
-                "renders on the GL device, llvmpipe included");
-  }
   if (o.contact_sheet && o.turntable < 2) throw Error(ExitCode::Usage, "--contact-sheet needs --turntable N with N >= 2");
   if (o.color_by == "error" && (o.input.empty() || is_vdb(o.input))) {
     throw InputError("--color-by error needs a MESH input: the exact distance comes from the mesh");
@@ -189,7 +187,9 @@ preview::SdfVolume volume_from_vdb(const Options& o) {
   return volume;
 }
 
-preview::SdfVolume volume_from_mesh_file(const Options& o, gpu::Context& context, std::optional<TriangleMesh>& mesh) {
+// The field is built where the picture is drawn: scan-converted on the GL device, or the exact SDF on
+// the CPU (no context).
+preview::SdfVolume volume_from_mesh_file(const Options& o, gpu::Context* context, std::optional<TriangleMesh>& mesh) {
   mesh = load_mesh(o.input);
   if (o.scale != 1.0) scale_mesh(*mesh, o.scale);
   ReportOptions report_options;
@@ -204,7 +204,9 @@ preview::SdfVolume volume_from_mesh_file(const Options& o, gpu::Context& context
   grid.voxel_size = o.voxel;
   grid.resolution = o.resolution;
   grid.band = o.band;
-  return naming_file(o.input, [&] { return preview::volume_from_mesh(context, *mesh, grid); });
+  return naming_file(o.input, [&] {
+    return context ? preview::volume_from_mesh(*context, *mesh, grid) : preview::volume_from_mesh_on_cpu(*mesh, grid);
+  });
 }
 
 // What the picture shows and how it is coloured, kept alive while it renders.
@@ -219,7 +221,8 @@ struct Content {
   std::vector<std::filesystem::path> inputs;
 };
 
-void load_field(const Options& o, gpu::Context& context, preview::Renderer& renderer, Content& content) {
+// `context`: the GL device's when the GPU draws, else null.
+void load_field(const Options& o, gpu::Context* context, preview::ImageRenderer& renderer, Content& content) {
   if (o.input.empty()) return;
   content.inputs.emplace_back(o.input);
   preview::SdfVolume volume = is_vdb(o.input) ? volume_from_vdb(o) : volume_from_mesh_file(o, context, content.mesh);
@@ -227,10 +230,10 @@ void load_field(const Options& o, gpu::Context& context, preview::Renderer& rend
   content.field = fmt::format("SDF {} x {} x {} voxels of {:.4g} m (band {:.3g}; sparse: {} band voxels, {:.1f} MiB)",
                               volume.spec.dims.x(), volume.spec.dims.y(), volume.spec.dims.z(), content.voxel_size,
                               volume.band, volume.band_voxels, volume.grid.size() / 1048576.0);
-  renderer.set_volume(std::move(volume));
+  renderer.load_volume(std::move(volume));
 }
 
-void load_particles(const Options& o, preview::Renderer& renderer, Content& content) {
+void load_particles(const Options& o, preview::ImageRenderer& renderer, Content& content) {
   if (o.particles.empty()) return;
   content.inputs.emplace_back(o.particles);
   content.loaded = preview::load_particles(o.particles, o.particle_radius);
@@ -277,12 +280,12 @@ void set_lighting(const Options& o, const Eigen::Vector2i& size, preview::Render
 }
 
 struct Views {
-  double seconds = 0.0;  // s, GPU render time of all views
+  double seconds = 0.0;  // s, render time of all views
   preview::ScalarSummary scalar;
 };
 
 // The turntable's views, written one PNG each or tiled into one contact sheet.
-Views render_views(const Options& o, preview::Renderer& renderer, preview::RenderSettings& settings,
+Views render_views(const Options& o, preview::ImageRenderer& renderer, preview::RenderSettings& settings,
                    const preview::Camera& camera, const std::vector<std::filesystem::path>& inputs) {
   std::vector<preview::Image> sheet;
   Views views;
@@ -308,7 +311,7 @@ Views render_views(const Options& o, preview::Renderer& renderer, preview::Rende
 }
 
 void print_summary(const Options& o, const Eigen::Vector2i& size, const Content& content, const Views& views,
-                   const preview::RenderSettings& settings, const gpu::Context& context) {
+                   const preview::RenderSettings& settings, const preview::ImageRenderer& renderer) {
   std::string what = content.field;
   const preview::Particles& particles = content.loaded.particles;
   if (!particles.centers.empty()) {
@@ -327,28 +330,38 @@ void print_summary(const Options& o, const Eigen::Vector2i& size, const Content&
                views.scalar.mean / static_cast<double>(views.scalar.pixels), views.scalar.max, views.scalar.pixels,
                settings.surface_scalar.max_value);
   }
-  fmt::print("  render           {:.3f} s on {}\n", views.seconds, context.summary());
+  fmt::print("  render           {:.3f} s on {}\n", views.seconds, renderer.device());
+}
+
+// The renderer the backend rule picks (gpu/backend.h); `context` is made only where it asks the
+// device (auto) or draws there (gpu), so --backend cpu runs without EGL.
+std::unique_ptr<preview::ImageRenderer> make_renderer(const Options& o, const GlobalOptions& global,
+                                                      std::unique_ptr<gpu::Context>& context) {
+  const gpu::Backend requested = gpu::parse_backend(o.backend).value();  // CLI::IsMember checked it
+  if (requested != gpu::Backend::Cpu) context = std::make_unique<gpu::Context>(context_options(global));
+  const gpu::Backend chosen = gpu::resolve_backend(requested, context.get());
+  fmt::print("{}\n", gpu::backend_line(requested, chosen, gpu::describe(context.get()), true, "renderer"));
+  if (chosen == gpu::Backend::Gpu) return std::make_unique<preview::Renderer>(*context, o.timings);
+  context.reset();  // the CPU draws and builds the field: the context is not needed any more
+  return std::make_unique<preview::CpuRenderer>(o.timings);
 }
 
 int run_preview(const Options& o, const GlobalOptions& global) {
   check_options(o);
   const Eigen::Vector2i size = parse_size(o.size);
-  gpu::Context context(context_options(global));
-  const gpu::Backend requested = gpu::parse_backend(o.backend).value();  // auto or gpu: check_options
-  fmt::print("{}\n", gpu::backend_line(requested, gpu::resolve_backend(requested, &context, false),
-                                       gpu::describe(&context), false));
-  preview::Renderer renderer(context, o.timings);
-  renderer.check_image_size(size.x(), size.y());
+  std::unique_ptr<gpu::Context> context;
+  const std::unique_ptr<preview::ImageRenderer> renderer = make_renderer(o, global, context);
+  renderer->check_image_size(size.x(), size.y());
   Content content;
-  load_field(o, context, renderer, content);
-  load_particles(o, renderer, content);
+  load_field(o, context.get(), *renderer, content);
+  load_particles(o, *renderer, content);
   preview::RenderSettings settings;
   set_surface_colouring(o, content, settings);
   set_lighting(o, size, settings);
-  const preview::Camera camera = make_camera(o, renderer.content_box(), static_cast<double>(size.x()) / size.y());
-  const Views views = render_views(o, renderer, settings, camera, content.inputs);
-  print_summary(o, size, content, views, settings, context);
-  if (o.timings) fmt::print("{}", renderer.timing_report());
+  const preview::Camera camera = make_camera(o, renderer->content_box(), static_cast<double>(size.x()) / size.y());
+  const Views views = render_views(o, *renderer, settings, camera, content.inputs);
+  print_summary(o, size, content, views, settings, *renderer);
+  if (o.timings) fmt::print("{}", renderer->timing_report());
   return 0;
 }
 
@@ -356,8 +369,8 @@ int run_preview(const Options& o, const GlobalOptions& global) {
 
 Runner add_preview_command(CLI::App& app, const GlobalOptions& global) {
   return add_command<Options>(app, global, "preview",
-                              "Off-screen preview: ray-cast SDF (of a mesh or a .vdb or .nvdb level set) with particles as sphere "
-                              "impostors, to PNG",
+                              "Off-screen preview: ray-cast SDF (of a mesh or a .vdb or .nvdb level set) with particles as "
+                              "spheres, to PNG, on the GL device or the CPU",
                               run_preview, add_input_options, add_camera_options, add_colour_options, add_sdf_options,
                               add_lighting_options);
 }

@@ -103,9 +103,10 @@ void add_sampling_options(CLI::App* cmd, Options& o) {
       ->check(positive())
       ->capture_default_str();
   cmd->add_option("--backend", o.backend,
-                  "Where the relaxation and the coverage certificate run: gpu (compute kernels), cpu (the "
-                  "same algorithms on all cores; with --sdf-backend auto or cpu and no --preview, no GL "
-                  "context at all) or auto (cpu on a software renderer, else gpu: the rule of every command)")
+                  "Where the relaxation, the coverage certificate and --preview run: gpu (compute kernels, the "
+                  "GL renderer), cpu (the same algorithms on all cores, the CPU renderer; with --sdf-backend "
+                  "auto or cpu no GL context at all) or auto (cpu on a software renderer, else gpu: the rule "
+                  "of every command)")
       ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
       ->capture_default_str();
   cmd->add_option("--sdf-backend", o.sdf_backend,
@@ -147,7 +148,8 @@ void add_solid_and_output_options(CLI::App* cmd, Options& o) {
       "Exit 1 unless the verdict is 'body OK' (the body is still written; a batch converts every mesh)");
   cmd->add_flag("--timings", o.sampling.timings, "Per-kernel GPU times and host-GPU round trips");
   cmd->add_flag("--preview", o.preview,
-                "Also write NAME.preview.png: the mesh's SDF ray-cast with the particles over it");
+                "Also write NAME.preview.png: the mesh's SDF ray-cast with the particles over it (drawn where "
+                "--backend says)");
   cmd->add_option("--up", o.up,
                   "With --preview: the mesh's up X,Y,Z (+z by convention; `info` tells its tallest axis)")
       ->delimiter(',')
@@ -210,8 +212,10 @@ void write_preview(const Options& o, gpu::Context* context, const TriangleMesh& 
   const std::filesystem::path png = std::filesystem::path(o.in.output) / (name + ".preview.png");
   preview::BodyPreviewSettings look;
   look.up = Eigen::Vector3d(o.up[0], o.up[1], o.up[2]);
-  // The context is there: needs_gl_context asks for one under --preview.
-  preview::write_body_preview(*context, mesh, body, png, {o.mesh}, look);
+  // The preview is drawn where --backend runs the relaxation (gpu/backend.h): on the CPU without a device
+  // or on a software renderer.
+  const bool on_gpu = gpu::resolve_backend(settings_of(o).backend, context) == gpu::Backend::Gpu;
+  preview::write_body_preview(on_gpu ? context : nullptr, mesh, body, png, {o.mesh}, look);
   log::info("preview: {}", png.string());
 }
 
@@ -256,10 +260,10 @@ int convert_one(const Options& o, gpu::Context* context, BatchRow& row) {
   return o.strict && verdict.verdict != sampler::Verdict::Ok ? 1 : 0;
 }
 
-// Whether a run needs a GL context at all: auto asks the device what it is, the GPU paths and --preview use
-// it. `--backend cpu` without them runs everything on the CPU, the SDF included (--sdf-backend auto then
-// means a CPU field, exact or OpenVDB's), so it works where EGL does not.
-bool needs_gl_context(const Options& o) { return o.backend != "cpu" || o.sdf_backend == "gpu" || o.preview; }
+// Whether a run needs a GL context at all: auto asks the device what it is, the GPU paths use it.
+// `--backend cpu` without --sdf-backend gpu runs everything on the CPU, the SDF and --preview included
+// (--sdf-backend auto then means a CPU field, exact or OpenVDB's), so it works where EGL does not.
+bool needs_gl_context(const Options& o) { return o.backend != "cpu" || o.sdf_backend == "gpu"; }
 
 // --scan auto, once for the whole batch, where the SDF is scanned on the GPU: the cached calibration of
 // this renderer and driver, or a calibration now (sdf/scan_calibration.h).
@@ -287,7 +291,8 @@ void print_backend_line(const Options& o, const gpu::Context* context) {
                                  : "by exact distance on the CPU";
   const std::string note = fmt::format("SDF: {}, {}", field, o.sdf_backend == "auto" ? "auto" : "asked for");
   const std::string line = gpu::backend_line(settings.backend, relax, gpu::describe(context), true,
-                                             "relaxation and certificate", note);
+                                             o.preview ? "relaxation, certificate and preview" : "relaxation and certificate",
+                                             note);
   if (o.json) {
     log::info("{}", line);
   } else {

@@ -1,16 +1,25 @@
 #include "preview/body_preview.h"
 
+#include <memory>
+
+#include "preview/cpu_renderer.h"
 #include "preview/renderer.h"
 
 namespace ts::preview {
 
-void write_body_preview(gpu::Context& context, const TriangleMesh& mesh, const body::ParticleBody& body,
+void write_body_preview(gpu::Context* context, const TriangleMesh& mesh, const body::ParticleBody& body,
                         const std::filesystem::path& png, const std::vector<std::filesystem::path>& inputs,
                         const BodyPreviewSettings& settings) {
-  Renderer renderer(context);
+  std::unique_ptr<ImageRenderer> drawn;
+  if (context) {
+    drawn = std::make_unique<Renderer>(*context);
+  } else {
+    drawn = std::make_unique<CpuRenderer>();
+  }
+  ImageRenderer& renderer = *drawn;
   sdf::SdfSettings grid;
   grid.resolution = settings.resolution;
-  renderer.set_volume(volume_from_mesh(context, mesh, grid));
+  renderer.load_volume(context ? volume_from_mesh(*context, mesh, grid) : volume_from_mesh_on_cpu(mesh, grid));
   Particles particles;
   for (const auto& p : body.positions) particles.centers.push_back(p.cast<double>());
   particles.radii = {static_cast<float>(body.particle_radius)};

@@ -16,9 +16,10 @@ struct BodyPreviewSettings {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // the mesh's up (sample --up), +z by convention
 };
 
-// Scan-converts `mesh` and renders it with `body`'s particles; writes `png` atomically, never over
-// one of `inputs`.
-void write_body_preview(gpu::Context& context, const TriangleMesh& mesh, const body::ParticleBody& body,
+// Scan-converts `mesh` on `context`'s device and renders it there with `body`'s particles, or with a
+// null context builds the exact SDF and renders on the CPU (preview/cpu_renderer.h); writes `png`
+// atomically, never over one of `inputs`.
+void write_body_preview(gpu::Context* context, const TriangleMesh& mesh, const body::ParticleBody& body,
                         const std::filesystem::path& png, const std::vector<std::filesystem::path>& inputs = {},
                         const BodyPreviewSettings& settings = {});
 

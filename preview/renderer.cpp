@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,6 +13,7 @@
 #include "gpu/graphics.h"
 #include "gpu/params.h"
 #include "preview/colors.h"
+#include "preview/frame.h"
 #include "shaders/preview/bindings.h"
 
 namespace ts::preview {
@@ -25,33 +25,6 @@ gpu::Texture make_target(GLenum format, int width, int height, GLenum filter, co
   gpu::Texture texture = gpu::Texture::create_2d(format, width, height, what);
   texture.set_sampling(filter);
   return texture;
-}
-
-// The camera as every pass sees it: relative to the scene origin, in float.
-struct CameraState {
-  Eigen::Matrix4d view_projection, inverse;
-  Eigen::Vector3d eye, forward, right, up;  // eye relative to the origin
-  bool ortho = false;
-  int width = 0, height = 0;
-};
-
-CameraState camera_state(const Camera& camera, int width, int height, const Eigen::Vector3d& origin, double radius) {
-  Camera local = camera;
-  local.eye -= origin;
-  local.target -= origin;
-  const ViewMatrices m =
-      view_matrices(local, static_cast<double>(width) / height, Eigen::Vector3d::Zero(), radius);
-  CameraState s;
-  s.view_projection = m.projection * m.view;
-  s.inverse = s.view_projection.inverse();
-  s.eye = local.eye;
-  s.forward = local.forward();
-  s.right = local.right();
-  s.up = local.image_up();
-  s.ortho = camera.ortho;
-  s.width = width;
-  s.height = height;
-  return s;
 }
 
 using gpu::params::CameraParams;
@@ -95,74 +68,7 @@ std::vector<T> flip_rows(const std::vector<T>& in, int width, int height, int pe
   return out;
 }
 
-Eigen::Vector3d any_perpendicular(const Eigen::Vector3d& v) {
-  const Eigen::Vector3d a = std::abs(v.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  return v.cross(a).normalized();
-}
-
-// The lowest point of a box along the unit vector `up` [m].
-double lowest_along(const Aabb& box, const Eigen::Vector3d& up) {
-  double lowest = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < 8; ++i) {
-    const Eigen::Vector3d corner(i & 1 ? box.max.x() : box.min.x(), i & 2 ? box.max.y() : box.min.y(),
-                                 i & 4 ? box.max.z() : box.min.z());
-    lowest = std::min(lowest, up.dot(corner));
-  }
-  return lowest;
-}
-
-// What every pass of one frame reads: the scene's bounding sphere, the cameras, light and ground.
-struct Frame {
-  Aabb content;               // what is drawn [m, world]
-  Eigen::Vector3d origin;     // the sphere's centre; GPU positions are relative to it [m, world]
-  double radius = 0.0;        // everything drawn lies within it [m]
-  CameraState camera;         // the image's
-  Eigen::Vector3d up, light;  // unit, world; `light` points towards the key light
-  double ground_level = 0.0;  // the ground plane along `up`, relative to origin [m]
-  int shadow_size = 0;        // shadow-map texels per side; 0 without shadows
-  CameraState light_camera;   // with shadows: orthographic along the light, holding the sphere
-};
-
-// The key light's shadow map: an orthographic view along the light holding the bounding sphere.
-void plan_shadow(const RenderSettings& s, int max_texture, Frame& f) {
-  f.shadow_size =
-      std::min(s.shadow_map_size > 0 ? s.shadow_map_size : std::clamp(std::max(s.width, s.height), 512, 4096),
-               max_texture);
-  Camera lc;
-  lc.target = f.origin;
-  lc.eye = f.origin + f.light * (2.0 * f.radius);
-  lc.up = any_perpendicular(f.light);
-  lc.ortho = true;
-  lc.ortho_height = 2.02 * f.radius;
-  f.light_camera = camera_state(lc, f.shadow_size, f.shadow_size, f.origin, f.radius);
-}
-
-// ts::InputError for a bad camera, up vector or colour map, or nothing to draw.
-void check_settings(const RenderSettings& s, const Aabb& content) {
-  validate(s.camera);
-  if (!(s.up.norm() > 0.0) || !s.up.allFinite())
-    throw InputError("the up vector must be finite and non-zero");
-  if (!content.valid()) throw InputError("nothing to render: no SDF and no particles");
-  if (s.surface_scalar.value && !(s.surface_scalar.max_value > 0.0)) {
-    throw InputError("the colour map's top value must be positive");
-  }
-}
-
 }  // namespace
-
-Eigen::Vector3d default_light(const Camera& camera, const Eigen::Vector3d& up) {
-  const Eigen::Vector3d u = up.normalized();
-  Eigen::Vector3d back = -camera.forward();
-  back -= back.dot(u) * u;
-  if (back.norm() < 1e-6) {  // looking straight down or up: the image's down is "towards the camera"
-    back = -camera.image_up();
-    back -= back.dot(u) * u;
-  }
-  if (back.norm() < 1e-6) back = any_perpendicular(u);
-  back.normalize();
-  const Eigen::Vector3d right = u.cross(back).normalized();
-  return (0.85 * u + 0.5 * back - 0.45 * right).normalized();
-}
 
 struct Renderer::Impl {
   explicit Impl(gpu::Context& c, bool timings)
@@ -178,7 +84,6 @@ struct Renderer::Impl {
     }
   }
 
-  Frame plan_frame(const RenderSettings& s, const Aabb& content, int max_texture) const;
   void ensure_targets(int w, int h);
   void ensure_shadow_map(int size);
   void upload_particles(const Eigen::Vector3d& new_origin);
@@ -232,26 +137,6 @@ struct Renderer::Impl {
   gpu::Texture albedo, normal, depth, particle_depth, final_color, shadow_depth;
   gpu::Framebuffer gbuffer, final_target, shadow_target;
 };
-
-Frame Renderer::Impl::plan_frame(const RenderSettings& s, const Aabb& content, int max_texture) const {
-  Frame f;
-  f.content = content;
-  // Everything drawn lies in this sphere; positions go to the GPU relative to its centre.
-  Aabb all = content;
-  if (has_volume) {
-    all.extend(volume_box.min);
-    all.extend(volume_box.max);
-  }
-  f.origin = all.center();
-  f.radius = std::max(0.5 * all.size().norm(), 1e-12);
-  f.camera = camera_state(s.camera, s.width, s.height, f.origin, f.radius);
-  f.up = s.up.normalized();
-  f.light = s.light ? s.light->normalized() : default_light(s.camera, f.up);
-  if (!f.light.allFinite()) throw InputError("the light direction must be finite and non-zero");
-  f.ground_level = s.ground_level.value_or(lowest_along(content, f.up)) - f.up.dot(f.origin);
-  if (s.shadows) plan_shadow(s, max_texture, f);
-  return f;
-}
 
 void Renderer::Impl::ensure_targets(int w, int h) {
   if (w == width && h == height) return;
@@ -414,21 +299,18 @@ void Renderer::Impl::bind_lighting_params(const RenderSettings& s, const Frame& 
   gpu::params::ShadeParams& p = shade_block.values;
   if (s.shadows) {
     p.light_view_projection = matrix(f.light_camera.view_projection);
-    const double texel = 2.02 * f.radius / shadow_size;
-    // Light depth is linear over the near-far range (about 2 radius): one texel of slack.
-    p.shadow = {static_cast<float>(texel), static_cast<float>(texel / (2.0 * f.radius)), 1.0f / shadow_size,
+    p.shadow = {static_cast<float>(f.shadow_texel), static_cast<float>(f.shadow_bias), 1.0f / shadow_size,
                 1.0f / shadow_size};
   }
   p.flags = {s.shadows ? 1 : 0, has_volume ? 1 : 0, s.ground ? 1 : 0, s.alpha ? 1 : 0};
   p.light_dir = xyz(f.light);
   p.world_up = xyz(f.up);
-  const Eigen::Vector3d center = f.content.center() - f.origin;
-  p.ground = xyz(Eigen::Vector3d(center - (f.up.dot(center) - f.ground_level) * f.up));
+  p.ground = xyz(f.ground_center);
   p.ground.w = static_cast<float>(f.ground_level);
-  p.ground_color = xyz(Eigen::Vector3f(0.88f, 0.88f, 0.87f));
-  p.ground_color.w = static_cast<float>(2.5 * 0.5 * f.content.size().norm());
-  p.background_top = xyz(Eigen::Vector3f(0.97f, 0.97f, 0.98f));
-  p.background_bottom = xyz(Eigen::Vector3f(0.80f, 0.82f, 0.86f));
+  p.ground_color = xyz(kGroundColor);
+  p.ground_color.w = static_cast<float>(f.ground_fade);
+  p.background_top = xyz(kBackgroundTop);
+  p.background_bottom = xyz(kBackgroundBottom);
   shade_block.bind(TS_PREVIEW_PARAMS);
 }
 
@@ -517,24 +399,12 @@ int Renderer::field_chunks() const { return impl_->has_volume ? impl_->field.chu
 void Renderer::set_particles(const Particles& particles) {
   Impl& m = *impl_;
   const std::size_t n = particles.centers.size();
-  if (n && particles.radii.size() != 1 && particles.radii.size() != n) {
-    throw InputError("particles: give one radius, or one per particle");
-  }
-  if (!particles.colors.empty() && particles.colors.size() != n) throw InputError("particles: one colour per particle");
   const long long max_bytes = m.context.limits().max_ssbo_bytes;
   if (max_bytes > 0 && static_cast<long long>(n * sizeof(Eigen::Vector4f)) > max_bytes) {
     throw InputError(fmt::format("{} particles exceed this GPU's largest storage buffer ({} particles)", n,
                                  max_bytes / static_cast<long long>(sizeof(Eigen::Vector4f))));
   }
-  Aabb box;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double r = particles.radii[particles.radii.size() == 1 ? 0 : i];
-    if (!particles.centers[i].allFinite() || !(r > 0.0) || !std::isfinite(r)) {
-      throw InputError(fmt::format("particle {} has a non-finite position or a radius that is not positive", i));
-    }
-    box.extend(particles.centers[i] - Eigen::Vector3d::Constant(r));
-    box.extend(particles.centers[i] + Eigen::Vector3d::Constant(r));
-  }
+  const Aabb box = particle_box(particles);
   m.particles = particles;
   m.particle_box = box;
   m.particles_dirty = true;
@@ -575,8 +445,8 @@ RenderResult Renderer::render(const RenderSettings& s) {
   Impl& m = *impl_;
   check_image_size(s.width, s.height);
   const Aabb content = content_box();
-  check_settings(s, content);
-  const Frame frame = m.plan_frame(s, content, max_image_size().maxCoeff());
+  const Frame frame = plan_frame(s, content, m.has_volume ? std::optional<Aabb>(m.volume_box) : std::nullopt,
+                                 max_image_size().maxCoeff());
   m.upload_particles(frame.origin);
   m.ensure_targets(s.width, s.height);
 
@@ -595,5 +465,7 @@ RenderResult Renderer::render(const RenderSettings& s) {
 }
 
 std::string Renderer::timing_report() { return impl_->queue.timing_report(); }
+
+std::string Renderer::device() const { return impl_->context.summary(); }
 
 }  // namespace ts::preview

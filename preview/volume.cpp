@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "sdf/exact_sdf.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_convert.h"
 
@@ -33,6 +34,7 @@ SdfVolume make_volume(const openvdb::FloatGrid& grid, const sdf::GridSpec& spec,
   v.spec = spec;
   v.band = band;
   v.grid = sdf::to_nanovdb(grid);
+  v.level_set = grid.copy();  // shares the tree
   v.band_voxels = grid.activeVoxelCount();
   v.surface = surface_box(grid, spec, v.world_box());
   return v;
@@ -89,6 +91,14 @@ SdfVolume volume_from_mesh(gpu::Context& context, const TriangleMesh& mesh, cons
   scan.index_space_grid = true;  // read by index on the GPU: any voxel size
   const sdf::ScanConvertResult result = sdf::scan_convert(context, mesh, sdf::compute_pseudonormals(mesh), spec, scan);
   return make_volume(*result.grid, spec, settings.band);
+}
+
+SdfVolume volume_from_mesh_on_cpu(const TriangleMesh& mesh, const sdf::SdfSettings& settings) {
+  const sdf::GridSpec spec = sdf::make_grid(bounding_box(mesh), settings);
+  const sdf::ExactDistance exact(mesh);
+  const openvdb::FloatGrid::Ptr grid =
+      sdf::exact_sdf_grid(exact, mesh, spec, settings.band, sdf::SignMethod::Pseudonormal, true);
+  return make_volume(*grid, spec, settings.band);
 }
 
 }  // namespace ts::preview

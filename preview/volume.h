@@ -18,7 +18,10 @@ namespace ts::preview {
 struct SdfVolume {
   sdf::GridSpec spec;   // the box of the band; voxel (i, j, k) at NanoVDB index spec.index_offset + (i, j, k)
   double band = 3.0;    // half-width of the narrow band [voxels]; |distance| saturates there
-  sdf::NanoGrid grid;   // signed distance [m] in the band, +-band * voxel off it
+  sdf::NanoGrid grid;   // signed distance [m] in the band, +-band * voxel off it (the GL renderer's)
+  // The same level set as OpenVDB holds it, shared, not copied (the CPU renderer's): index (i, j, k) of
+  // the grid at spec.index_offset + (i, j, k), values in world units; its transform is not used.
+  openvdb::FloatGrid::ConstPtr level_set;
   Aabb surface;         // the voxels at or inside the zero level, grown by half a voxel [m]
   std::size_t band_voxels = 0;  // active voxels of the level set
 
@@ -33,5 +36,8 @@ SdfVolume volume_from_level_set(const openvdb::FloatGrid& grid, const std::files
 
 // Scan-converts a mesh on the GPU (sdf::scan_convert into an index-space level set) on make_grid(settings).
 SdfVolume volume_from_mesh(gpu::Context& context, const TriangleMesh& mesh, const sdf::SdfSettings& settings);
+// The same grid without a GL context: the exact SDF on every core (sdf::exact_sdf_grid, pseudonormal
+// signs, as the scan conversion's), for the CPU renderer.
+SdfVolume volume_from_mesh_on_cpu(const TriangleMesh& mesh, const sdf::SdfSettings& settings);
 
 }  // namespace ts::preview

@@ -6,6 +6,7 @@
 // the scene that catches the shadows. Colours are sRGB in and out, lit in linear light.
 #include "preview/bindings.h"
 #include "preview/camera.glsl"
+#include "preview/look.h"
 #include "preview/volume.glsl"
 
 layout(binding = TS_PREVIEW_UNIT_ALBEDO) uniform sampler2D albedo_texture;
@@ -18,13 +19,13 @@ layout(std140, binding = TS_PREVIEW_PARAMS) uniform ShadeBlock { ShadeParams par
 
 out vec4 color;
 
-vec3 to_linear(vec3 c) { return pow(c, vec3(2.2)); }
-vec3 to_srgb(vec3 c) { return pow(clamp(c, 0.0, 1.0), vec3(1.0 / 2.2)); }
+vec3 to_linear(vec3 c) { return pow(c, vec3(TS_PREVIEW_GAMMA)); }
+vec3 to_srgb(vec3 c) { return pow(clamp(c, 0.0, 1.0), vec3(1.0 / TS_PREVIEW_GAMMA)); }
 
 // 1 lit .. 0 in shadow. The point is pushed along its normal by two texels against acne.
 float light_visibility(vec3 p, vec3 n) {
   if (params.flags.x == 0) return 1.0;
-  vec4 c = params.light_view_projection * vec4(p + n * (2.0 * params.shadow.x), 1.0);
+  vec4 c = params.light_view_projection * vec4(p + n * (TS_PREVIEW_SHADOW_OFFSET_TEXELS * params.shadow.x), 1.0);
   vec3 s = 0.5 * c.xyz / c.w + 0.5;
   if (any(lessThan(s.xy, vec2(0.0))) || any(greaterThan(s.xy, vec2(1.0)))) return 1.0;
   float ref = min(s.z, 1.0) - params.shadow.y;
@@ -45,17 +46,17 @@ float surface_occlusion(vec3 p, vec3 n) {
     occlusion += weight * clamp((delta - sdf_at(u + n * delta)) / delta, 0.0, 1.0);
     weight *= 0.5;
   }
-  return clamp(1.0 - 1.6 * occlusion, 0.0, 1.0);
+  return clamp(1.0 - TS_PREVIEW_OCCLUSION_GAIN * occlusion, 0.0, 1.0);
 }
 
 vec3 lit(vec3 base, vec3 p, vec3 n, vec3 view, float specular, float occlusion) {
   float visibility = light_visibility(p, n);
   float diffuse = max(dot(n, params.light_dir.xyz), 0.0);
   vec3 h = normalize(params.light_dir.xyz + view);
-  float spec = diffuse > 0.0 ? specular * pow(max(dot(n, h), 0.0), 48.0) : 0.0;
-  float ambient = mix(0.07, 0.26, 0.5 + 0.5 * dot(n, params.world_up.xyz));
-  float fill = 0.10 * max(dot(n, view), 0.0);  // a weak light from the camera keeps shadows readable
-  return base * ((ambient + fill) * occlusion + 0.8 * diffuse * visibility) + vec3(spec * visibility);
+  float spec = diffuse > 0.0 ? specular * pow(max(dot(n, h), 0.0), TS_PREVIEW_SPECULAR_POWER) : 0.0;
+  float ambient = mix(TS_PREVIEW_AMBIENT_DOWN, TS_PREVIEW_AMBIENT_UP, 0.5 + 0.5 * dot(n, params.world_up.xyz));
+  float fill = TS_PREVIEW_CAMERA_FILL * max(dot(n, view), 0.0);  // a weak light from the camera keeps shadows readable
+  return base * ((ambient + fill) * occlusion + TS_PREVIEW_DIFFUSE * diffuse * visibility) + vec3(spec * visibility);
 }
 
 void main() {
@@ -71,7 +72,8 @@ void main() {
     vec3 n = normalize(nl.xyz);
     vec3 base = to_linear(texelFetch(albedo_texture, pixel, 0).rgb);
     bool surface = layer == TS_PREVIEW_LAYER_SURFACE;
-    vec3 c = lit(base, p, n, -ray, surface ? 0.25 : 0.35, surface ? surface_occlusion(p, n) : 1.0);
+    float specular = surface ? TS_PREVIEW_SPECULAR_SURFACE : TS_PREVIEW_SPECULAR_PARTICLE;
+    vec3 c = lit(base, p, n, -ray, specular, surface ? surface_occlusion(p, n) : 1.0);
     color = vec4(to_srgb(c), 1.0);
     return;
   }
@@ -84,15 +86,16 @@ void main() {
   float t = (params.ground.w - dot(params.world_up.xyz, near_point)) / along;
   if (t <= 0.0) return;
   vec3 g = near_point + t * ray;
-  float fade = 1.0 - smoothstep(0.3 * params.ground_color.w, params.ground_color.w, length(g - params.ground.xyz));
+  float fade_radius = params.ground_color.w;
+  float fade = 1.0 - smoothstep(TS_PREVIEW_GROUND_FADE_START * fade_radius, fade_radius, length(g - params.ground.xyz));
   if (fade <= 0.0) return;
   float visibility = light_visibility(g, params.world_up.xyz);
   if (params.flags.w == 1) {
-    color = vec4(0.0, 0.0, 0.0, 0.55 * fade * (1.0 - visibility));
+    color = vec4(0.0, 0.0, 0.0, TS_PREVIEW_GROUND_SHADOW_ALPHA * fade * (1.0 - visibility));
   } else {
     vec3 base = to_linear(params.ground_color.xyz);
     float diffuse = max(dot(params.world_up.xyz, params.light_dir.xyz), 0.0);
-    vec3 c = base * (0.32 + 0.75 * diffuse * visibility);
+    vec3 c = base * (TS_PREVIEW_GROUND_AMBIENT + TS_PREVIEW_GROUND_DIFFUSE * diffuse * visibility);
     color = vec4(mix(sky, to_srgb(c), fade), 1.0);
   }
 }

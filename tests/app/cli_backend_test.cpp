@@ -1,6 +1,6 @@
 // `--backend`: which engine `sim`, `sdf`, `sample` and `preview` run, chosen by the one rule of gpu/backend.h
 // (issues 16 and 42: "the fastest path where there is no GPU"): on a software GL device auto takes the CPU
-// path (the preview, with no CPU path yet, the GPU) and every command says so in the same one line;
+// path and every command says so in the same one line;
 // `--backend gpu` forces the GPU, `--cpu` stays an alias of `sim --backend cpu`, and bad combinations are
 // usage errors (exit 2).
 #include <gtest/gtest.h>
@@ -437,7 +437,7 @@ TEST(CliSampleBackend, BackendCpuRelaxesOnTheCpuWithNoRoundTrip) {
 }
 
 // --backend cpu opens no GL context: a device that does not exist stops auto and --backend gpu (exit 3), not
-// it; --preview still needs one.
+// it, --preview included (drawn on the CPU).
 TEST(CliSampleBackend, BackendCpuRunsWithoutAGlContext) {
   std::string out;
   ASSERT_EQ(run_sample("--device 99 ", "--backend cpu", &out), 0) << out;
@@ -450,7 +450,7 @@ TEST(CliSampleBackend, BackendCpuRunsWithoutAGlContext) {
       std::string::npos)
       << out;
   EXPECT_NE(out.find("certificate      certified"), std::string::npos) << out;
-  for (const std::string flags : {"--backend auto", "--backend gpu", "--backend cpu --preview"}) {
+  for (const std::string flags : {"--backend auto", "--backend gpu"}) {
     EXPECT_EQ(run_sample("--device 99 ", flags, &out), 3) << flags << "\n" << out;
     EXPECT_NE(out.find("device 99 does not exist"), std::string::npos) << flags << "\n" << out;
   }
@@ -464,9 +464,9 @@ TEST(CliSampleBackend, BadBackendIsAUsageError) {
   EXPECT_EQ(out.find("certificate"), std::string::npos) << out;  // refused before any work
 }
 
-// The preview has no CPU renderer yet: auto takes the GPU on a software device too and names why; --backend
-// cpu is a usage error that says so, before any work.
-TEST(PreviewBackend, AutoTakesTheGpuForWantOfACpuPathAndCpuIsAUsageError) {
+// The preview: auto draws on the CPU on a software device and names why; --backend cpu needs no GL
+// context (a device that does not exist does not stop it); --backend gpu draws on the device.
+TEST(PreviewBackend, AutoDrawsOnTheCpuOnASoftwareDeviceAndCpuNeedsNoContext) {
   const auto device = software_device();
   if (!device) GTEST_SKIP() << "EGL lists no software device";
   const auto dir = test::temp_dir();
@@ -474,16 +474,17 @@ TEST(PreviewBackend, AutoTakesTheGpuForWantOfACpuPathAndCpuIsAUsageError) {
       "preview " + quoted(test::asset("cube.obj")) + " --size 64x48 --resolution 24 -o ";
   std::string out;
   ASSERT_EQ(test::run_tetrasand(*device + preview + quoted(dir / "auto.png"), &out), 0) << out;
-  EXPECT_NE(
-      out.find(
-          "backend: gpu (auto: there is no CPU path yet; the GL device is llvmpipe, a software renderer)\n"),
-      std::string::npos)
+  EXPECT_NE(out.find("backend: cpu, renderer (auto: the GL device is llvmpipe, a software renderer; --backend "
+                     "gpu forces the GPU)\n"),
+            std::string::npos)
       << out;
   EXPECT_TRUE(std::filesystem::exists(dir / "auto.png"));
-  EXPECT_EQ(test::run_tetrasand(*device + preview + quoted(dir / "cpu.png") + " --backend cpu", &out), 2)
+  ASSERT_EQ(test::run_tetrasand("--device 99 " + preview + quoted(dir / "cpu.png") + " --backend cpu", &out), 0)
       << out;
-  EXPECT_NE(out.find("--backend cpu: the preview has only a GPU path for now"), std::string::npos) << out;
-  EXPECT_FALSE(std::filesystem::exists(dir / "cpu.png"));
+  EXPECT_NE(out.find("backend: cpu, renderer (asked for)\n"), std::string::npos) << out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "cpu.png"));
+  ASSERT_EQ(test::run_tetrasand(*device + preview + quoted(dir / "gpu.png") + " --backend gpu", &out), 0) << out;
+  EXPECT_NE(out.find("backend: gpu, renderer (asked for)\n"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -135,7 +135,12 @@ TEST(CliPreview, BadInputsExitWithClearMessages) {
                         Case{q(dir / "thin.vdb") + png, 1, "narrower than the 1 voxel the ray cast reads; rebuild it with a wider band (tetrasand sdf --band 3"},
                         Case{q(dir / "missing.vdb") + png, 1, "no such file"},
                         Case{sphere + png + " --size 0x0", 1, "at least 1 pixel"},
-                        Case{sphere + png + " --size 100000x100000", 1, "exceeds this GPU's largest render target"},
+                        Case{sphere + png + " --size 100000x100000 --backend gpu", 1,
+                             "exceeds this GPU's largest render target"},
+                        Case{sphere + png + " --size 100000x100000 --backend cpu", 1,
+                             "exceeds the CPU renderer's largest image"},
+                        Case{q(dir / "thin.vdb") + png + " --backend cpu", 1, "narrower than the 1 voxel the ray cast reads"},
+                        Case{q(dir / "empty.vdb") + png + " --backend cpu", 1, "is empty"},
                         Case{sphere + png + " --size big", 1, "expected WIDTHxHEIGHT"},
                         Case{q(dir / "fog.vdb") + png + " --color-by error", 1, "needs a MESH input"},
                         Case{sphere + png + " --color-by particle-distance", 1, "needs --particles"},
@@ -170,6 +175,21 @@ TEST(CliPreview, SampleWritesAPreviewBesideTheBody) {
             0)
       << out;
   EXPECT_NE(out.find("(body.json)"), std::string::npos) << out;
+}
+
+// sample --backend cpu --preview draws on the CPU and needs no GL context: a device that does not exist
+// does not stop it.
+TEST(CliPreview, SampleUnderBackendCpuDrawsItsPreviewWithoutAGlContext) {
+  const auto dir = test::temp_dir();
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("--device 99 sample " + q(test::asset("sphere.obj")) + " -o " + q(dir) +
+                                    " --count 150 --probes 5000 --backend cpu --preview",
+                                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("backend: cpu, relaxation, certificate and preview (asked for"), std::string::npos) << out;
+  ASSERT_TRUE(std::filesystem::exists(dir / "sphere.preview.png")) << out;
+  EXPECT_EQ(preview::read_png(dir / "sphere.preview.png").width, 800);
 }
 
 // A smaller drawing radius shows the surface between the impostors; the colours stay in radii of the
