@@ -2,8 +2,8 @@
 // The one rule for where a stage runs, CPU or GPU, shared by every command (sdf, sample, preview, sim), and
 // the one-line report each prints of its choice. Auto: the CPU on a software renderer (Mesa llvmpipe runs the
 // GL kernels on the same cores as the CPU twins, plus a fixed cost per dispatch, so the twins are faster
-// there: docs/architecture.md, "Which engine runs") or without a GL context; the GPU on a hardware device. A
-// stage with no CPU path yet (the preview's renderer) takes the GPU under auto and its line says why.
+// there: docs/architecture.md, "Which engine runs") or without a GL context; the GPU on a hardware device.
+// Every stage has both paths (the preview's CPU renderer since issue 45: preview/cpu_renderer.h).
 #include <optional>
 #include <string>
 #include <string_view>
