@@ -1,7 +1,8 @@
 #pragma once
 // The contact stage of the CPU reference, in double precision: particle positions from the body
-// poses, a hashed grid, and for each dynamic particle the forces of its touching partners (other
-// bodies' particles, then walls) gathered in a fixed order, TBB-parallel and deterministic. It is
+// poses, contact candidate lists with a skin rebuilt only when stale (sim/cpu_lists.h), and for each
+// dynamic particle, visited in cell order, the forces of its touching partners (other bodies'
+// particles by increasing id, then walls in declaration order), TBB-parallel and deterministic. It is
 // apart from the stepper (sim/cpu_stepper.h) because both engines need it: sim::CpuStepper gathers
 // its forces here, and the GPU pipeline takes from it what only the reference computes (contact
 // dumps, the spring energy of a state it is given).
@@ -9,29 +10,15 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "sim/contact_model.h"
+#include "sim/cpu_lists.h"
 #include "sim/stepper.h"
 #include "sim/world.h"
 
 namespace ts::sim {
-
-// The hashed uniform grid: cell = largest particle diameter; a table of next_pow2(max(2 N, 4)) buckets
-// filled by counting sort in particle order, so a bucket lists its particles by increasing id.
-struct NeighbourGrid {
-  double cell_size = 0;                        // m
-  std::uint32_t table_size = 0;                // power of two
-  std::vector<Eigen::Vector3i> cell;           // per particle
-  std::vector<std::uint32_t> bucket_start;     // table_size + 1 entries
-  std::vector<std::uint32_t> sorted;           // particle ids grouped by bucket
-};
-void build_neighbour_grid(const std::vector<Eigen::Vector3d>& positions, double cell_size, NeighbourGrid& grid);
-// x + P1 y + P2 z modulo the table (Teschner et al. 2003 with the x factor set to 1): cells next to
-// each other along x get consecutive buckets, so a particle's 27 neighbour cells are 9 contiguous
-// scans and neighbouring particles read neighbouring memory. (The GPU grid of
-// shaders/common/hash_grid.glsl keeps Teschner's XOR hash; the two grids need not agree.)
-std::uint32_t hash_cell(const Eigen::Vector3i& cell, std::uint32_t table_size);
 
 // What one gather of a state produces, per particle in world order.
 struct GatheredForces {
@@ -58,19 +45,38 @@ class CpuContacts {
   // J: the Hertz energy stored in every contact of `world` (each once), as gather() counts it.
   double elastic_energy(const World& world);
 
-  // Of the state last gathered or listed: particle world positions (m) and the grid.
+  // The next step rebuilds the lists (a new world loaded, a state restored).
+  void invalidate_lists() { lists_.invalidate(); }
+
+  // Of the state last gathered or listed: particle world positions (m) and the lists.
   const std::vector<Eigen::Vector3d>& positions() const { return position_; }
-  const NeighbourGrid& grid() const { return grid_; }
+  const CpuContactLists& lists() const { return lists_; }
+
+  // For --timings: the skin, the list builds and what they cost, candidates and contacts per particle.
+  std::string report() const;
 
  private:
-  // What the neighbour search reads of each candidate, in the grid's bucket order: one cache line
-  // per candidate instead of four scattered loads (the search is most of a step's time).
-  struct Candidate {
-    Eigen::Vector3d position;  // m
-    double radius = 0;         // m
-    double inverse_mass = 0;   // 1/kg, of its body
-    Eigen::Vector3i cell;
-    std::uint32_t body = 0, particle = 0;
+  // What a step reads of a particle, in cell order: one and a half cache lines per candidate.
+  struct ParticleState {
+    Eigen::Vector3d position;          // m
+    Eigen::Vector3d velocity;          // m/s
+    Eigen::Vector3d angular_velocity;  // rad/s, of its body
+    double radius = 0;                 // m
+    double inverse_mass = 0;           // 1/kg, of its body
+    std::uint32_t material = 0;
+  };
+  // Everything one particle's gather produces.
+  struct ParticleContacts {
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();   // N
+    Eigen::Vector3d torque = Eigen::Vector3d::Zero();  // N m, about the particle centre
+    std::uint32_t pairs = 0, walls = 0, overlap_clamps = 0;
+    std::uint32_t touching = 0;  // particle partners touching, counted here or not
+    double max_overlap_ratio = 0;
+    double elastic_energy = 0;  // J
+    // The first smooth wall (in visiting order) the particle has passed through; -1: none.
+    std::int64_t passed_wall = -1;
+
+    void add(const ContactForce<double>& c, double smaller_radius, bool count);
   };
   // Particle i's spring slots: the old ones it reads and, when stepping, the new ones it writes.
   struct SpringSlots {
@@ -81,17 +87,22 @@ class CpuContacts {
     std::size_t used = 0, overflows = 0;
   };
 
+  // Particle positions and velocities from the poses, the lists rebuilt if stale, the step's state
+  // in cell order.
   void prepare_particles(const World& world);
-  // Calls fn(force, partner, smaller radius) for each touching partner of particle i, in a fixed order.
+  // Calls fn(force, partner, smaller radius) for each touching partner of the particle at `slot` of
+  // the cell order: other particles by increasing id, then walls.
   // With springs (TangentialModel::Spring) each touching contact takes its spring from `springs`'
   // old slots and, when its new slots are given, writes it back there, advanced.
   template <typename Fn>
-  void visit_contacts(const World& world, std::uint32_t i, Fn&& fn, SpringSlots* springs = nullptr) const;
+  void visit_contacts(const World& world, std::uint32_t slot, Fn&& fn, SpringSlots* springs = nullptr) const;
   class SpringLookup;
   template <typename Fn>
-  void visit_neighbours(const World& world, std::uint32_t i, Fn& fn, SpringLookup& lookup) const;
+  void visit_neighbours(std::uint32_t slot, Fn& fn, SpringLookup& lookup) const;
   template <typename Fn>
-  void visit_walls(const World& world, std::uint32_t i, Fn& fn, SpringLookup& lookup) const;
+  void visit_walls(const World& world, std::uint32_t slot, Fn& fn, SpringLookup& lookup) const;
+  // Sums the per-particle results into `out_forces` and `stats`, in world order.
+  void reduce(GatheredForces& out_forces, StepStats& stats);
   double overlap_ratio_cap() const;  // settings' max_overlap_ratio, or no cap
   // Slots of particle i for reading the springs of `world` (none without the spring model).
   SpringSlots read_only_slots(const World& world, std::uint32_t i) const;
@@ -99,9 +110,16 @@ class CpuContacts {
   StepSettings settings_;
   std::size_t material_count_ = 0;
   std::vector<ContactCoefficients<double>> pairs_;  // material_count^2, row-major
-  NeighbourGrid grid_;
-  std::vector<Candidate> candidates_;
-  std::vector<Eigen::Vector3d> position_, velocity_;  // per particle, reused between steps
+  CpuContactLists lists_;
+  // Reused from step to step, so a step allocates nothing once the sizes are reached.
+  std::vector<Eigen::Vector3d> position_, velocity_;  // world order
+  std::vector<ParticleState> state_;                  // cell order
+  std::vector<ParticleContacts> particle_contacts_;   // world order
+  std::vector<std::size_t> overflows_;                // world order
+  // For report(): steps gathered, touching particle partners summed over them (both sides of a
+  // pair), and seconds spent building lists and gathering in all.
+  std::size_t gathers_ = 0, touching_ = 0;
+  double build_seconds_ = 0, gather_seconds_ = 0;
 };
 
 }  // namespace ts::sim

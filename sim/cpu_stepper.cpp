@@ -20,6 +20,7 @@ CpuStepper::CpuStepper(const World& world, const StepSettings& settings) : CpuSt
 void CpuStepper::load(const World& world) {
   // As a new stepper would: the pair table rebuilt, the energy reference taken again.
   contacts_.set_materials(world, true);
+  contacts_.invalidate_lists();
   reset_energy_reference(world);
 }
 
@@ -51,8 +52,9 @@ StepStats CpuStepper::advance(World& world, std::int64_t steps) {
   return last;
 }
 
-// The energy check's reference is all the stepper keeps between steps (forces and the grid are
-// recomputed every step).
+// The energy check's reference is all the stepper keeps between steps that a resume needs. The
+// contact lists are derived: each particle's forces are summed by increasing partner id whatever the
+// build the lists come from, so a resumed run rebuilds them at its first step and steps on bit for bit.
 std::string CpuStepper::save_state() const {
   ByteWriter w;
   w.put<std::uint64_t>(material_count_);
@@ -67,6 +69,7 @@ void CpuStepper::restore_state(const World& world, std::string_view state) {
   for (double* v : {&energy_reference_, &energy_scale_, &dynamic_mass_, &max_diameter_}) r.get(*v);
   reference_pending_ = r.get<std::uint8_t>() != 0;
   if (!r.done()) r.fail("bytes left over");
+  contacts_.invalidate_lists();
 }
 
 std::vector<ContactRecord> CpuStepper::contacts(const World& world) {
@@ -92,12 +95,14 @@ Eigen::Matrix3d world_inverse_inertia(const Eigen::Quaterniond& q, const Eigen::
 
 }  // namespace
 
-void CpuStepper::integrate(World& world, StepStats& stats) const {
+void CpuStepper::integrate(World& world, StepStats& stats) {
   Bodies& b = world.bodies;
   const double dt = settings_.dt;
-  const double max_speed = settings_.cfl > 0 ? settings_.cfl * contacts_.grid().cell_size / dt : 1e300;  // m/s
+  // The CFL cell is the largest particle diameter (the lists' grid cell adds the skin).
+  const double cell = contacts_.lists().largest_diameter();                      // m
+  const double max_speed = settings_.cfl > 0 ? settings_.cfl * cell / dt : 1e300;  // m/s
   const auto count = static_cast<std::uint32_t>(b.size());
-  std::vector<std::uint8_t> clamped(count, 0);  // bit 0: linear, bit 1: angular
+  clamped_.assign(count, 0);  // bit 0: linear, bit 1: angular
 
   tbb::parallel_for(std::uint32_t{0}, count, [&](std::uint32_t k) {
     if (b.motion[k] == MotionType::Static) return;
@@ -130,11 +135,11 @@ void CpuStepper::integrate(World& world, StepStats& stats) const {
     const double reach = b.bounding_radius[k];
     if (v.norm() > max_speed) {
       v *= max_speed / v.norm();
-      clamped[k] |= 1;
+      clamped_[k] |= 1;
     }
     if (w.norm() * reach > max_speed) {
       w *= max_speed / (w.norm() * reach);
-      clamped[k] |= 2;
+      clamped_[k] |= 2;
     }
     if (settings_.angular_damping_rate > 0 && v.norm() + w.norm() * reach < settings_.angular_damping_speed) {
       w *= std::max(0.0, 1.0 - settings_.angular_damping_rate * dt);
@@ -142,7 +147,7 @@ void CpuStepper::integrate(World& world, StepStats& stats) const {
     b.linear_velocity[k] = v;
     b.angular_velocity[k] = w;
   });
-  for (std::uint8_t c : clamped) {
+  for (std::uint8_t c : clamped_) {
     stats.velocity_clamps += c & 1;
     stats.angular_velocity_clamps += (c >> 1) & 1;
   }

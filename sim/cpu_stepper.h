@@ -2,8 +2,10 @@
 // The CPU reference stepper: one time step of the DEM in double precision, TBB-parallel and
 // deterministic (every sum visits its terms in a fixed order, whatever the thread count). The GPU
 // pipeline follows the same stages on the same data layout:
-//   poses -> particle positions/velocities -> hashed grid (counting sort) -> per-particle contact
-//   force and torque (gather, other bodies only, then walls) -> per-body sums -> integration.
+//   poses -> particle positions/velocities -> contact candidate lists with a skin (rebuilt from a
+//   hashed grid only when some particle moved more than half the skin) -> per-particle contact force
+//   and torque (gather, in cell order: other bodies' particles by increasing id, then walls) ->
+//   per-body sums -> integration.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -40,15 +42,19 @@ class CpuStepper : public Stepper {
   // restarts from the next step's state. Also rebuilds the pair table if materials were added.
   void reset_energy_reference(const World& world);
 
-  const NeighbourGrid& grid() const { return contacts_.grid(); }
+  // The skin, list builds, candidates and contacts per particle, and the time they took.
+  std::string timing_report() override { return contacts_.report(); }
+
+  const CpuContactLists& lists() const { return contacts_.lists(); }
 
  private:
-  void integrate(World& world, StepStats& stats) const;
+  void integrate(World& world, StepStats& stats);
   void check_stability(const World& world, double mechanical_energy, const StepStats& stats) const;
 
   StepSettings settings_;
   CpuContacts contacts_;
   GatheredForces forces_;           // of the current step; its springs are swapped into the world
+  std::vector<std::uint8_t> clamped_;  // per body, of the current step (reused: a step allocates nothing)
   std::size_t material_count_ = 0;  // of the world the energy reference belongs to
   double energy_reference_ = 0;     // J: kinetic + potential + spring energy when the reference was taken
   double energy_scale_ = 0;         // J
