@@ -7,6 +7,7 @@
 #include <atomic>
 #include <map>
 #include <mutex>
+#include <stdexcept>
 #include <utility>
 
 #include "core/error.h"
@@ -303,11 +304,39 @@ double Queue::host_seconds(const std::string& name) const {
   return 0.0;
 }
 
+void Queue::begin_indirect(const Buffer* args) {
+  if (indirect_) throw std::logic_error("Queue::begin_indirect: an indirect section is already open");
+  indirect_ = true;
+  indirect_args_ = args;
+  indirect_plan_.clear();
+  if (args) glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, args->id());
+}
+
+std::vector<std::array<std::uint32_t, 4>> Queue::end_indirect() {
+  if (!indirect_) throw std::logic_error("Queue::end_indirect without begin_indirect");
+  if (indirect_args_ && indirect_args_->bytes() < indirect_plan_.size() * 16) {
+    throw std::logic_error("Queue::end_indirect: more dispatches than the argument buffer has rows");
+  }
+  indirect_ = false;
+  indirect_args_ = nullptr;
+  return std::move(indirect_plan_);
+}
+
 void Queue::dispatch(const Program& program, std::uint32_t gx, std::uint32_t gy, std::uint32_t gz, GLbitfield barrier) {
   if (gx == 0 || gy == 0 || gz == 0) return;
+  if (indirect_) {
+    const std::size_t row = indirect_plan_.size();
+    indirect_plan_.push_back({gx, gy, gz, 0u});
+    if (!indirect_args_) return;  // a dry run
+    if (indirect_args_->bytes() < (row + 1) * 16) return;  // end_indirect reports it
+  }
   begin(program.name());
   program.use();
-  glDispatchCompute(gx, gy, gz);
+  if (indirect_) {
+    glDispatchComputeIndirect(static_cast<GLintptr>(16 * (indirect_plan_.size() - 1)));
+  } else {
+    glDispatchCompute(gx, gy, gz);
+  }
   if (barrier) glMemoryBarrier(barrier);
   end(program.name());
   if (check_errors_) check("kernel " + program.name());

@@ -131,6 +131,14 @@ class Queue {
   void dispatch_items(const Program& program, std::size_t items, GLbitfield barrier = GL_SHADER_STORAGE_BARRIER_BIT);
   // The (x, y) grid dispatch_groups uses for `groups` when at most `max_x` fit along x.
   static std::pair<std::uint32_t, std::uint32_t> group_grid(std::size_t groups, std::size_t max_x);
+  // GPU-decided work: the dispatches issued between begin_indirect and end_indirect take their group
+  // counts from `args` (one 16-byte row per dispatch, in issue order: x, y, z, unused) through
+  // glDispatchComputeIndirect, so a kernel run before them decides, with no host read, whether they
+  // run: it copies each row of the plan in, or writes zeros. With args = nullptr nothing is issued
+  // and the dispatches are only recorded (a dry run that makes the plan). end_indirect returns the
+  // group counts each dispatch would have had directly: the plan.
+  void begin_indirect(const Buffer* args);
+  std::vector<std::array<std::uint32_t, 4>> end_indirect();
   // Times arbitrary GL work (draw calls, copies) under `name`.
   // The host's wall time in each name's sections is kept whether or not timings are on.
   template <typename F>
@@ -173,6 +181,9 @@ class Queue {
   std::vector<Pending> pending_;
   std::vector<GLuint> spare_queries_;
   std::vector<KernelTiming> totals_;
+  bool indirect_ = false;
+  const Buffer* indirect_args_ = nullptr;                 // null: a dry run (record only)
+  std::vector<std::array<std::uint32_t, 4>> indirect_plan_;  // the rows of this indirect section so far
   std::vector<std::pair<std::string, double>> host_seconds_;  // per timed() name, in first-use order
   GLint max_groups_[2] = {0, 0};  // GL_MAX_COMPUTE_WORK_GROUP_COUNT along x and y, 0 until first needed
 };

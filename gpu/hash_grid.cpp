@@ -41,11 +41,16 @@ void PrefixScan::run(Queue& queue, Buffer& values, std::uint32_t count) {
 BucketSort::BucketSort(const ShaderLibrary& library)
     : scatter_(Program::compute(library, "common/grid_scatter.comp")),
       sort_buckets_(Program::compute(library, "common/grid_sort_cells.comp")),
+      copy_(Program::compute(library, "common/copy_uints.comp")),
       scan_(library) {}
 
 void BucketSort::finish(Queue& queue, const Buffer& keys, const Buffer& counts, const Buffer& slots, Buffer& starts,
                         Buffer& sorted, std::uint32_t count, std::uint32_t table_size) {
-  glCopyNamedBufferSubData(counts.id(), starts.id(), 0, 0, static_cast<GLsizeiptr>(table_size * sizeof(std::uint32_t)));
+  counts.bind(TS_COPY_SOURCE);
+  starts.bind(TS_COPY_DESTINATION);
+  copy_params_.values.count.x = table_size;
+  copy_params_.bind(TS_FILL_PARAMS);
+  queue.dispatch_items(copy_, table_size);
   scan_.run(queue, starts, table_size);
   keys.bind(TS_SORT_KEY);
   counts.bind(TS_SORT_BUCKET_COUNT);
@@ -59,7 +64,9 @@ void BucketSort::finish(Queue& queue, const Buffer& keys, const Buffer& counts, 
 }
 
 HashGrid::HashGrid(const ShaderLibrary& library)
-    : count_(Program::compute(library, "common/grid_count.comp")), sort_(library) {}
+    : count_(Program::compute(library, "common/grid_count.comp")),
+      zero_(Program::compute(library, "common/zero_uints.comp")),
+      sort_(library) {}
 
 void HashGrid::reserve(std::uint32_t count) {
   if (count <= capacity_ && table_size_ != 0) return;
@@ -76,7 +83,10 @@ void HashGrid::reserve(std::uint32_t count) {
 void HashGrid::build(Queue& queue, const Buffer& positions, std::uint32_t count, float cell_size) {
   reserve(count);
   cell_size_ = cell_size;
-  cell_count_.fill_zero();
+  cell_count_.bind(TS_FILL_VALUES);
+  zero_params_.values.count.x = table_size_;
+  zero_params_.bind(TS_FILL_PARAMS);
+  queue.dispatch_items(zero_, table_size_);
   positions.bind(TS_GRID_POSITIONS);
   cell_of_.bind(TS_SORT_KEY);
   cell_count_.bind(TS_SORT_BUCKET_COUNT);

@@ -38,15 +38,18 @@ class BucketSort {
               Buffer& sorted, std::uint32_t count, std::uint32_t table_size);
 
  private:
-  Program scatter_, sort_buckets_;
+  Program scatter_, sort_buckets_, copy_;
   ParamBlock<params::GridParams> params_;  // ids and buckets (scatter and in-bucket sort alike)
+  ParamBlock<params::ItemCount> copy_params_;
   PrefixScan scan_;
 };
 
 class HashGrid {
  public:
   explicit HashGrid(const ShaderLibrary& library);
-  // positions: vec4 per particle (xyz used), bound to TS_GRID_POSITIONS during the build.
+  // positions: vec4 per particle (xyz used), bound to TS_GRID_POSITIONS during the build. Every
+  // step of the build is a kernel (the clear and the copy too), so the whole build can be GPU-decided
+  // work (Queue::begin_indirect).
   void build(Queue& queue, const Buffer& positions, std::uint32_t count, float cell_size);
   // Rebinds the grid to TS_GRID_CELL_COUNT, TS_GRID_CELL_START and TS_GRID_SORTED for a neighbour kernel.
   void bind() const;
@@ -56,8 +59,9 @@ class HashGrid {
 
  private:
   void reserve(std::uint32_t count);
-  Program count_;
+  Program count_, zero_;
   ParamBlock<params::GridParams> params_;
+  ParamBlock<params::ItemCount> zero_params_;
   BucketSort sort_;
   Buffer cell_of_, slot_, cell_count_, cell_start_, sorted_;
   std::uint32_t capacity_ = 0, table_size_ = 0;

@@ -83,6 +83,8 @@ GpuStepper::GpuStepper(gpu::Context& context, const StepSettings& settings, Prec
       gather_rows_(gpu::Program::compute(library_, "sim/gather_rows.comp")),
       bucket_sort_(library_),
       resort_scan_(library_),
+      list_decide_(gpu::Program::compute(library_, "sim/list_decide.comp")),
+      list_build_(gpu::Program::compute(library_, "sim/list_build.comp", precision_defines(precision))),
       syncs_at_start_(gpu::host_sync_counts()) {}
 
 template <typename T>
@@ -208,7 +210,10 @@ void GpuStepper::upload(const World& world) {
   allocate_resort(body_count_, particle_count_);
   upload_materials_and_walls(world);
   allocate_statistics();
+  allocate_lists(world);  // before set_params: the contact kernel's grid cell and capacity
   set_params();
+  // Bodies in cell order from the first step (the gathers' locality), not only after resort_every.
+  if (settings_.resort_every > 0) resort();
 }
 
 void GpuStepper::upload_bodies(const World& world) {
@@ -287,7 +292,8 @@ namespace {
 // or SimContactParams64, whose step length is a double.
 template <typename Params>
 void fill_contact_params(Params& p, const StepSettings& s, std::uint32_t particles, std::uint32_t planes,
-                         std::uint32_t cylinders, std::uint32_t materials, double cell_size) {
+                         std::uint32_t cylinders, std::uint32_t materials, double cell_size,
+                         std::uint32_t capacity) {
   p.sizes = {particles, p.sizes.y, planes, cylinders};
   p.materials = {materials, 0u, 0u, 0u};
   p.models = {s.normal_damping == NormalDamping::Tsuji ? 0 : 1, s.tangential == TangentialModel::Spring ? 1 : 0,
@@ -295,6 +301,7 @@ void fill_contact_params(Params& p, const StepSettings& s, std::uint32_t particl
   p.limits = {static_cast<float>(cell_size),
               static_cast<float>(s.max_overlap_ratio > 0 ? s.max_overlap_ratio : 1e30), 0.0f, 0.0f};
   p.step.x = static_cast<decltype(p.step.x)>(s.dt);
+  p.lists = {capacity, 0u, 0u, 0u};
 }
 
 // The integration kernel's parameters but the step's end time (set each step); Params:
@@ -317,9 +324,9 @@ void GpuStepper::set_params() {
   const double max_speed = settings_.cfl > 0 ? settings_.cfl * cell_size_ / settings_.dt : 1e30;
   update_params_.values.count.x = particle_count_;
   fill_contact_params(contact_params_.values, settings_, particle_count_, plane_count_, cylinder_count_,
-                      material_count_, cell_size_);
+                      material_count_, list_cell_, list_capacity_);
   fill_contact_params(contact_params64_.values, settings_, particle_count_, plane_count_, cylinder_count_,
-                      material_count_, cell_size_);
+                      material_count_, list_cell_, list_capacity_);
   fill_integrate_params(integrate_params_.values, settings_, body_count_, gravity_, max_speed);
   fill_integrate_params(integrate_params64_.values, settings_, body_count_, gravity_, max_speed);
   metrics_params_.values.sizes.x = body_count_;
@@ -379,14 +386,20 @@ void GpuStepper::step(int steps) {
     return;
   }
   for (int s = 0; s < steps; ++s) {
+    // The re-sort stays on a host schedule rather than following the GPU's list rebuilds: its
+    // gathers swap freshly allocated buffers in on the host, so it cannot be an indirect dispatch as
+    // it stands; every 100 steps it costs a few bytes a grain-step (docs/architecture.md).
     if (settings_.resort_every > 0 && steps_since_resort_ >= settings_.resort_every) resort();
     ++steps_since_resort_;
     bind_state();
+    build_position_.bind(TS_SIM_BUILD_POSITION);
+    list_state_.bind(TS_SIM_LIST_STATE);
     update_params_.bind(TS_SIM_PARAMS);
     queue_.dispatch_items(update_, particle_count_);
-    grid_.build(queue_, particle_position_, particle_count_, static_cast<float>(cell_size_));
+    update_lists();
     bind_state();
     grid_.bind();
+    list_.bind(TS_SIM_LIST);
     bind_contact_params(grid_.table_size());
     queue_.dispatch_items(contacts_, particle_count_);
     bind_integrate_params(time_ + settings_.dt);
@@ -424,6 +437,8 @@ StepStats GpuStepper::statistics() {
   stats.angular_velocity_clamps = counters[1];
   stats.spring_overflows = counters[2];
   stats.penetration = penetration(counters);
+  list_builds_ += counters[TS_SIM_COUNTER_LIST_BUILDS];
+  list_overflows_ += counters[TS_SIM_COUNTER_LIST_OVERFLOWS];
   counters_.fill_zero();
   if (bad > 0.0 || !std::isfinite(stats.energy.total())) {
     throw Error(ExitCode::Unstable, fmt::format("simulation unstable at t = {:.6g} s: {} bodies have a non-finite "
@@ -631,6 +646,7 @@ void GpuStepper::resort() {
   resort_fixup_params_.values = {{particle_count_, 0u, 0u, 0u}, {springs ? 1 : 0, 0, 0, 0}};
   resort_fixup_params_.bind(TS_SIM_PARAMS);
   queue_.dispatch_items(resort_fixup_, particle_count_);
+  force_list_rebuild();  // the lists name particles by their old index
 }
 
 std::size_t GpuStepper::gpu_bytes() const {
@@ -638,7 +654,8 @@ std::size_t GpuStepper::gpu_bytes() const {
   for (const gpu::Buffer* b : {&particle_position_, &particle_position_exact_, &particle_velocity_, &particle_info_,
                                &particle_local_, &body_position_, &body_orientation_, &body_velocity_, &body_omega_,
                                &body_inverse_inertia_, &body_range_, &body_momentum_, &particle_wrench_,
-                               &springs_, &keyframes_, &pairs_, &planes_, &cylinders_, &particle_stats_buffer_})
+                               &springs_, &keyframes_, &pairs_, &planes_, &cylinders_, &particle_stats_buffer_,
+                               &list_, &build_position_})
     total += b->bytes();
   return total;
 }
@@ -661,7 +678,8 @@ std::vector<gpu::HostSyncPhase> GpuStepper::round_trips() const {
 
 std::string GpuStepper::timing_report() {
   std::string kernels = queue_.timing_report();  // first: its read of the timers is in the total
-  return kernels + gpu::host_sync_report(round_trips());
+  std::string lists = list_report();
+  return kernels + lists + gpu::host_sync_report(round_trips());
 }
 
 std::string GpuStepper::save_state() const {
@@ -700,6 +718,9 @@ void GpuStepper::restore_state(const World& world, std::string_view state) {
     if (!bytes.empty()) b->upload(bytes.data(), bytes.size());
   }
   if (!r.done()) r.fail("bytes left over");
+  // The lists are not saved: rebuilt from the restored positions they hold the same candidates in
+  // the same ascending order, so the forces, summed over the touching ones, are the same bits.
+  force_list_rebuild();
 }
 
 std::vector<ContactRecord> GpuStepper::contacts(const World& world) { return CpuContacts(settings_).contacts(world); }

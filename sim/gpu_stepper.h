@@ -1,8 +1,9 @@
 #pragma once
 // The GPU pipeline of the DEM, stage for stage the same as CpuStepper (sim/cpu_stepper.h) on the same
-// World: poses -> particle positions and velocities -> hashed grid (counting sort) -> contact forces
-// gathered per particle (no float atomics) -> per-body sums and integration. Steps run with no CPU
-// round trip; statistics and state are read back only when asked. What only the CPU reference
+// World: poses -> particle positions and velocities -> (when the contact candidate lists are stale,
+// decided on the GPU) hashed grid (counting sort) and lists -> contact forces gathered per particle
+// over its list (no float atomics) -> per-body sums and integration. Steps run with no CPU round
+// trip; statistics and state are read back only when asked. What only the CPU reference
 // computes (contact dumps, the spring energy of a loaded state) comes from sim/cpu_contacts.h.
 #include <array>
 #include <cstdint>
@@ -61,7 +62,17 @@ class GpuStepper : public Stepper {
   std::vector<Eigen::Vector3d> particle_forces() const;
   double time() const { return time_; }
   std::size_t gpu_bytes() const;
-  // The world index of each body in GPU memory order (identity until the first re-sort).
+  // The contact candidate lists (sim/contact_lists.h): skin [m], grid cell [m], capacity K per
+  // particle, and the builds and overflows (particles that had more than K candidates, summed over
+  // builds) counted on the GPU and read by statistics().
+  struct ListStats {
+    double skin = 0.0, cell = 0.0;
+    std::uint32_t capacity = 0;
+    std::uint64_t builds = 0, overflows = 0;
+  };
+  ListStats list_stats() const { return {skin_, list_cell_, list_capacity_, list_builds_, list_overflows_}; }
+  // The world index of each body in GPU memory order (bodies are re-sorted at load and then every
+  // StepSettings::resort_every steps).
   std::vector<std::uint32_t> body_order() const { return original_ids(original_body_, body_count_); }
   // Host-GPU round trips by phase (gpu/host_sync.h): inside step() (none, by design), inside
   // advance()'s read-backs after the steps, and all this thread's since this stepper was made
@@ -88,8 +99,17 @@ class GpuStepper : public Stepper {
   std::size_t counter_count() const;  // uints of counters_
   Penetration penetration(const std::vector<std::uint32_t>& counters) const;
   void allocate_resort(std::uint32_t body_count, std::uint32_t particle_count);
-  // Re-sorts bodies (and their particles, springs renamed) by the cell of their centre.
+  // Re-sorts bodies (and their particles, springs renamed) by the cell of their centre; forces a
+  // list rebuild.
   void resort();
+  // Contact candidate lists (sim/gpu_lists.cpp): sizes and the rebuild's dispatch plan, from the
+  // radii of `world`; the rebuild passes (the grid and the list build); each step's decision and the
+  // passes it enables; a rebuild at the next step whatever the displacement.
+  void allocate_lists(const World& world);
+  void list_build_passes();
+  void update_lists();
+  void force_list_rebuild();
+  std::string list_report();
   // buffer = its rows reordered: row r takes old row index[r]; rows of `width` 16-byte words.
   void gather(gpu::Buffer& buffer, const gpu::Buffer& index, std::uint32_t rows, std::uint32_t width);
   // World index of each GPU body and particle (identity until the first re-sort).
@@ -134,6 +154,14 @@ class GpuStepper : public Stepper {
   gpu::Buffer sort_key_, sort_slot_, bucket_count_, bucket_start_, order_, new_first_, new_range_;
   gpu::Buffer source_particle_, new_of_old_, owner_, original_body_, original_particle_;
   std::uint32_t bucket_table_ = 0;
+  // Contact candidate lists (TS_SIM_LIST*).
+  gpu::Program list_decide_, list_build_;
+  gpu::ParamBlock<gpu::params::SimListParams> list_params_;
+  gpu::Buffer list_, build_position_, list_state_, list_plan_, list_args_;
+  std::vector<std::array<std::uint32_t, 4>> list_plan_rows_;  // what list_plan_ holds
+  double skin_ = 0.0, list_cell_ = 0.0;                       // m
+  std::uint32_t list_capacity_ = 0;
+  std::uint64_t list_builds_ = 0, list_overflows_ = 0;
   std::int64_t steps_since_resort_ = 0;
   std::uint32_t particle_count_ = 0, body_count_ = 0, plane_count_ = 0, cylinder_count_ = 0, material_count_ = 0;
   double cell_size_ = 0.0;  // m: the largest particle diameter, as the CPU reference

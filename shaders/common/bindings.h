@@ -6,6 +6,8 @@
 //   pass (kernel)               slots
 //   common/scan_blocks.comp     TS_SCAN_VALUES, TS_SCAN_BLOCK_SUMS
 //   common/scan_add.comp        TS_SCAN_VALUES, TS_SCAN_BLOCK_SUMS (the scanned sums, added back)
+//   common/zero_uints.comp      TS_FILL_VALUES
+//   common/copy_uints.comp      TS_COPY_SOURCE, TS_COPY_DESTINATION
 //   common/grid_count.comp      TS_GRID_POSITIONS, TS_SORT_KEY, TS_SORT_BUCKET_COUNT, TS_SORT_SLOT
 //   common/grid_scatter.comp    TS_SORT_KEY, TS_SORT_SLOT, TS_SORT_BUCKET_START, TS_SORT_SORTED
 //   common/grid_sort_cells.comp TS_SORT_BUCKET_COUNT, TS_SORT_BUCKET_START, TS_SORT_SORTED
@@ -19,6 +21,13 @@
 // so kernels of different passes share a number.
 #define TS_SCAN_PARAMS 0  // ItemCount: values in this level (common/scan_*.comp)
 #define TS_GRID_PARAMS 0  // GridParams (common/grid_*.comp)
+#define TS_FILL_PARAMS 0  // ItemCount: values cleared or copied (common/zero_uints.comp, copy_uints.comp)
+
+// Clears and copies of uint buffers as kernels (gpu::HashGrid, gpu::BucketSort), so they can be
+// GPU-decided work like the passes around them.
+#define TS_FILL_VALUES 0       // uint[]: zeroed
+#define TS_COPY_SOURCE 0       // uint[]
+#define TS_COPY_DESTINATION 1  // uint[]
 
 // Exclusive prefix sum (gpu::PrefixScan), one level at a time.
 #define TS_SCAN_VALUES 0      // uint[]: the level scanned in place

@@ -25,7 +25,8 @@ struct alignas(16) mat4 { vec4 column[4]; };  // column-major, as GLSL's mat4 in
 #define TS_PARAMS(name) struct name
 #endif
 
-// ---- Kernels whose one parameter is how many items they cover (common/scan_*.comp, sampler/project.comp,
+// ---- Kernels whose one parameter is how many items they cover (common/scan_*.comp,
+// common/zero_uints.comp, common/copy_uints.comp, sampler/project.comp,
 // sampler/reduce_steps.comp, sampler/certify_scatter.comp, sim/update_particles.comp,
 // sim/reduce_particle_stats.comp, sim/resort_ranges.comp, sim/resort_particles.comp).
 TS_PARAMS(ItemCount) {
@@ -129,15 +130,26 @@ TS_PARAMS(SimContactParams) {
   ivec4 models;           // x: damping model (0 Tsuji, 1 thesis), y: 1 tangential springs (static
                           // friction), 0 viscous eq. 3.28, z: 1 counts dynamic particles that passed
                           // through a wall (StepSettings::check_penetration); w unused
-  vec4 limits;            // x: cell size [m], y: overlap clamp ratio (thesis 3.3.1): delta <= ratio * min radius
+  vec4 limits;            // x: cell size of the hashed grid [m] (largest diameter + skin), y: overlap
+                          // clamp ratio (thesis 3.3.1): delta <= ratio * min radius
   vec4 step;              // x: dt [s], advances the springs; yzw unused
+  uvec4 lists;            // x: candidate list capacity K per particle (TS_SIM_LIST); yzw unused
 };
 TS_PARAMS(SimContactParams64) {
   uvec4 sizes;
   uvec4 materials;
   ivec4 models;
   vec4 limits;
+  uvec4 lists;            // before step, which std140 puts at the next 32-byte offset (96) either way
   dvec4 step;
+};
+
+// ---- sim/list_decide.comp and sim/list_build.comp: the contact candidate lists (sim/contact_lists.h).
+TS_PARAMS(SimListParams) {
+  uvec4 sizes;            // x: particles, y: hash table size, z: list capacity K per particle, w: rows of
+                          // the rebuild's indirect dispatch plan (TS_SIM_LIST_PLAN)
+  vec4 lengths;           // x: cell size of the hashed grid [m] (largest diameter + skin), y: skin [m],
+                          // z: the list's cut-off beyond ri + rj [m] (the skin and a rounding margin); w unused
 };
 
 // ---- sim/integrate_bodies.comp (SimIntegrateParams64 with TS_FP64).

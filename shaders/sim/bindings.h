@@ -9,11 +9,14 @@
 //
 //   pass (kernel)                 slots
 //   sim/update_particles.comp     PARTICLE_POSITION, _VELOCITY, _INFO, _LOCAL, _POSITION_EXACT (fp64),
-//                                 BODY_POSITION, _ORIENTATION, _VELOCITY, _OMEGA
-//   common/grid_* (the grid)      TS_GRID_POSITIONS = PARTICLE_POSITION, TS_SORT_* (1-5)
+//                                 BODY_POSITION, _ORIENTATION, _VELOCITY, _OMEGA, BUILD_POSITION, LIST_STATE
+//   sim/list_decide.comp          LIST_STATE, LIST_PLAN, LIST_ARGS, COUNTERS
+//   common/grid_* (the grid)      TS_GRID_POSITIONS = PARTICLE_POSITION, TS_SORT_* (1-5), TS_FILL_*, TS_COPY_*
+//   sim/list_build.comp           PARTICLE_POSITION, _INFO, BODY_POSITION, LIST, BUILD_POSITION, COUNTERS,
+//                                 TS_GRID_CELL_START, TS_GRID_SORTED
 //   sim/contact_forces.comp       PARTICLE_POSITION, _VELOCITY, _INFO, _WRENCH, _STATS, _POSITION_EXACT
 //                                 (fp64), BODY_POSITION, _OMEGA, PAIRS, PLANES, CYLINDERS, COUNTERS,
-//                                 SPRINGS, TS_GRID_CELL_START, TS_GRID_SORTED
+//                                 SPRINGS, LIST, TS_GRID_CELL_START, TS_GRID_SORTED
 //   sim/integrate_bodies.comp     BODY_POSITION, _ORIENTATION, _VELOCITY, _OMEGA, _INV_INERTIA, _RANGE,
 //                                 _MOMENTUM, PARTICLE_WRENCH, COUNTERS, KEYFRAMES
 //   sim/reduce_metrics.comp       BODY_POSITION, _VELOCITY, _OMEGA, _MOMENTUM, METRIC_PARTIALS
@@ -64,8 +67,21 @@
 #define TS_SIM_KEYFRAMES 26          // 2 real4 per key of a kinematic track (sim::Keyframe): xyz centre of mass [m], w time [s]; quaternion (x, y, z, w)
 
 // Entries of TS_SIM_COUNTERS after the three clamp and overflow counts.
-#define TS_SIM_COUNTER_PENETRATIONS 3  // particle-steps of a dynamic particle wholly behind a smooth wall
-#define TS_SIM_COUNTER_WALL_SLOTS 4    // the first per-wall slot
+#define TS_SIM_COUNTER_PENETRATIONS 3     // particle-steps of a dynamic particle wholly behind a smooth wall
+#define TS_SIM_COUNTER_LIST_BUILDS 4      // contact list builds (list_decide.comp)
+#define TS_SIM_COUNTER_LIST_OVERFLOWS 5   // particles found with more than K candidates, summed over builds
+#define TS_SIM_COUNTER_WALL_SLOTS 6       // the first per-wall slot
+
+// ---- Contact candidate lists (sim/contact_lists.h; GpuStepper::rebuild_lists). LIST and
+// BUILD_POSITION share slots with the statistics' partials, which only their own passes bind; the
+// decision's buffers reuse low slots that the grid passes after it bind for themselves.
+#define TS_SIM_LIST 24               // uint[(K + 1) N], column-major: [i] count, [(k + 1) N + i] candidate k (list_build.comp)
+#define TS_SIM_BUILD_POSITION 25     // vec4 per particle: TS_SIM_PARTICLE_POSITION at the last list build
+#define TS_SIM_LIST_STATE 1          // uint[2]: TS_SIM_LIST_MAX_DISPLACEMENT, TS_SIM_LIST_FORCED
+#define TS_SIM_LIST_PLAN 2           // uvec4 per rebuild dispatch: its work groups x, y, z (gpu::Queue::end_indirect)
+#define TS_SIM_LIST_ARGS 3           // uvec4 per rebuild dispatch: the plan's row or zeros (read by glDispatchComputeIndirect)
+#define TS_SIM_LIST_MAX_DISPLACEMENT 0  // float bits: the largest distance a particle moved since the last build [m]
+#define TS_SIM_LIST_FORCED 1            // 1: rebuild at the next step whatever the displacement
 
 // ---- Re-sort by Morton key (GpuStepper::resort): the keys go through gpu::BucketSort (TS_SORT_*).
 #define TS_SIM_RESORT_ORDER TS_SORT_SORTED  // uint per new body: its old index (the sort's output)

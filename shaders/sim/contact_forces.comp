@@ -1,15 +1,16 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Step 3: contact forces gathered per particle over the 27 surrounding cells in a fixed order (cells
-// in a fixed sweep, ids sorted within cells), so there are no float atomics and results are bitwise
-// reproducible. Only particles of different bodies touch; walls are implicit (no particle storage).
+// Step 3: contact forces gathered per particle over its contact candidate list (list_build.comp), in
+// ascending GPU index whenever the list was built, so there are no float atomics and results are
+// bitwise reproducible, also across a rebuild at another step. A particle whose candidates overflowed
+// the list walks the grid of the same build instead, in the same order (sim/candidates.glsl). Only
+// particles of different bodies touch; walls are implicit (no particle storage).
 // With the spring tangential model each dynamic particle keeps its contacts' springs in its own
 // history slots (read at the start, rewritten in gather order), matched by partner id, as
 // CpuStepper::visit_contacts does. At most 16 storage blocks (the per-stage minimum of GL 4.3).
 #include "common/dispatch.glsl"
 #include "common/bindings.h"
 #include "sim/bindings.h"
-#include "common/hash_grid.glsl"
 #include "common/layouts.h"
 #include "sim/contact.glsl"
 #include "sim/rigid.glsl"
@@ -27,6 +28,7 @@ layout(std430, binding = TS_SIM_PLANES) readonly buffer Planes { SimPlane planes
 layout(std430, binding = TS_SIM_CYLINDERS) readonly buffer Cylinders { SimCylinder cylinders[]; };
 layout(std430, binding = TS_SIM_PARTICLE_STATS) writeonly buffer S { vec4 particle_stats[]; };
 layout(std430, binding = TS_SIM_COUNTERS) buffer C { uint counters[]; };
+layout(std430, binding = TS_SIM_LIST) readonly buffer L { uint list[]; };
 #ifdef TS_FP64
 layout(std430, binding = TS_SIM_PARTICLE_POSITION_EXACT) readonly buffer PX { dvec4 particle_position_exact[]; };
 #define POSITION(k) particle_position_exact[k]
@@ -36,6 +38,7 @@ layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots64 sprin
 layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots springs[]; };
 #endif
 
+#include "sim/candidates.glsl"
 #include "common/params.h"
 #ifdef TS_FP64
 layout(std140, binding = TS_SIM_PARAMS) uniform ContactBlock { SimContactParams64 params; };
@@ -98,22 +101,27 @@ void main() {
   bool with_springs = params.models.y != 0 && inv_mass_i > 0.0;
   if (with_springs) load_springs(i);
 
-  ivec3 c = cell_of_position(particle_position[i].xyz, params.limits.x);
   float pair_contacts = 0.0, walls = 0.0, clamps = 0.0, worst_overlap = 0.0;
   real overlap_cap = real(params.limits.y);
-  // The 27 cells in a fixed sweep, like CpuStepper::compute_forces: a bucket shared with another
-  // cell is visited once per cell, keeping only that cell's particles.
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        ivec3 cell = c + ivec3(dx, dy, dz);
-        uint h = hash_cell(cell, params.sizes.y);
-        // A bucket ends where the next begins (the last one at the particle count).
-        uint begin = cell_start[h], end = h + 1u < params.sizes.y ? cell_start[h + 1u] : params.sizes.x;
-        for (uint k = begin; k < end; ++k) {
-          uint j = sorted_ids[k];
+  // The list's candidates (rows 1..n, column-major), or past capacity the grid walk from the cell the
+  // build stored in rows 1-3: both in ascending index, one fixed order whenever the list was built.
+  uint particles = params.sizes.x, listed = list[i];
+  bool from_list = listed <= params.lists.x;
+  if (!from_list) {
+    ivec3 cell = ivec3(int(list[particles + i]), int(list[2u * particles + i]), int(list[3u * particles + i]));
+    begin_walk(cell, params.sizes.y, particles);
+  }
+  for (uint k = 0u;; ++k) {
+          uint j;
+          if (from_list) {
+            if (k >= listed) break;
+            j = list[(k + 1u) * particles + i];
+          } else {
+            j = next_candidate();
+            if (j == TS_SIM_WALK_DONE) break;
+          }
           uint body_j = particle_info[j].x;
-          if (body_j == body_i || cell_of_position(particle_position[j].xyz, params.limits.x) != cell) continue;
+          if (body_j == body_i) continue;  // the grid walk's own body (lists hold other bodies only)
           real inv_mass_j = body_position[body_j].w;
           if (inv_mass_i == 0.0 && inv_mass_j == 0.0) continue;  // neither body can move
           real4 xj4 = POSITION(j);
@@ -136,8 +144,7 @@ void main() {
             worst_overlap = max(worst_overlap, float(delta / smaller));
             clamps += raw > delta ? 1.0 : 0.0;
           }
-        }
-      }
+  }
 
   if (inv_mass_i > 0.0) {
     // Smooth walls in declaration order: planes, then cylinders (as the CPU reference).

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <array>
 #include <fstream>
 #include <numeric>
 #include <vector>
@@ -81,6 +82,43 @@ TEST(GpuQueue, DispatchComputesSaxpyAndReadsBack) {
   EXPECT_EQ(timings[0].calls, 2u);
   EXPECT_GE(timings[0].milliseconds, 0.0);
   EXPECT_NE(queue.timing_report().find("test/saxpy.comp"), std::string::npos);
+}
+
+// An indirect section: a dry run issues nothing and returns the group counts of its dispatches (the
+// plan); with arguments of zeros the dispatches run no work, with the plan copied in they run as
+// direct dispatches would.
+TEST(GpuQueue, IndirectSectionRunsWhatItsArgumentsSayAndNothingOnZeros) {
+  Context context;
+  ShaderLibrary library;
+  Program saxpy = Program::compute(library, "test/saxpy.comp");
+  const unsigned n = 1000;
+  std::vector<float> x(n), y(n, 1.0f);
+  std::iota(x.begin(), x.end(), 0.0f);
+  Buffer bx = Buffer::from<float>(x), by = Buffer::from<float>(y);
+  bx.bind(TS_TEST_SAXPY_X);
+  by.bind(TS_TEST_SAXPY_Y);
+  ParamBlock<params::SaxpyParams> params;
+  params.values = {{n, 0u, 0u, 0u}, {2.0f, 0.0f, 0.0f, 0.0f}};
+  params.bind(TS_TEST_PARAMS);
+  Queue queue(/*timings=*/false, /*check_errors=*/true);
+  auto section = [&](const Buffer* args) {
+    queue.begin_indirect(args);
+    queue.dispatch_items(saxpy, n);
+    return queue.end_indirect();
+  };
+  const auto plan = section(nullptr);
+  const auto local = static_cast<std::uint32_t>(saxpy.local_size()[0]);
+  ASSERT_EQ(plan.size(), 1u);
+  EXPECT_EQ(plan[0], (std::array<std::uint32_t, 4>{(n + local - 1) / local, 1u, 1u, 0u}));
+  EXPECT_EQ(by.read<float>(n), y);  // the dry run ran nothing
+  Buffer args(16);
+  args.fill_zero();
+  EXPECT_EQ(section(&args), plan);
+  EXPECT_EQ(by.read<float>(n), y);  // zero groups: no work
+  args.upload(plan.data(), 16);
+  section(&args);
+  const auto result = by.read<float>(n);
+  for (unsigned i = 0; i < n; ++i) ASSERT_FLOAT_EQ(result[i], 1.0f + 2.0f * static_cast<float>(i)) << i;
 }
 
 // A ParamBlock rewritten between two dispatches: the first reads what it was issued with, the second

@@ -64,7 +64,7 @@ BlockSpec contact() {
           sizeof(Contact),
           {TS_MEMBER(params, Contact, sizes), TS_MEMBER(params, Contact, materials),
            TS_MEMBER(params, Contact, models), TS_MEMBER(params, Contact, limits),
-           TS_MEMBER(params, Contact, step)}};
+           TS_MEMBER(params, Contact, step), TS_MEMBER(params, Contact, lists)}};
 }
 template <typename Integrate>
 BlockSpec integrate() {
@@ -143,6 +143,8 @@ class GpuParams : public ::testing::Test {
 TEST_F(GpuParams, CommonKernelsMatchCpp) {
   check(compute("common/scan_blocks.comp"), {item_count("ScanBlock")});
   check(compute("common/scan_add.comp"), {item_count("ScanBlock")});
+  check(compute("common/zero_uints.comp"), {item_count("FillBlock")});
+  check(compute("common/copy_uints.comp"), {item_count("FillBlock")});
   for (const char* kernel :
        {"common/grid_count.comp", "common/grid_scatter.comp", "common/grid_sort_cells.comp"}) {
     check(compute(kernel), {grid("GridBlock")});
@@ -209,6 +211,12 @@ TEST_F(GpuParams, SimKernelsMatchCppInBothPrecisions) {
   check(compute("sim/integrate_bodies.comp"), {integrate<SimIntegrateParams>()});
   check(compute("sim/integrate_bodies.comp", {"TS_FP64 1"}), {integrate<SimIntegrateParams64>()});
   check(compute("sim/update_particles.comp"), {item_count("UpdateBlock")});
+  const BlockSpec lists{"ListBlock",
+                        sizeof(SimListParams),
+                        {TS_MEMBER(params, SimListParams, sizes), TS_MEMBER(params, SimListParams, lengths)}};
+  check(compute("sim/list_decide.comp"), {lists});
+  check(compute("sim/list_build.comp"), {lists});
+  check(compute("sim/list_build.comp", {"TS_FP64 1"}), {lists});
   check(compute("sim/reduce_particle_stats.comp"), {item_count("StatsBlock")});
   check(compute("sim/resort_ranges.comp"), {item_count("RangesBlock")});
   check(compute("sim/resort_particles.comp"), {item_count("ParticlesBlock")});
