@@ -1,10 +1,12 @@
 // Cundall number (grain time steps per second) of the GPU pipeline and of the CPU reference on the
 // same scenes, in one run, as ratios, from 1k to 1M grains; memory per grain of both. Usage:
 //   tetrasand_bench_sim [--grains 1000,8000,64000,512000,1000000] [--seconds 2] [--min-steps 2]
-//                       [--precision float|double|float,double] [--csv FILE] [--timings]
+//                       [--precision float|double|full-double (a list)] [--csv FILE] [--timings]
 // The scene of every size is the settled bed of bench/bench_scenes.h (reference/bed_tile.toml copied
 // side by side), so each size sees the same contacts per grain. scripts/bench.sh sim plots the CSV.
 // With two precisions the CPU reference is measured once per size and each GPU precision gets a row.
+// double is the mixed-precision pipeline of `--precision double`; full-double keeps the contact kernel
+// in double too (sim::Precision::FullDouble), to time what the mixed pipeline saves.
 // The CSV is rewritten (atomically) after every size, so a run stopped at its time cap keeps its rows.
 #include <fmt/format.h>
 #include <unistd.h>
@@ -56,9 +58,11 @@ Options parse(int argc, char** argv) {
       o.precisions.clear();
       std::stringstream list(next());
       for (std::string p; std::getline(list, p, ',');) {
-        if (p != "float" && p != "double")
-          throw std::runtime_error("--precision: expected float or double, got " + p);
-        o.precisions.push_back(p == "double" ? ts::sim::Precision::Double : ts::sim::Precision::Float);
+        if (p != "float" && p != "double" && p != "full-double")
+          throw std::runtime_error("--precision: expected float, double or full-double, got " + p);
+        o.precisions.push_back(p == "double"        ? ts::sim::Precision::Double
+                               : p == "full-double" ? ts::sim::Precision::FullDouble
+                                                    : ts::sim::Precision::Float);
       }
     } else if (arg == "--csv") {
       o.csv = next();
@@ -146,7 +150,7 @@ Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Optio
 }
 
 const char* precision_name(ts::sim::Precision p) {
-  return p == ts::sim::Precision::Double ? "double" : "float";
+  return p == ts::sim::Precision::Double ? "double" : p == ts::sim::Precision::FullDouble ? "full-double" : "float";
 }
 
 // The printed line and the CSV row of one size and precision k.
