@@ -1,13 +1,16 @@
 // Cundall number (grain time steps per second) of the GPU pipeline and of the CPU reference on the
 // same scenes, in one run, as ratios, from 1k to 1M grains; memory per grain of both. Usage:
 //   tetrasand_bench_sim [--grains 1000,8000,64000,512000,1000000] [--seconds 2] [--min-steps 2]
-//                       [--cpu-min-steps N] [--precision float|double|float,double] [--csv FILE] [--timings]
+//                       [--cpu-min-steps N] [--precision float|double|full-double (a list)] [--csv FILE]
+//                       [--timings]
 // --cpu-min-steps: the CPU reference's own minimum (default --min-steps), so a device run can time 10 GPU
 // steps a size without spending its time cap on 10 CPU steps of 4M grains. --timings prints each engine's
 // timing_report() (per-kernel GPU times, the contact lists' skin, builds and candidates) on stderr.
 // The scene of every size is the settled bed of bench/bench_scenes.h (reference/bed_tile.toml copied
 // side by side), so each size sees the same contacts per grain. scripts/bench.sh sim plots the CSV.
 // With two precisions the CPU reference is measured once per size and each GPU precision gets a row.
+// double is the mixed-precision pipeline of `--precision double`; full-double keeps the contact kernel
+// in double too (sim::Precision::FullDouble), to time what the mixed pipeline saves.
 // The CSV is rewritten (atomically) after every size, so a run stopped at its time cap keeps its rows.
 #include <fmt/format.h>
 #include <unistd.h>
@@ -62,9 +65,11 @@ Options parse(int argc, char** argv) {
       o.precisions.clear();
       std::stringstream list(next());
       for (std::string p; std::getline(list, p, ',');) {
-        if (p != "float" && p != "double")
-          throw std::runtime_error("--precision: expected float or double, got " + p);
-        o.precisions.push_back(p == "double" ? ts::sim::Precision::Double : ts::sim::Precision::Float);
+        if (p != "float" && p != "double" && p != "full-double")
+          throw std::runtime_error("--precision: expected float, double or full-double, got " + p);
+        o.precisions.push_back(p == "double"        ? ts::sim::Precision::Double
+                               : p == "full-double" ? ts::sim::Precision::FullDouble
+                                                    : ts::sim::Precision::Float);
       }
     } else if (arg == "--csv") {
       o.csv = next();
@@ -154,7 +159,7 @@ Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Optio
 }
 
 const char* precision_name(ts::sim::Precision p) {
-  return p == ts::sim::Precision::Double ? "double" : "float";
+  return p == ts::sim::Precision::Double ? "double" : p == ts::sim::Precision::FullDouble ? "full-double" : "float";
 }
 
 // The printed line and the CSV row of one size and precision k.

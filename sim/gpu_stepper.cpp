@@ -25,7 +25,20 @@ using gpu::layout::SimSpringSlots64;
 static_assert(ContactSprings::kSlots == TS_SIM_SPRING_SLOTS, "CPU and GPU keep the same number of springs");
 
 std::vector<std::string> precision_defines(Precision precision) {
-  return precision == Precision::Double ? std::vector<std::string>{"TS_FP64 1"} : std::vector<std::string>{};
+  return precision != Precision::Float ? std::vector<std::string>{"TS_FP64 1"} : std::vector<std::string>{};
+}
+
+// The contact kernel's specialisation for these settings and a world with or without walls
+// (shaders/sim/contact_forces.comp, TS_CONTACT_*): switches the whole scene shares are compiled in, so
+// what is off (the spring history above all) costs the kernel no registers.
+std::vector<std::string> contact_defines(Precision precision, const StepSettings& s, bool walls) {
+  std::vector<std::string> defines = precision_defines(precision);
+  if (precision == Precision::FullDouble) defines.emplace_back("TS_CONTACT_FP64 1");
+  defines.push_back(fmt::format("TS_CONTACT_SPRINGS {}", s.tangential == TangentialModel::Spring ? 1 : 0));
+  defines.push_back(fmt::format("TS_CONTACT_DAMPING {}", s.normal_damping == NormalDamping::Tsuji ? 0 : 1));
+  defines.push_back(fmt::format("TS_CONTACT_WALLS {}", walls ? 1 : 0));
+  defines.push_back(fmt::format("TS_CONTACT_PENETRATION {}", s.check_penetration ? 1 : 0));
+  return defines;
 }
 
 void append(std::vector<double>& out, const Eigen::Vector3d& v, double w) {
@@ -71,7 +84,6 @@ GpuStepper::GpuStepper(gpu::Context& context, const StepSettings& settings, Prec
       precision_(precision),
       queue_(timings, context.debug()),
       update_(gpu::Program::compute(library_, "sim/update_particles.comp", precision_defines(precision))),
-      contacts_(gpu::Program::compute(library_, "sim/contact_forces.comp", precision_defines(precision))),
       integrate_(gpu::Program::compute(library_, "sim/integrate_bodies.comp", precision_defines(precision))),
       metrics_(gpu::Program::compute(library_, "sim/reduce_metrics.comp", precision_defines(precision))),
       particle_stats_(gpu::Program::compute(library_, "sim/reduce_particle_stats.comp")),
@@ -89,13 +101,13 @@ GpuStepper::GpuStepper(gpu::Context& context, const StepSettings& settings, Prec
 
 template <typename T>
 gpu::Buffer GpuStepper::real_buffer(const std::vector<T>& values) const {
-  if (precision_ == Precision::Double) return gpu::Buffer::from<double>(std::vector<double>(values.begin(), values.end()));
+  if (fp64()) return gpu::Buffer::from<double>(std::vector<double>(values.begin(), values.end()));
   const std::vector<float> narrow(values.begin(), values.end());
   return gpu::Buffer::from<float>(narrow);
 }
 
 std::vector<double> GpuStepper::read_real(const gpu::Buffer& buffer, std::size_t count) const {
-  if (precision_ == Precision::Double) return buffer.read<double>(count);
+  if (fp64()) return buffer.read<double>(count);
   const auto values = buffer.read<float>(count);
   return {values.begin(), values.end()};
 }
@@ -209,6 +221,9 @@ void GpuStepper::upload(const World& world) {
   upload_springs(world);
   allocate_resort(body_count_, particle_count_);
   upload_materials_and_walls(world);
+  // Compiled for this world (walls or none); the context's program cache links each variant once.
+  contacts_ = gpu::Program::compute(library_, "sim/contact_forces.comp",
+                                    contact_defines(precision_, settings_, plane_count_ + cylinder_count_ > 0));
   allocate_statistics();
   allocate_lists(world);  // before set_params: the contact kernel's grid cell and capacity
   set_params();
@@ -239,12 +254,12 @@ void GpuStepper::upload_particles(const World& world) {
     max_radius = std::max(max_radius, p.radius[i]);
   }
   cell_size_ = particle_count_ > 0 ? 2.0 * max_radius : 1.0;
-  const std::size_t real_size = precision_ == Precision::Double ? 8 : 4;
+  const std::size_t real_size = fp64() ? 8 : 4;
   particle_local_ = real_buffer(local);
   particle_info_ = gpu::Buffer::from<std::uint32_t>(info);
   const std::size_t particles = particle_count_;  // size_t products: no 32-bit overflow
   particle_position_ = gpu::Buffer(particles * 16);
-  particle_position_exact_ = gpu::Buffer(precision_ == Precision::Double ? particles * 32 : 16);
+  particle_position_exact_ = gpu::Buffer(fp64() ? particles * 32 : 16);
   particle_velocity_ = gpu::Buffer(particles * 4 * real_size);
   particle_wrench_ = gpu::Buffer(particles * 8 * real_size);
 }
@@ -296,8 +311,6 @@ void fill_contact_params(Params& p, const StepSettings& s, std::uint32_t particl
                          std::uint32_t capacity) {
   p.sizes = {particles, p.sizes.y, planes, cylinders};
   p.materials = {materials, 0u, 0u, 0u};
-  p.models = {s.normal_damping == NormalDamping::Tsuji ? 0 : 1, s.tangential == TangentialModel::Spring ? 1 : 0,
-              s.check_penetration ? 1 : 0, 0};
   p.limits = {static_cast<float>(cell_size),
               static_cast<float>(s.max_overlap_ratio > 0 ? s.max_overlap_ratio : 1e30), 0.0f, 0.0f};
   p.step.x = static_cast<decltype(p.step.x)>(s.dt);
@@ -336,7 +349,7 @@ void GpuStepper::set_params() {
 }
 
 void GpuStepper::bind_contact_params(std::uint32_t table_size) {
-  if (precision_ == Precision::Double) {
+  if (fp64()) {
     contact_params64_.values.sizes.y = table_size;
     contact_params64_.bind(TS_SIM_PARAMS);
   } else {
@@ -346,7 +359,7 @@ void GpuStepper::bind_contact_params(std::uint32_t table_size) {
 }
 
 void GpuStepper::bind_integrate_params(double time_after) {
-  if (precision_ == Precision::Double) {
+  if (fp64()) {
     integrate_params64_.values.time.x = time_after;
     integrate_params64_.bind(TS_SIM_PARAMS);
   } else {
@@ -520,7 +533,7 @@ static void unpack_springs(const std::vector<Slots>& slots, const std::vector<st
 void GpuStepper::upload_springs(const World& world) {
   const bool on = settings_.tangential == TangentialModel::Spring;
   const std::size_t n = on ? particle_count_ : 1;  // a placeholder keeps the binding valid
-  if (precision_ == Precision::Double) {
+  if (fp64()) {
     springs_ = gpu::Buffer::from<SimSpringSlots64>(pack_springs<SimSpringSlots64>(world, n));
   } else {
     springs_ = gpu::Buffer::from<SimSpringSlots>(pack_springs<SimSpringSlots>(world, n));
@@ -530,7 +543,7 @@ void GpuStepper::upload_springs(const World& world) {
 void GpuStepper::download_springs(World& world) const {
   if (settings_.tangential != TangentialModel::Spring) return;
   const std::vector<std::uint32_t> original = original_ids(original_particle_, particle_count_);
-  if (precision_ == Precision::Double) {
+  if (fp64()) {
     unpack_springs(springs_.read<SimSpringSlots64>(particle_count_), original, world);
   } else {
     unpack_springs(springs_.read<SimSpringSlots>(particle_count_), original, world);
@@ -626,7 +639,7 @@ void GpuStepper::resort() {
   std::swap(body_range_, new_range_);
 
   // Every persistent array follows (per-step scratch such as forces is recomputed anyway).
-  const std::uint32_t r4 = precision_ == Precision::Double ? 2 : 1;  // 16-byte words per real4
+  const std::uint32_t r4 = fp64() ? 2 : 1;  // 16-byte words per real4
   for (gpu::Buffer* b : {&body_position_, &body_orientation_, &body_velocity_, &body_omega_, &body_momentum_})
     gather(*b, order_, body_count_, r4);
   gather(body_inverse_inertia_, order_, body_count_, 3 * r4);
@@ -636,7 +649,7 @@ void GpuStepper::resort() {
   gather(original_particle_, source_particle_, particle_count_, 1);
   const bool springs = settings_.tangential == TangentialModel::Spring;
   if (springs) {
-    const std::uint32_t words = precision_ == Precision::Double ? sizeof(SimSpringSlots64) / 16 : sizeof(SimSpringSlots) / 16;
+    const std::uint32_t words = fp64() ? sizeof(SimSpringSlots64) / 16 : sizeof(SimSpringSlots) / 16;
     gather(springs_, source_particle_, particle_count_, words);
   }
   particle_info_.bind(TS_SIM_PARTICLE_INFO);

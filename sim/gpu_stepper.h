@@ -21,7 +21,10 @@
 
 namespace ts::sim {
 
-enum class Precision { Float, Double };
+// Float: float state and arithmetic. Double: double state and integration, contact arithmetic in float
+// on double-differenced positions and velocities (mixed precision; `--precision double`). FullDouble:
+// the contact kernel in double too, kept only to measure Double against (tests and bench/sim_accuracy).
+enum class Precision { Float, Double, FullDouble };
 
 class GpuStepper : public Stepper {
  public:
@@ -41,7 +44,9 @@ class GpuStepper : public Stepper {
   // Per-kernel GPU times, then the host-GPU round trips of the steps, of the outputs and in all.
   std::string timing_report() override;
   const StepSettings& settings() const override { return settings_; }
-  std::string engine() const override { return precision_ == Precision::Double ? "gpu double" : "gpu float"; }
+  std::string engine() const override {
+    return precision_ == Precision::Float ? "gpu float" : precision_ == Precision::Double ? "gpu double" : "gpu full double";
+  }
   // The persistent buffers in GPU memory order, the re-sort counter, the time and the energy check's
   // reference; the device's renderer goes along (another device continues, with a warning, not bitwise).
   std::string save_state() const override;
@@ -80,6 +85,8 @@ class GpuStepper : public Stepper {
   std::vector<gpu::HostSyncPhase> round_trips() const;
 
  private:
+  // Double-precision state (Double and FullDouble).
+  bool fp64() const { return precision_ != Precision::Float; }
   template <typename T>
   gpu::Buffer real_buffer(const std::vector<T>& values) const;
   std::vector<double> read_real(const gpu::Buffer& buffer, std::size_t count) const;

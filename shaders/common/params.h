@@ -122,14 +122,12 @@ TS_PARAMS(ComputeScanParams) {
   vec4 band;    // x: half-width [voxels]; yzw unused
 };
 
-// ---- sim/contact_forces.comp. SimContactParams64 is the same for the double-precision pipeline
-// (TS_FP64), whose step length is a double.
+// ---- sim/contact_forces.comp. SimContactParams64 is the same for the double-precision pipelines
+// (TS_FP64), whose step length is a double. The contact law, springs, walls present and the
+// penetration check are compile-time switches of the kernel (TS_CONTACT_*), not parameters.
 TS_PARAMS(SimContactParams) {
   uvec4 sizes;            // x: particles, y: hash table size, z: planes (walls), w: cylinders
   uvec4 materials;        // x: material count; yzw unused
-  ivec4 models;           // x: damping model (0 Tsuji, 1 thesis), y: 1 tangential springs (static
-                          // friction), 0 viscous eq. 3.28, z: 1 counts dynamic particles that passed
-                          // through a wall (StepSettings::check_penetration); w unused
   vec4 limits;            // x: cell size of the hashed grid [m] (largest diameter + skin), y: overlap
                           // clamp ratio (thesis 3.3.1): delta <= ratio * min radius
   vec4 step;              // x: dt [s], advances the springs; yzw unused
@@ -138,9 +136,8 @@ TS_PARAMS(SimContactParams) {
 TS_PARAMS(SimContactParams64) {
   uvec4 sizes;
   uvec4 materials;
-  ivec4 models;
   vec4 limits;
-  uvec4 lists;            // before step, which std140 puts at the next 32-byte offset (96) either way
+  uvec4 lists;            // before step, which std140 puts at the next 32-byte offset (64) either way
   dvec4 step;
 };
 

@@ -8,12 +8,34 @@
 // With the spring tangential model each dynamic particle keeps its contacts' springs in its own
 // history slots (read at the start, rewritten in gather order), matched by partner id, as
 // CpuStepper::visit_contacts does. At most 16 storage blocks (the per-stage minimum of GL 4.3).
+// Scene-wide switches are compile-time specialisations (GpuStepper compiles one program per
+// combination a loaded world uses; the shader cache keeps each): what is off costs no registers.
+//   TS_CONTACT_SPRINGS      1: tangential springs (static friction), 0: viscous eq. 3.28
+//   TS_CONTACT_DAMPING      TS_DAMPING_TSUJI (0) or TS_DAMPING_THESIS (1)
+//   TS_CONTACT_WALLS        1: the world has smooth walls (planes or cylinders)
+//   TS_CONTACT_PENETRATION  1: count dynamic particles that passed through a wall
+// Without them (glslangValidator, the Params test) every switch is on, Tsuji damping.
+#ifndef TS_CONTACT_SPRINGS
+#define TS_CONTACT_SPRINGS 1
+#endif
+#ifndef TS_CONTACT_DAMPING
+#define TS_CONTACT_DAMPING 0
+#endif
+#ifndef TS_CONTACT_WALLS
+#define TS_CONTACT_WALLS 1
+#endif
+#ifndef TS_CONTACT_PENETRATION
+#define TS_CONTACT_PENETRATION 1
+#endif
 #include "common/dispatch.glsl"
 #include "common/bindings.h"
 #include "sim/bindings.h"
 #include "common/layouts.h"
 #include "sim/contact.glsl"
 #include "sim/rigid.glsl"
+// Work-group size rule: 128 for per-particle gathers like this one (enough warps per group to hide
+// the dependent neighbour loads, small enough that a group's register file does not cap occupancy),
+// 256 for the tree reductions (reduce_*.comp), which halve the partial count per level.
 layout(local_size_x = 128) in;
 layout(std430, binding = TS_SIM_PARTICLE_POSITION) readonly buffer P { vec4 particle_position[]; };
 layout(std430, binding = TS_GRID_CELL_START) readonly buffer CellStart { uint cell_start[]; };
@@ -46,9 +68,10 @@ layout(std140, binding = TS_SIM_PARAMS) uniform ContactBlock { SimContactParams6
 layout(std140, binding = TS_SIM_PARAMS) uniform ContactBlock { SimContactParams params; };
 #endif
 
+#if TS_CONTACT_SPRINGS
 // This particle's contact history: the old slots, read once, and how many new ones are written.
 int old_partner[TS_SIM_SPRING_SLOTS];
-real3 old_spring[TS_SIM_SPRING_SLOTS];
+real3 old_spring[TS_SIM_SPRING_SLOTS];  // state: `real` (sim/contact.glsl, spring_tangential_force)
 uint slots_used = 0u, slot_overflows = 0u;
 
 void load_springs(uint i) {
@@ -57,16 +80,19 @@ void load_springs(uint i) {
     old_spring[s] = real3(springs[i].displacement[s].xyz);
   }
 }
+#endif
 
 // The force of one touching contact; with springs, takes the contact's spring from the old slots
 // (zero when new) and keeps it, advanced, in the next free slot (counted when none is left).
-real3 contact_force(uint i, bool with_springs, int partner, real3 n, real delta, real3 vc, real effective_radius,
-                    real effective_mass, SimPair c) {
-  if (!with_springs) return hertz_contact_force(n, delta, vc, effective_radius, effective_mass, c, params.models.x);
+creal3 contact_force(uint i, bool with_springs, int partner, creal3 n, creal delta, creal3 vc, creal effective_radius,
+                     creal effective_mass, SimPair c) {
+#if TS_CONTACT_SPRINGS
+  if (!with_springs) return hertz_contact_force(n, delta, vc, effective_radius, effective_mass, c, TS_CONTACT_DAMPING);
   real3 spring = real3(0.0);
   for (uint s = 0u; s < TS_SIM_SPRING_SLOTS; ++s)
     if (old_partner[s] == partner) spring = old_spring[s];
-  real3 f = hertz_spring_contact_force(n, delta, vc, effective_radius, effective_mass, c, params.models.x, params.step.x, spring);
+  creal3 f = hertz_spring_contact_force(n, delta, vc, effective_radius, effective_mass, c, TS_CONTACT_DAMPING,
+                                        real(params.step.x), spring);
   if (slots_used == TS_SIM_SPRING_SLOTS) {
     ++slot_overflows;
   } else {
@@ -75,14 +101,19 @@ real3 contact_force(uint i, bool with_springs, int partner, real3 n, real delta,
     ++slots_used;
   }
   return f;
+#else
+  return hertz_contact_force(n, delta, vc, effective_radius, effective_mass, c, TS_CONTACT_DAMPING);
+#endif
 }
 
 // Particle i lies wholly behind the surface of smooth wall `slot` (planes, then cylinders): counted,
 // and the wall keeps the lowest world particle id found behind it (as ~id, so 0 means none).
+#if TS_CONTACT_WALLS && TS_CONTACT_PENETRATION
 void note_penetration(uint i, uint slot) {
   atomicAdd(counters[TS_SIM_COUNTER_PENETRATIONS], 1u);
   atomicMax(counters[TS_SIM_COUNTER_WALL_SLOTS + slot], ~particle_info[i].z);
 }
+#endif
 
 void main() {
   uint i = dispatch_item();
@@ -90,19 +121,21 @@ void main() {
   uint body_i = particle_info[i].x;
   real4 xi4 = POSITION(i);
   real3 xi = xi4.xyz;
-  real ri = xi4.w;
+  creal ri = creal(xi4.w);
   real3 vi = particle_velocity[i].xyz;
-  real3 wi = body_omega[body_i].xyz;
+  creal3 wi = creal3(body_omega[body_i].xyz);
   real inv_mass_i = body_position[body_i].w;
   uint pair_row = particle_info[i].y * params.materials.x;
   real3 force = real3(0.0), torque = real3(0.0);
-  real3 arm_i = xi - body_position[body_i].xyz;
+  creal3 arm_i = creal3(xi - body_position[body_i].xyz);  // relative in double, then float (mixed)
   // Static and kinematic particles keep no springs (their partners hold the contact's), as on the CPU.
-  bool with_springs = params.models.y != 0 && inv_mass_i > 0.0;
+  bool with_springs = TS_CONTACT_SPRINGS != 0 && inv_mass_i > 0.0;
+#if TS_CONTACT_SPRINGS
   if (with_springs) load_springs(i);
+#endif
 
   float pair_contacts = 0.0, walls = 0.0, clamps = 0.0, worst_overlap = 0.0;
-  real overlap_cap = real(params.limits.y);
+  creal overlap_cap = creal(params.limits.y);
   // The list's candidates (rows 1..n, column-major), or past capacity the grid walk from the cell the
   // build stored in rows 1-3: both in ascending index, one fixed order whenever the list was built.
   uint particles = params.sizes.x, listed = list[i];
@@ -112,59 +145,75 @@ void main() {
     begin_walk(cell, params.sizes.y, particles);
   }
   for (uint k = 0u;; ++k) {
-          uint j;
-          if (from_list) {
-            if (k >= listed) break;
-            j = list[(k + 1u) * particles + i];
-          } else {
-            j = next_candidate();
-            if (j == TS_SIM_WALK_DONE) break;
-          }
-          uint body_j = particle_info[j].x;
-          if (body_j == body_i) continue;  // the grid walk's own body (lists hold other bodies only)
-          real inv_mass_j = body_position[body_j].w;
-          if (inv_mass_i == 0.0 && inv_mass_j == 0.0) continue;  // neither body can move
-          real4 xj4 = POSITION(j);
-          real3 d = xi - xj4.xyz;
-          real dist = length(d);
-          real raw = ri + xj4.w - dist;
-          if (raw <= 0.0 || dist <= 0.0) continue;
-          real3 n = d / dist;
-          real smaller = min(ri, xj4.w);
-          real delta = min(raw, overlap_cap * smaller);
-          real3 arm1 = -(ri - 0.5 * raw) * n;
-          real3 arm2 = (xj4.w - 0.5 * raw) * n;
-          real3 vc = (vi + cross(wi, arm1)) - (particle_velocity[j].xyz + cross(body_omega[body_j].xyz, arm2));
-          real3 f = contact_force(i, with_springs, int(j), n, delta, vc, ri * xj4.w / (ri + xj4.w),
-                                  1.0 / (inv_mass_i + inv_mass_j), pair_table[pair_row + particle_info[j].y]);
-          force += f;
-          torque += cross(arm_i + arm1, f);
-          if (i < j) {  // each pair is counted once, by its lower id
-            pair_contacts += 1.0;
-            worst_overlap = max(worst_overlap, float(delta / smaller));
-            clamps += raw > delta ? 1.0 : 0.0;
-          }
+    uint j;
+    if (from_list) {
+      if (k >= listed) break;
+      j = list[(k + 1u) * particles + i];
+    } else {
+      j = next_candidate();
+      if (j == TS_SIM_WALK_DONE) break;
+    }
+    uint body_j = particle_info[j].x;
+    if (body_j == body_i) continue;  // the grid walk's own body (lists hold other bodies only)
+    real inv_mass_j = body_position[body_j].w;
+    if (inv_mass_i == 0.0 && inv_mass_j == 0.0) continue;  // neither body can move
+    real4 xj4 = POSITION(j);
+    // Mixed precision: the position and velocity differences in double, rounded once to float
+    // (exact to float relative to the pair's separation and relative speed); the rest in float
+    // but the overlap: radii and separation are each ~1000 small overlaps, so their float
+    // difference would keep three or four digits of it. It is (reach^2 - |dx|^2) / (reach + |dx|)
+    // with the numerator in `real`, for the pairs float cannot already tell apart.
+    real3 dx = xi - xj4.xyz;
+    creal3 d = creal3(dx);
+    creal rj = creal(xj4.w);
+    creal dist = length(d);
+    if (dist >= (ri + rj) * 1.00001 || dist <= 0.0) continue;
+    real reach = xi4.w + xj4.w;
+    real gap2 = reach * reach - dot(dx, dx);
+    if (gap2 <= 0.0) continue;
+    creal raw = creal(gap2) / (creal(reach) + dist);
+    creal3 n = d / dist;
+    creal smaller = min(ri, rj);
+    creal delta = min(raw, overlap_cap * smaller);
+    creal3 arm1 = -(ri - 0.5 * raw) * n;
+    creal3 arm2 = (rj - 0.5 * raw) * n;
+    creal3 vc = creal3(vi - particle_velocity[j].xyz) + cross(wi, arm1) -
+                cross(creal3(body_omega[body_j].xyz), arm2);
+    creal3 f = contact_force(i, with_springs, int(j), n, delta, vc, ri * rj / (ri + rj),
+                             creal(1.0 / (inv_mass_i + inv_mass_j)), pair_table[pair_row + particle_info[j].y]);
+    force += real3(f);  // summed in `real`: double in the double pipelines
+    torque += real3(cross(arm_i + arm1, f));
+    if (i < j) {  // each pair is counted once, by its lower id
+      pair_contacts += 1.0;
+      worst_overlap = max(worst_overlap, float(delta / smaller));
+      clamps += raw > delta ? 1.0 : 0.0;
+    }
   }
 
+#if TS_CONTACT_WALLS
   if (inv_mass_i > 0.0) {
-    // Smooth walls in declaration order: planes, then cylinders (as the CPU reference).
+    // Smooth walls in declaration order: planes, then cylinders (as the CPU reference). The overlap
+    // in `real` (double in the double pipelines: the radius and the distance to the wall are each far
+    // larger than it), the rest of the contact in `creal`.
     for (uint k = 0u; k < params.sizes.z; ++k) {
       SimPlane plane = planes[k];
-      real3 n = real3(plane.normal_offset.xyz);
-      real raw = ri - (dot(n, xi) - real(plane.normal_offset.w));
+      creal3 n = creal3(plane.normal_offset.xyz);
+      creal raw = creal(xi4.w - (dot(real3(plane.normal_offset.xyz), xi) - real(plane.normal_offset.w)));
       if (raw <= 0.0) continue;
       if (plane.extent.w != 0.0) {
-        real3 rel = xi - real3(plane.extent.xyz);
-        real lateral = length(rel - dot(rel, n) * n);
-        if (plane.extent.w > 0.0 ? lateral > real(plane.extent.w) : lateral < real(-plane.extent.w)) continue;
+        creal3 rel = creal3(xi - real3(plane.extent.xyz));
+        creal lateral = length(rel - dot(rel, n) * n);
+        if (plane.extent.w > 0.0 ? lateral > creal(plane.extent.w) : lateral < creal(-plane.extent.w)) continue;
       }
-      if (params.models.z != 0 && raw > 2.0 * ri) note_penetration(i, k);
-      real delta = min(raw, overlap_cap * ri);
-      real3 arm = -(ri - 0.5 * raw) * n;
-      real3 f = contact_force(i, with_springs, -1 - int(k), n, delta, vi + cross(wi, arm), ri, 1.0 / inv_mass_i,
-                              pair_table[pair_row + plane.material.x]);
-      force += f;
-      torque += cross(arm_i + arm, f);
+#if TS_CONTACT_PENETRATION
+      if (raw > 2.0 * ri) note_penetration(i, k);
+#endif
+      creal delta = min(raw, overlap_cap * ri);
+      creal3 arm = -(ri - 0.5 * raw) * n;
+      creal3 f = contact_force(i, with_springs, -1 - int(k), n, delta, creal3(vi) + cross(wi, arm), ri,
+                               creal(1.0 / inv_mass_i), pair_table[pair_row + plane.material.x]);
+      force += real3(f);
+      torque += real3(cross(arm_i + arm, f));
       walls += 1.0;
       worst_overlap = max(worst_overlap, float(delta / ri));
       clamps += raw > delta ? 1.0 : 0.0;
@@ -172,28 +221,34 @@ void main() {
     for (uint k = 0u; k < params.sizes.w; ++k) {
       SimCylinder cyl = cylinders[k];
       if (xi.z < real(cyl.range.x) || xi.z > real(cyl.range.y)) continue;
-      real2 radial = xi.xy - real2(cyl.axis_radius.xy);
-      real distance = length(radial);
+      real2 radial_exact = xi.xy - real2(cyl.axis_radius.xy);
+      real distance = length(radial_exact);
       if (distance <= 0.0) continue;
-      real raw = ri - (real(cyl.axis_radius.w) - distance);
+      creal2 radial = creal2(radial_exact);
+      creal raw = creal(xi4.w - (real(cyl.axis_radius.w) - distance));
       if (raw <= 0.0) continue;
-      real3 n = real3(-radial / distance, 0.0);
-      if (params.models.z != 0 && raw > 2.0 * ri) note_penetration(i, params.sizes.z + k);
-      real delta = min(raw, overlap_cap * ri);
-      real3 arm = -(ri - 0.5 * raw) * n;
-      real3 f = contact_force(i, with_springs, -1 - int(params.sizes.z + k), n, delta, vi + cross(wi, arm), ri,
-                              1.0 / inv_mass_i, pair_table[pair_row + cyl.material.x]);
-      force += f;
-      torque += cross(arm_i + arm, f);
+      creal3 n = creal3(-radial / length(radial), 0.0);
+#if TS_CONTACT_PENETRATION
+      if (raw > 2.0 * ri) note_penetration(i, params.sizes.z + k);
+#endif
+      creal delta = min(raw, overlap_cap * ri);
+      creal3 arm = -(ri - 0.5 * raw) * n;
+      creal3 f = contact_force(i, with_springs, -1 - int(params.sizes.z + k), n, delta, creal3(vi) + cross(wi, arm),
+                               ri, creal(1.0 / inv_mass_i), pair_table[pair_row + cyl.material.x]);
+      force += real3(f);
+      torque += real3(cross(arm_i + arm, f));
       walls += 1.0;
       worst_overlap = max(worst_overlap, float(delta / ri));
       clamps += raw > delta ? 1.0 : 0.0;
     }
   }
+#endif
+#if TS_CONTACT_SPRINGS
   if (with_springs) {
     for (uint s = slots_used; s < TS_SIM_SPRING_SLOTS; ++s) springs[i].partner[s / 4u][s % 4u] = TS_SIM_NO_PARTNER;
     if (slot_overflows > 0u) atomicAdd(counters[2], slot_overflows);  // integer counts: order-free
   }
+#endif
   particle_wrench[2u * i] = real4(force, 0.0);
   particle_wrench[2u * i + 1u] = real4(torque, 0.0);
   particle_stats[i] = vec4(pair_contacts, walls, worst_overlap, clamps);

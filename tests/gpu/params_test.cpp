@@ -63,8 +63,7 @@ BlockSpec contact() {
   return {"ContactBlock",
           sizeof(Contact),
           {TS_MEMBER(params, Contact, sizes), TS_MEMBER(params, Contact, materials),
-           TS_MEMBER(params, Contact, models), TS_MEMBER(params, Contact, limits),
-           TS_MEMBER(params, Contact, step), TS_MEMBER(params, Contact, lists)}};
+           TS_MEMBER(params, Contact, limits), TS_MEMBER(params, Contact, step), TS_MEMBER(params, Contact, lists)}};
 }
 template <typename Integrate>
 BlockSpec integrate() {
@@ -208,6 +207,11 @@ TEST_F(GpuParams, SdfProgramsMatchCpp) {
 TEST_F(GpuParams, SimKernelsMatchCppInBothPrecisions) {
   check(compute("sim/contact_forces.comp"), {contact<SimContactParams>()});
   check(compute("sim/contact_forces.comp", {"TS_FP64 1"}), {contact<SimContactParams64>()});
+  check(compute("sim/contact_forces.comp", {"TS_FP64 1", "TS_CONTACT_FP64 1"}), {contact<SimContactParams64>()});
+  // The leanest specialisation still reads the whole block (std140 keeps every member).
+  const std::vector<std::string> lean{"TS_CONTACT_SPRINGS 0", "TS_CONTACT_DAMPING 1", "TS_CONTACT_WALLS 0",
+                                      "TS_CONTACT_PENETRATION 0"};
+  check(compute("sim/contact_forces.comp", lean), {contact<SimContactParams>()});
   check(compute("sim/integrate_bodies.comp"), {integrate<SimIntegrateParams>()});
   check(compute("sim/integrate_bodies.comp", {"TS_FP64 1"}), {integrate<SimIntegrateParams64>()});
   check(compute("sim/update_particles.comp"), {item_count("UpdateBlock")});

@@ -320,6 +320,9 @@ def variants(closure_text):
     sets = [[]]
     if "TS_FP64" in closure_text:
         sets.append(["TS_FP64=1"])
+    if "TS_CONTACT_SPRINGS" in closure_text:  # the contact kernel's specialisations (GpuStepper)
+        lean = ["TS_CONTACT_SPRINGS=0", "TS_CONTACT_DAMPING=1", "TS_CONTACT_WALLS=0", "TS_CONTACT_PENETRATION=0"]
+        sets += [lean, ["TS_FP64=1"] + lean, ["TS_FP64=1", "TS_CONTACT_FP64=1"]]
     if "TS_FIELD_CHUNKS" in closure_text:
         sets += [["TS_FIELD_CHUNKS=2", "TS_FIELD_CHUNK_SHIFT=25"], ["TS_FIELD_CHUNKS=8", "TS_FIELD_CHUNK_SHIFT=25"]]
     if "TS_PROBE_MODE" in closure_text:
