@@ -443,16 +443,8 @@ void CpuRenderer::set_particles(const Particles& particles) {
 }
 
 Aabb CpuRenderer::content_box() const {
-  Aabb box;
-  if (impl_->field) {
-    box.extend(impl_->surface_box.min);
-    box.extend(impl_->surface_box.max);
-  }
-  if (impl_->particle_box.valid()) {
-    box.extend(impl_->particle_box.min);
-    box.extend(impl_->particle_box.max);
-  }
-  return box;
+  return preview::content_box(impl_->field ? std::optional<Aabb>(impl_->surface_box) : std::nullopt,
+                              impl_->particle_box);
 }
 
 void CpuRenderer::check_image_size(int width, int height) const {

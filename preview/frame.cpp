@@ -77,6 +77,19 @@ CameraState camera_state(const Camera& camera, int width, int height, const Eige
   return s;
 }
 
+Aabb content_box(const std::optional<Aabb>& surface, const Aabb& particles) {
+  Aabb box;
+  if (surface) {
+    box.extend(surface->min);
+    box.extend(surface->max);
+  }
+  if (particles.valid()) {
+    box.extend(particles.min);
+    box.extend(particles.max);
+  }
+  return box;
+}
+
 Aabb particle_box(const Particles& particles) {
   const std::size_t n = particles.centers.size();
   if (n && particles.radii.size() != 1 && particles.radii.size() != n) {

@@ -48,6 +48,10 @@ struct Frame {
 // non-finite centre or a radius that is not positive.
 Aabb particle_box(const Particles& particles);
 
+// What a renderer draws, for framing: the surface's box (when there is a surface) joined with the
+// particles' (when valid).
+Aabb content_box(const std::optional<Aabb>& surface, const Aabb& particles);
+
 // The key light's default direction: from the upper left, behind the camera, about 50 degrees above
 // the ground plane, turning with the camera about `up`.
 Eigen::Vector3d default_light(const Camera& camera, const Eigen::Vector3d& up);

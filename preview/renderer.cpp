@@ -411,16 +411,8 @@ void Renderer::set_particles(const Particles& particles) {
 }
 
 Aabb Renderer::content_box() const {
-  Aabb box;
-  if (impl_->has_volume) {
-    box.extend(impl_->surface_box.min);
-    box.extend(impl_->surface_box.max);
-  }
-  if (impl_->particle_box.valid()) {
-    box.extend(impl_->particle_box.min);
-    box.extend(impl_->particle_box.max);
-  }
-  return box;
+  return preview::content_box(impl_->has_volume ? std::optional<Aabb>(impl_->surface_box) : std::nullopt,
+                              impl_->particle_box);
 }
 
 Eigen::Vector2i Renderer::max_image_size() const {

@@ -15,6 +15,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "core/error.h"
+#include "core/morton.h"
 #include "core/stopwatch.h"
 
 namespace ts::sampler {
@@ -109,20 +110,6 @@ class CpuRelaxer::NeighbourGrid {
 
 namespace {
 
-// Interleaves the low 21 bits of x, y and z (a Morton code).
-std::uint64_t morton(std::uint64_t x, std::uint64_t y, std::uint64_t z) {
-  const auto spread = [](std::uint64_t v) {
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffull;
-    v = (v | v << 16) & 0x1f0000ff0000ffull;
-    v = (v | v << 8) & 0x100f00f00f00f00full;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-    v = (v | v << 2) & 0x1249249249249249ull;
-    return v;
-  };
-  return spread(x) | spread(y) << 1 | spread(z) << 2;
-}
-
 // The particles sorted along a Morton curve of cells of `cell` [m]: neighbours in space are then
 // neighbours in memory, so the threads' blocks of particles read the same few buckets (at 10^6
 // particles the positions no longer fit the cache). Particles move about a spacing in a relaxation,
@@ -133,7 +120,7 @@ std::vector<std::uint32_t> spatial_order(const std::vector<Eigen::Vector3f>& pos
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(positions.size());
   tbb::parallel_for(std::size_t{0}, positions.size(), [&](std::size_t i) {
     const Eigen::Vector3d c = ((positions[i].cast<double>() - lo) / cell).array().floor();
-    keyed[i] = {morton(static_cast<std::uint64_t>(c.x()), static_cast<std::uint64_t>(c.y()),
+    keyed[i] = {morton_code(static_cast<std::uint64_t>(c.x()), static_cast<std::uint64_t>(c.y()),
                        static_cast<std::uint64_t>(c.z())),
                 static_cast<std::uint32_t>(i)};
   });

@@ -12,6 +12,7 @@
 #include <limits>
 #include <utility>
 
+#include "core/morton.h"
 #include "sim/contact_lists.h"
 
 namespace ts::sim {
@@ -21,17 +22,6 @@ namespace {
 // Relative margin on the build's reach and cell, so that a pair the rebuild rule says cannot touch
 // yet is not lost to the round-off of the distances compared at the build and at the step.
 constexpr double kRoundOffMargin = 1e-9;
-
-// Bits 0, 3, 6, ... of the result are bits 0, 1, 2, ... of v (v < 2^21).
-std::uint64_t spread_bits(std::uint64_t v) {
-  v &= 0x1fffffu;
-  v = (v | v << 32) & 0x1f00000000ffffull;
-  v = (v | v << 16) & 0x1f0000ff0000ffull;
-  v = (v | v << 8) & 0x100f00f00f00f00full;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-  v = (v | v << 2) & 0x1249249249249249ull;
-  return v;
-}
 
 }  // namespace
 
@@ -125,7 +115,7 @@ void CpuContactLists::sort_by_cell() {
     std::uint64_t key = 0;
     for (int axis = 0; axis < 3; ++axis) {
       const std::int64_t from_low = std::int64_t{grid_.cell[i][axis]} - low[axis];
-      key |= spread_bits(static_cast<std::uint64_t>(std::min<std::int64_t>(from_low, 0x1fffff))) << axis;
+      key |= spread_bits_3d(static_cast<std::uint64_t>(std::min<std::int64_t>(from_low, 0x1fffff))) << axis;
     }
     keyed[i] = {key, i};
   });
