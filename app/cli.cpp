@@ -34,6 +34,7 @@ Runner add_manpage_command(CLI::App& app) {
 std::unique_ptr<CommandLine> make_command_line() {
   auto cli = std::make_unique<CommandLine>();
   CLI::App& app = cli->app;
+  app.name("tetrasand");  // usage lines name the command, not the path it was started by
   app.description(
       "tetrasand: triangle meshes -> narrow-band SDFs -> particle rigid bodies -> GPU sand simulation.\n"
       "Exit codes: 0 ok, 1 bad input, 2 usage, 3 GPU/context failure, 4 simulation unstable, 5 internal "
