@@ -13,6 +13,7 @@
 #include <random>
 
 #include "core/error.h"
+#include "core/splitmix.h"
 #include "sampler/point_grid.h"
 #include "sampler/surface_points.h"
 
@@ -22,13 +23,6 @@ namespace {
 // Probes per generator: large enough that seeding (312 words) is negligible, small enough that two
 // cores share a million probes evenly.
 constexpr std::size_t kProbesPerChunk = 1 << 14;
-
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
 
 // Probe k of a coverage measurement, reproducible alone: its chunk's generator, advanced past the
 // three draws of each earlier probe of the chunk.

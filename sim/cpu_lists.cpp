@@ -81,6 +81,7 @@ void CpuContactLists::build(const World& world, const std::vector<Eigen::Vector3
   const double cell = (largest_diameter_ + skin_) * (1 + kRoundOffMargin);  // m
   build_neighbour_grid(positions, cell > 0 ? cell : 1.0, grid_);
   fill_grid_entries(world, positions);
+  bonded_ = bonded_partners(world.bonds, positions.size());
   sort_by_cell();
   fill_lists();
   built_position_ = positions;
@@ -139,6 +140,7 @@ void CpuContactLists::search(const GridEntry& self, Fn&& fn) const {
       // A cell of another row hashed here, or a pair that can take no force.
       if (other.cell.y() != y || other.cell.z() != z || std::abs(other.cell.x() - own.x()) > 1) continue;
       if (other.body == self.body || (!self.receives_force && !other.receives_force)) continue;
+      if (!bonded_.empty() && bonded_.bonded(self.particle, other.particle)) continue;
       const double reach = (self.radius + other.radius + skin_) * (1 + kRoundOffMargin);  // m
       if ((self.position - other.position).squaredNorm() < reach * reach) fn(other.particle);
     }

@@ -90,7 +90,7 @@ class CpuContactLists {
   void sort_by_cell();
   void fill_lists();
   // Calls fn(world id) for each particle of another body within the skin of `self`'s surface (and
-  // not both unable to receive a force), in grid order.
+  // not both unable to receive a force, nor bonded to it by an intact bond), in grid order.
   template <typename Fn>
   void search(const GridEntry& self, Fn&& fn) const;
 
@@ -101,6 +101,7 @@ class CpuContactLists {
   std::vector<std::uint32_t> offsets_;       // CSR by slot: size + 1 entries
   std::vector<ListEntry> entries_;
   std::vector<Eigen::Vector3d> built_position_;  // m, world order, at the build
+  BondedPartners bonded_;                        // of the build: pairs the contact law leaves to their bond
   double skin_ = 0, largest_diameter_ = 0;
   std::size_t builds_ = 0, listed_ = 0;
   bool built_ = false;

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "sim/cpu_bonds.h"
 #include "sim/state_bytes.h"
 
 namespace ts::sim {
@@ -44,7 +45,9 @@ StepStats CpuStepper::advance(World& world, std::int64_t steps) {
     sums.angular_velocity_clamps += last.angular_velocity_clamps;
     sums.overlap_clamps += last.overlap_clamps;
     sums.spring_overflows += last.spring_overflows;
+    sums.bonds_broken += last.bonds_broken;
   }
+  last.bonds_broken = sums.bonds_broken;
   last.spring_overflows = sums.spring_overflows;
   last.velocity_clamps = sums.velocity_clamps;
   last.angular_velocity_clamps = sums.angular_velocity_clamps;
@@ -184,12 +187,22 @@ void CpuStepper::check_stability(const World& world, double mechanical_energy, c
   }
 }
 
+// The bonds' loads join the contacts' (sim/cpu_bonds.h). A bond that broke leaves its pair to the
+// contact law, which the lists left it out of: they are rebuilt at the next step.
+void CpuStepper::add_bonds(World& world, StepStats& stats) {
+  const BondStep bonds = add_bond_loads(world, contacts_.positions(), settings_.dt, forces_.force, forces_.torque);
+  stats.elastic_energy += bonds.energy;
+  stats.bonds_broken = bonds.broke;
+  if (bonds.broke > 0) contacts_.invalidate_lists();
+}
+
 StepStats CpuStepper::step(World& world) {
   if (world.materials.size() != material_count_) reset_energy_reference(world);
   StepStats stats;
   apply_tracks(world, world.time);  // keyframed bodies start the step on their track
   contacts_.gather(world, forces_, stats);
   if (settings_.tangential == TangentialModel::Spring) std::swap(world.springs, forces_.springs);
+  if (!world.bonds.a.empty()) add_bonds(world, stats);
   // Kinetic + potential + spring energy at the start of the step: what the contacts may only lose.
   const Energy start = energy(world);
   const double mechanical = start.total() + stats.elastic_energy;  // J

@@ -48,6 +48,7 @@ class CpuStepper : public Stepper {
   const CpuContactLists& lists() const { return contacts_.lists(); }
 
  private:
+  void add_bonds(World& world, StepStats& stats);
   void integrate(World& world, StepStats& stats);
   void check_stability(const World& world, double mechanical_energy, const StepStats& stats) const;
 

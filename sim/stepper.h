@@ -73,7 +73,8 @@ struct Penetration {
 
 struct StepStats {
   Energy energy;                          // J, after the step
-  double elastic_energy = 0;              // J, in the contact springs at the start of the step (CPU reference)
+  double elastic_energy = 0;              // J, in the contact springs at the start of the step (CPU reference),
+                                          // and in the bonds (sim/bonds.h)
   std::size_t contacts = 0;               // particle pairs in contact (each pair once)
   std::size_t wall_contacts = 0;          // particle-wall contacts
   double max_overlap_ratio = 0;           // largest overlap / smaller radius
@@ -81,6 +82,7 @@ struct StepStats {
   std::size_t angular_velocity_clamps = 0;
   std::size_t overlap_clamps = 0;         // contacts whose overlap was capped
   std::size_t spring_overflows = 0;       // contacts beyond a particle's spring slots (no spring: viscous only)
+  std::size_t bonds_broken = 0;           // bonds of breakable props broken by the step (summed by advance())
   Penetration penetration;                // when check_penetration is on
 };
 

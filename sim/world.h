@@ -14,6 +14,7 @@
 #include <limits>
 #include <vector>
 
+#include "sim/bonds.h"
 #include "sim/contact_model.h"
 #include "sim/grain.h"
 #include "sim/keyframes.h"
@@ -101,6 +102,10 @@ struct World {
   Walls walls;                               // rough walls are static bodies made of particles
   std::vector<KinematicTrack> tracks;        // keyframed kinematic bodies
   std::vector<Material> materials;
+  // Breakable props (issue 48): the bonds between their spheres, indexed by particle, and the bond
+  // materials they name (BondSet::material). Empty in a scene without breakable props.
+  BondSet bonds;
+  std::vector<BondMaterial> bond_materials;
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2
   double time = 0;                           // s
 };

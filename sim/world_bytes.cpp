@@ -108,6 +108,71 @@ std::vector<Material> get_materials(ByteReader& r) {
   });
 }
 
+void put_bonds(ByteWriter& w, const World& world) {
+  put_each(w, world.bond_materials, [&](const BondMaterial& m) {
+    for (double v : {m.youngs_modulus, m.stiffness_ratio, m.radius_factor, m.tensile_strength, m.shear_strength,
+                     m.strength_spread, m.bond_distance})
+      w.put(v);
+  });
+  const BondSet& b = world.bonds;
+  for (const auto* v : {&b.a, &b.b}) w.put_vector(*v);
+  w.put_vector(b.material);
+  w.put_vector(b.tensile_strength);
+  w.put_vector(b.shear_strength);
+  w.put_vector(b.intact);
+  put_each(w, b.state, [&](const BondState<double>& s) {
+    w.put(s.normal_force);
+    w.put(s.shear_force);
+    w.put(s.twisting_moment);
+    w.put(s.bending_moment);
+  });
+}
+
+void get_bonds(ByteReader& r, World& world) {
+  world.bond_materials = get_each<BondMaterial>(r, 56, [&](BondMaterial& m) {
+    for (double* v : {&m.youngs_modulus, &m.stiffness_ratio, &m.radius_factor, &m.tensile_strength,
+                      &m.shear_strength, &m.strength_spread, &m.bond_distance})
+      r.get(*v);
+  });
+  BondSet& b = world.bonds;
+  b.a = r.get_vector<std::uint32_t>();
+  b.b = r.get_vector<std::uint32_t>();
+  b.material = r.get_vector<std::uint16_t>();
+  b.tensile_strength = r.get_vector<double>();
+  b.shear_strength = r.get_vector<double>();
+  b.intact = r.get_vector<std::uint8_t>();
+  b.state = get_each<BondState<double>>(r, 64, [&](BondState<double>& s) {
+    r.get(s.normal_force);
+    r.get(s.shear_force);
+    r.get(s.twisting_moment);
+    r.get(s.bending_moment);
+  });
+}
+
+// Bonds join two different particles of the world, name a bond material, and carry finite loads
+// within strengths that are positive: a crafted file must not index out of range or resume into NaN.
+void check_bonds(const World& w, ByteReader& r) {
+  const BondSet& b = w.bonds;
+  const std::size_t n = b.size();
+  if (b.b.size() != n || b.material.size() != n || b.tensile_strength.size() != n || b.shear_strength.size() != n ||
+      b.intact.size() != n || b.state.size() != n)
+    r.fail("the bonds' arrays differ in length");
+  for (std::size_t k = 0; k < n; ++k) {
+    if (b.a[k] >= w.particles.size() || b.b[k] >= w.particles.size() || b.a[k] == b.b[k] ||
+        b.material[k] >= w.bond_materials.size() || b.intact[k] > 1)
+      r.fail(fmt::format("bond {} names missing particles or a missing bond material", k));
+    const BondState<double>& s = b.state[k];
+    if (!(b.tensile_strength[k] > 0 && b.shear_strength[k] > 0 && std::isfinite(b.tensile_strength[k]) &&
+          std::isfinite(b.shear_strength[k]) && std::isfinite(s.normal_force) && s.shear_force.allFinite() &&
+          std::isfinite(s.twisting_moment) && s.bending_moment.allFinite()))
+      r.fail(fmt::format("bond {} has a strength that is not finite and > 0, or a load that is not finite", k));
+  }
+  for (std::size_t i = 0; i < w.bond_materials.size(); ++i) {
+    if (const std::string problem = validate(w.bond_materials[i]); !problem.empty())
+      r.fail(fmt::format("bond material of entry {}: {}", i, problem));
+  }
+}
+
 // Does the world hang together (a damaged or hand-made file must not index out of range later)?
 void check_world(const World& w, ByteReader& r) {
   const Bodies& b = w.bodies;
@@ -287,6 +352,7 @@ std::string world_bytes(const World& world) {
   put_walls(w, world.walls);
   put_tracks(w, world.tracks);
   put_materials(w, world.materials);
+  put_bonds(w, world);
   w.put(world.gravity);
   w.put(world.time);
   return w.bytes();
@@ -304,10 +370,12 @@ World world_from_bytes(ByteReader& r) {
   get_walls(r, world.walls);
   world.tracks = get_tracks(r);
   world.materials = get_materials(r);
+  get_bonds(r, world);
   r.get(world.gravity);
   r.get(world.time);
   if (!r.done()) r.fail("bytes left after the world");
   check_world(world, r);
+  check_bonds(world, r);
   check_world_values(world, r);
   return world;
 }

@@ -1,0 +1,258 @@
+// Bonded spheres in the CPU reference (sim/cpu_bonds.h): criterion 2 of docs/validation.md "Bonded
+// particles" for a whole body, bonds breaking into contacts, the bonds in checkpoints, and the GPU
+// pipeline's refusal until it has the law.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "core/error.h"
+#include "sim/cpu_bonds.h"
+#include "sim/cpu_stepper.h"
+#include "sim/gpu_stepper.h"
+#include "sim/state_bytes.h"
+#include "sim/world_bytes.h"
+
+namespace ts::sim {
+namespace {
+
+using V = Eigen::Vector3d;
+constexpr double kRadius = 1e-3;  // m
+
+BondMaterial cement(double strength = 1e9) {
+  BondMaterial m;
+  m.youngs_modulus = 1e8;
+  m.tensile_strength = strength;
+  m.shear_strength = strength;
+  return m;
+}
+
+// An FCC block of n^3 cells of touching spheres, each sphere its own dynamic body, all bonded.
+World bonded_block(int n, const BondMaterial& bond, const V& centre = V::Zero()) {
+  World w;
+  w.materials.push_back(Material{});
+  w.gravity = V::Zero();
+  const double edge = 2.0 * std::sqrt(2.0) * kRadius;
+  const V basis[4] = {V(0, 0, 0), V(0.5, 0.5, 0), V(0.5, 0, 0.5), V(0, 0.5, 0.5)};
+  std::vector<V> centres;
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        for (const V& b : basis) centres.push_back(edge * (V(x, y, z) + b));
+  V mean = V::Zero();
+  for (const V& c : centres) mean += c;
+  mean /= static_cast<double>(centres.size());
+  for (V& c : centres) c += centre - mean;  // the block's centre of mass at `centre`
+  const double mass = w.materials[0].density * 4.0 * std::sqrt(2.0) * std::pow(kRadius, 3);  // a lattice cell's
+  for (const V& c : centres) {
+    BodyDesc d;
+    d.position = c;
+    d.inverse_mass = 1.0 / mass;
+    d.inverse_inertia = Eigen::Matrix3d::Identity() / (0.4 * mass * kRadius * kRadius);
+    add_body(w, d, {V::Zero()}, {kRadius}, 0);
+  }
+  w.bonds = build_bonds(centres, std::vector<double>(centres.size(), kRadius), bond, 11);
+  w.bond_materials = {bond};
+  return w;
+}
+
+double bond_step(const World& w) {
+  std::vector<double> masses, radii;
+  for (std::size_t k = 0; k < w.bodies.size(); ++k) masses.push_back(1.0 / w.bodies.inverse_mass[k]);
+  radii = w.particles.radius;
+  return bond_time_step(w.bonds, masses, radii, w.bond_materials[0]);
+}
+
+StepSettings symplectic(double dt) {
+  StepSettings s;
+  s.dt = dt;
+  s.integrator = Integrator::SemiImplicitEuler;
+  s.design_speed = 1.0;
+  return s;
+}
+
+// Kinetic energy with each body's mid-step velocities (the mean of the two half-step ones).
+double mid_step_kinetic(const World& before, const World& after) {
+  double e = 0;
+  for (std::size_t k = 0; k < after.bodies.size(); ++k) {
+    const double m = 1.0 / after.bodies.inverse_mass[k];
+    const double inertia = 1.0 / after.bodies.inverse_inertia[k](0, 0);
+    const V v = 0.5 * (before.bodies.linear_velocity[k] + after.bodies.linear_velocity[k]);
+    const V w = 0.5 * (before.bodies.angular_velocity[k] + after.bodies.angular_velocity[k]);
+    e += 0.5 * m * v.squaredNorm() + 0.5 * inertia * w.squaredNorm();
+  }
+  return e;
+}
+
+// Spins the block about its centre and shakes each sphere (up to `shake`, m/s), so every bond
+// stretches, shears, twists and bends.
+void launch(World& w, const V& spin, double shake) {
+  for (std::size_t k = 0; k < w.bodies.size(); ++k) {
+    const double wobble = shake * std::sin(1.7 * static_cast<double>(k));  // m/s
+    w.bodies.linear_velocity[k] = spin.cross(w.bodies.position[k]) + V(wobble, -0.5 * wobble, 0.3 * wobble);
+    w.bodies.angular_velocity[k] = spin;
+  }
+}
+
+TEST(CpuBonds, UnbrokenBodyKeepsItsEnergyWithoutDampingOrContact) {
+  World w = bonded_block(2, cement());
+  launch(w, V(0.0, 0.0, 2.0), 1e-4);
+  const double dt = bond_step(w);
+  CpuStepper stepper(w, symplectic(dt));
+  double first = 0, worst = 0;
+  for (int k = 0; k < 10000; ++k) {
+    const World before = w;
+    const double held = bond_energy(w);  // at the step's start, where the loads are taken
+    stepper.step(w);
+    const double energy = mid_step_kinetic(before, w) + held;
+    if (k == 0) first = energy;
+    worst = std::max(worst, std::abs(energy / first - 1.0));
+  }
+  EXPECT_EQ(w.bonds.intact_count(), w.bonds.size());
+  std::printf("bonded block: largest energy error %.3g over 10^4 steps at dt = %.3g s\n", worst, dt);
+  EXPECT_LT(worst, 0.005) << "criterion 2: 0.5 % over 10^4 steps at the bonds' time step";
+}
+
+TEST(CpuBonds, StiffBondedBodyTurnsAsTheRigidBodyDoes) {
+  BondMaterial stiff = cement();
+  stiff.youngs_modulus = 100 * Material{}.youngs_modulus;  // criterion 2: 100x the contact modulus
+  World w = bonded_block(2, stiff);
+  const V spin(0.0, 0.0, 1000.0);  // rad/s: half a turn and more over the run
+  for (std::size_t k = 0; k < w.bodies.size(); ++k) {
+    w.bodies.linear_velocity[k] = spin.cross(w.bodies.position[k]);
+    w.bodies.angular_velocity[k] = spin;
+  }
+  const std::vector<V> start = w.bodies.position;
+  const double dt = bond_step(w);
+  CpuStepper stepper(w, symplectic(dt));
+  const int steps = 10000;
+  stepper.advance(w, steps);
+  const Eigen::AngleAxisd turn(spin.norm() * dt * steps, spin.normalized());
+  double size = 0, worst = 0;
+  for (std::size_t k = 0; k < start.size(); ++k) {
+    size = std::max(size, start[k].norm());
+    worst = std::max(worst, (w.bodies.position[k] - turn * start[k]).norm());
+  }
+  EXPECT_GT(spin.norm() * dt * steps, 0.5) << "the test must turn the block by a good angle";
+  std::printf("stiff bonded block: largest departure from the rigid turn %.3g of its size\n", worst / size);
+  EXPECT_LT(worst, 0.01 * size) << "criterion 2: within 1 % of the rigid rotation";
+}
+
+// A block thrown at a floor of static spheres: how many bonds break, and how deep the pieces go.
+struct Throw {
+  std::size_t broken = 0, bonds = 0;
+  double max_overlap_ratio = 0;
+};
+
+Throw throw_at_floor(double strength, double speed) {
+  World w = bonded_block(2, cement(strength), V(0, 0, 0.01));
+  w.gravity = V(0, 0, -9.81);
+  std::vector<V> floor;
+  for (int i = -6; i <= 6; ++i)
+    for (int j = -6; j <= 6; ++j) floor.emplace_back(2 * kRadius * i, 2 * kRadius * j, 0.0);
+  BodyDesc ground;
+  ground.motion = MotionType::Static;
+  add_body(w, ground, floor, std::vector<double>(floor.size(), kRadius), 0);
+  for (std::size_t k = 0; k + 1 < w.bodies.size(); ++k) w.bodies.linear_velocity[k] = V(0, 0, -speed);
+  StepSettings s = symplectic(std::min(bond_step(w), 2e-7));
+  s.design_speed = speed;
+  CpuStepper stepper(w, s);
+  Throw out;
+  out.bonds = w.bonds.size();
+  const double fall = (0.01 - 4 * kRadius) / speed;  // s until the block reaches the floor
+  const auto steps = static_cast<std::int64_t>(1.5 * fall / s.dt);
+  for (std::int64_t k = 0; k < steps; ++k) {
+    const StepStats stats = stepper.step(w);
+    out.broken += stats.bonds_broken;
+    out.max_overlap_ratio = std::max(out.max_overlap_ratio, stats.max_overlap_ratio);
+  }
+  EXPECT_EQ(out.broken, w.bonds.size() - w.bonds.intact_count());
+  return out;
+}
+
+TEST(CpuBonds, StrongBondsHoldAnImpactThatBreaksWeakOnesIntoTouchingPieces) {
+  const Throw strong = throw_at_floor(1e9, 1.0);
+  EXPECT_EQ(strong.broken, 0u);
+  const Throw weak = throw_at_floor(2e4, 1.0);  // Hertz at 1 m/s: about 5e4 Pa across a bond
+  std::printf("thrown block: %zu of %zu bonds broken; largest overlap / r %.3g (strong: %.3g)\n", weak.broken,
+              weak.bonds, weak.max_overlap_ratio, strong.max_overlap_ratio);
+  EXPECT_GT(weak.broken, 0u);
+  // The pieces still meet through the contact law once their bonds are gone. A lone sphere hitting the
+  // floor at 1 m/s sinks about 0.1 r by Hertz; the block pressing with its whole mass goes deeper; a
+  // piece passing through another (a contact left out) would go past r.
+  EXPECT_LT(weak.max_overlap_ratio, 0.5);
+}
+
+TEST(CpuBonds, BondedSpheresTakeNoContactForceUntilTheirBondBreaks) {
+  World w = bonded_block(1, cement());
+  for (V& p : w.bodies.position) p *= 0.98;  // every bonded pair overlaps a little
+  CpuStepper stepper(w, symplectic(1e-8));
+  EXPECT_TRUE(stepper.contacts(w).empty());
+
+  // Two touching spheres bonded weakly in shear, pressed together and slid past each other: once the
+  // bond breaks in a step, the same stepper's next lists hold the pair as a contact.
+  World two;
+  two.materials = {Material{}};
+  two.gravity = V::Zero();
+  const double mass = 1.0 / w.bodies.inverse_mass[0];
+  for (double x : {-kRadius, kRadius}) {
+    BodyDesc d;
+    d.position = V(x, 0, 0);
+    d.linear_velocity = V(x > 0 ? -0.01 : 0.01, x > 0 ? 0.05 : -0.05, 0);
+    d.inverse_mass = 1.0 / mass;
+    d.inverse_inertia = Eigen::Matrix3d::Identity() / (0.4 * mass * kRadius * kRadius);
+    add_body(two, d, {V::Zero()}, {kRadius}, 0);
+  }
+  BondMaterial weak_shear = cement();
+  weak_shear.shear_strength = 1e3;
+  two.bonds = build_bonds({two.bodies.position[0], two.bodies.position[1]}, {kRadius, kRadius}, weak_shear, 1);
+  two.bond_materials = {weak_shear};
+  ASSERT_EQ(two.bonds.size(), 1u);
+  CpuStepper slide(two, symplectic(1e-8));
+  std::size_t broke = 0;
+  for (int k = 0; k < 1000 && broke == 0; ++k) broke = slide.step(two).bonds_broken;
+  ASSERT_EQ(broke, 1u);
+  EXPECT_EQ(slide.step(two).contacts, 1u) << "the broken pair meets through the contact law";
+}
+
+TEST(CpuBonds, ResumedRunWithBondsGoesOnBitForBit) {
+  World w = bonded_block(2, cement(3e4), V(0, 0, 0));
+  launch(w, V(50.0, -30.0, 80.0), 0.5);  // shaken hard enough to break some bonds
+  const StepSettings s = symplectic(bond_step(w));
+  CpuStepper straight(w, s);
+  straight.advance(w, 300);
+  const std::string world_saved = world_bytes(w);
+  const std::string engine_saved = straight.save_state();
+  straight.advance(w, 300);
+
+  ByteReader reader(world_saved, "the saved world");
+  World resumed = world_from_bytes(reader);
+  CpuStepper again(s);
+  again.restore_state(resumed, engine_saved);
+  again.advance(resumed, 300);
+  EXPECT_EQ(world_bytes(resumed), world_bytes(w));
+  EXPECT_GT(w.bonds.size() - w.bonds.intact_count(), 0u) << "the run should break bonds on the way";
+}
+
+TEST(CpuBonds, DamagedBondsInASavedWorldAreRefused) {
+  World w = bonded_block(1, cement());
+  w.bonds.b[0] = static_cast<std::uint32_t>(w.particles.size());  // past the last sphere
+  const std::string bytes = world_bytes(w);
+  ByteReader reader(bytes, "the saved world");
+  EXPECT_THROW(world_from_bytes(reader), std::exception);
+}
+
+TEST(CpuBonds, GpuPipelineRefusesBondsUntilItHasTheLaw) {
+  gpu::Context context;
+  const World w = bonded_block(1, cement());
+  try {
+    GpuStepper gpu(context, w, symplectic(1e-8), Precision::Double);
+    FAIL() << "the GPU pipeline took a world with bonds";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--backend cpu"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace ts::sim
