@@ -9,6 +9,7 @@
 
 #include "app/commands.h"
 #include "app/numeric_options.h"
+#include "app/preview_report.h"
 #include "app/progress.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -35,6 +36,7 @@ struct Options {
   double fov = 30.0, particle_radius = 0.0, color_max = 0.0, voxel = 0.0, band = 3.0, scale = 1.0;
   int resolution = 192, turntable = 1;
   bool ortho = false, contact_sheet = false, alpha = false, no_ground = false, no_shadows = false, timings = false;
+  bool json = false;  // the report as JSON on standard output instead of the summary
 };
 
 Eigen::Vector3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
@@ -165,6 +167,9 @@ void add_lighting_options(CLI::App* cmd, Options& o) {
   cmd->add_flag("--no-ground", o.no_ground, "No ground plane");
   cmd->add_flag("--no-shadows", o.no_shadows, "No shadow map");
   cmd->add_flag("--timings", o.timings, "Per-pass times (GPU timer queries, or wall time on the CPU)");
+  cmd->add_flag("--json", o.json,
+                "Print the report (inputs, PNGs written, image size, backend and device, what was drawn, "
+                "per-pass times) as JSON on standard output");
 }
 
 // Combinations CLI11 cannot check by itself.
@@ -336,21 +341,63 @@ void print_summary(const Options& o, const Eigen::Vector2i& size, const Content&
 // The renderer the backend rule picks (gpu/backend.h); `context` is made only where it asks the
 // device (auto) or draws there (gpu), so --backend cpu runs without EGL.
 std::unique_ptr<preview::ImageRenderer> make_renderer(const Options& o, const GlobalOptions& global,
-                                                      std::unique_ptr<gpu::Context>& context) {
+                                                      std::unique_ptr<gpu::Context>& context,
+                                                      PreviewReport& report) {
   const gpu::Backend requested = gpu::parse_backend(o.backend).value();  // CLI::IsMember checked it
   if (requested != gpu::Backend::Cpu) context = std::make_unique<gpu::Context>(context_options(global));
   const gpu::Backend chosen = gpu::resolve_backend(requested, context.get());
-  fmt::print("{}\n", gpu::backend_line(requested, chosen, gpu::describe(context.get()), true, "renderer"));
-  if (chosen == gpu::Backend::Gpu) return std::make_unique<preview::Renderer>(*context, o.timings);
+  const std::string line =
+      gpu::backend_line(requested, chosen, gpu::describe(context.get()), true, "renderer");
+  if (o.json) {
+    log::info("{}", line);  // standard output stays the JSON
+  } else {
+    fmt::print("{}\n", line);
+  }
+  report.requested_backend = o.backend;
+  report.backend = gpu::backend_name(chosen);
+  const bool timings = o.timings || o.json;  // --json reports the per-pass times
+  if (chosen == gpu::Backend::Gpu) return std::make_unique<preview::Renderer>(*context, timings);
   context.reset();  // the CPU draws and builds the field: the context is not needed any more
-  return std::make_unique<preview::CpuRenderer>(o.timings);
+  return std::make_unique<preview::CpuRenderer>(timings);
+}
+
+// --json: the run's figures into the report, printed as one JSON object.
+void print_json(const Options& o, const Eigen::Vector2i& size, const Content& content, const Views& views,
+                const preview::RenderSettings& settings, preview::ImageRenderer& renderer, PreviewReport& r) {
+  r.field_input = o.input;
+  r.particles_input = o.particles;
+  for (int k = 0; k < (o.contact_sheet ? 1 : o.turntable); ++k) {
+    r.outputs.push_back(o.turntable > 1 && !o.contact_sheet ? numbered(o.output, k, o.turntable)
+                                                            : std::filesystem::path(o.output));
+  }
+  r.width = size.x();
+  r.height = size.y();
+  r.views = o.turntable;
+  r.contact_sheet = o.contact_sheet;
+  r.device = renderer.device();
+  r.field = content.field;
+  r.voxel_size = content.voxel_size;
+  if (const preview::Particles& p = content.loaded.particles; !p.centers.empty()) {
+    r.particles = p.centers.size();
+    r.particle_radius = p.radii[0];
+    r.radius_source = content.loaded.radius_source;
+  }
+  r.colour_by = o.color_by;
+  r.colour_pixels = views.scalar.pixels;
+  r.colour_mean = views.scalar.mean;  // summed over pixels by render_views
+  r.colour_max = views.scalar.max;
+  r.colour_map_max = settings.surface_scalar.max_value;
+  r.render_seconds = views.seconds;
+  r.timing_report = renderer.timing_report();
+  fmt::print("{}\n", preview_report_json(r).dump(2));
 }
 
 int run_preview(const Options& o, const GlobalOptions& global) {
   check_options(o);
   const Eigen::Vector2i size = parse_size(o.size);
   std::unique_ptr<gpu::Context> context;
-  const std::unique_ptr<preview::ImageRenderer> renderer = make_renderer(o, global, context);
+  PreviewReport report;
+  const std::unique_ptr<preview::ImageRenderer> renderer = make_renderer(o, global, context, report);
   renderer->check_image_size(size.x(), size.y());
   Content content;
   load_field(o, context.get(), *renderer, content);
@@ -360,6 +407,10 @@ int run_preview(const Options& o, const GlobalOptions& global) {
   set_lighting(o, size, settings);
   const preview::Camera camera = make_camera(o, renderer->content_box(), static_cast<double>(size.x()) / size.y());
   const Views views = render_views(o, *renderer, settings, camera, content.inputs);
+  if (o.json) {
+    print_json(o, size, content, views, settings, *renderer, report);
+    return 0;
+  }
   print_summary(o, size, content, views, settings, *renderer);
   if (o.timings) fmt::print("{}", renderer->timing_report());
   return 0;

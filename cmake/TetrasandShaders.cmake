@@ -1,10 +1,10 @@
 # Shaders are validated at build time by glslangValidator, so a GLSL error fails the build, not a run,
 # and are copied next to the executables (build tree) and installed beside them (share/tetrasand/shaders).
 #
-# tetrasand_add_shaders(<target> <file>...) with files relative to ${CMAKE_SOURCE_DIR}/shaders.
+# tetrasand_add_shaders(<target> <file>...) with files relative to ${PROJECT_SOURCE_DIR}/shaders.
 function(tetrasand_add_shaders target)
   set(stamps)
-  set(shader_root ${CMAKE_SOURCE_DIR}/shaders)
+  set(shader_root ${PROJECT_SOURCE_DIR}/shaders)
   # A kernel may include any header of any stage (common/, preview/...), so each check depends on all.
   file(GLOB_RECURSE shared_headers CONFIGURE_DEPENDS ${shader_root}/*.h ${shader_root}/*.glsl)
   foreach(rel IN LISTS ARGN)
@@ -37,11 +37,11 @@ function(tetrasand_add_shader_headers target)
   foreach(rel IN LISTS ARGN)
     set(dst ${TETRASAND_SHADER_BUILD_DIR}/${rel})
     add_custom_command(OUTPUT ${dst}
-      COMMAND ${CMAKE_COMMAND} -E copy_if_different ${CMAKE_SOURCE_DIR}/shaders/${rel} ${dst}
-      DEPENDS ${CMAKE_SOURCE_DIR}/shaders/${rel} VERBATIM)
+      COMMAND ${CMAKE_COMMAND} -E copy_if_different ${PROJECT_SOURCE_DIR}/shaders/${rel} ${dst}
+      DEPENDS ${PROJECT_SOURCE_DIR}/shaders/${rel} VERBATIM)
     list(APPEND outs ${dst})
     get_filename_component(rel_dir ${rel} DIRECTORY)
-    install(FILES ${CMAKE_SOURCE_DIR}/shaders/${rel} DESTINATION share/tetrasand/shaders/${rel_dir})
+    install(FILES ${PROJECT_SOURCE_DIR}/shaders/${rel} DESTINATION share/tetrasand/shaders/${rel_dir})
   endforeach()
   add_custom_target(${target} ALL DEPENDS ${outs})
 endfunction()

@@ -36,6 +36,11 @@ fs::path ShaderLibrary::default_root() {
   const fs::path beside = executable_directory() / ".." / "share" / "tetrasand" / "shaders";
   std::error_code ec;
   if (fs::is_directory(beside, ec)) return fs::weakly_canonical(beside, ec);
+  // A program of another project, linked against the installed package, lives elsewhere: the prefix
+  // this library was configured to install to holds the kernels of the same build.
+#ifdef TETRASAND_SHADER_INSTALL_DIR
+  if (fs::is_directory(TETRASAND_SHADER_INSTALL_DIR, ec)) return TETRASAND_SHADER_INSTALL_DIR;
+#endif
 #ifdef TETRASAND_SHADER_BUILD_DIR
   if (fs::is_directory(TETRASAND_SHADER_BUILD_DIR, ec)) return TETRASAND_SHADER_BUILD_DIR;
 #endif

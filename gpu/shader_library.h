@@ -16,7 +16,8 @@ struct ShaderSource {
 class ShaderLibrary {
  public:
   // TETRASAND_SHADER_DIR, else <exe>/../share/tetrasand/shaders (build tree and install tree alike),
-  // else the build tree this binary was configured in.
+  // else <CMAKE_INSTALL_PREFIX>/share/tetrasand/shaders as configured (programs of other projects
+  // linking the installed package), else the build tree this binary was configured in.
   static std::filesystem::path default_root();
 
   explicit ShaderLibrary(std::filesystem::path root = default_root());

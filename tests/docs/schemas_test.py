@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The published JSON Schemas (docs/schemas/) hold for what tetrasand writes: a body from `sample`, the
-bundled bodies `sample` made, and the `--json` reports of `info`, `sdf`, `sample`, `sim`, `export lammps`
-and `frames`; a body with a key missing or a wrong unit fails its schema, and so does a report with a key
+bundled bodies `sample` made, and the `--json` reports of `info`, `sdf`, `sample`, `sim`, `export lammps`,
+`preview` and `frames`; a body with a key missing or a wrong unit fails its schema, and so does a report with a key
 it does not define (so the check can fail). Debian's python3-jsonschema.
 
   schemas_test.py TETRASAND_BINARY SOURCE_DIR      exit 0 when every check holds
@@ -81,13 +81,30 @@ def check_reports(binary, source, work):
     expect_valid(validator(source, "export-report.schema.json"), deck, "export lammps --json")
     frames = os.path.join(work, "frames")
     os.makedirs(frames)
-    res = subprocess.run([binary, "preview", os.path.join(source, "assets", "cube.obj"), "-o",
-                          os.path.join(frames, "frame_000000.png"), "--size", "48x32", "--resolution", "16"],
-                         capture_output=True, text=True, cwd=work)
-    check(res.returncode == 0, f"preview exits 0: {res.stderr[-600:]}")
+    check_preview_reports(binary, source, work, os.path.join(frames, "frame_000000.png"))
     shutil.copy(os.path.join(frames, "frame_000000.png"), os.path.join(frames, "frame_000001.png"))
     sheet = run_json(binary, ["frames", frames, "-o", os.path.join(work, "sheet.png"), "--json"], work)
     expect_valid(validator(source, "frames-report.schema.json"), sheet, "frames --json")
+
+
+def check_preview_reports(binary, source, work, png):
+    """preview --json on the CPU (a mesh) and on the GL device (a mesh, the sample's body, a turntable)."""
+    v = validator(source, "preview-report.schema.json")
+    cpu = run_json(binary, ["preview", os.path.join(source, "assets", "cube.obj"), "-o", png, "--size", "48x32",
+                            "--resolution", "16", "--backend", "cpu", "--json"], work)
+    expect_valid(v, cpu, "preview --json (CPU)")
+    check(cpu["outputs"] == [png] and os.path.isfile(png), f"preview --json names the PNG it wrote: {cpu['outputs']}")
+    check(cpu["backend"]["chosen"] == "cpu" and cpu["passes"], "preview --json (CPU) reports its passes")
+    check(not v.is_valid(dict(cpu, surprise=1)), "a preview report with an unknown key fails its schema")
+    gpu = run_json(binary, ["preview", os.path.join(source, "assets", "sphere.obj"), "--particles",
+                            os.path.join(work, "body", "sphere.body.json"), "-o", "turn.png", "--size", "32x32",
+                            "--resolution", "16", "--turntable", "2", "--color-by", "particle-distance",
+                            "--backend", "gpu", "--json"], work)
+    expect_valid(v, gpu, "preview --json (GPU)")
+    check(gpu["outputs"] == ["turn_000.png", "turn_001.png"] and all(
+        os.path.isfile(os.path.join(work, f)) for f in gpu["outputs"]), f"the turntable's PNGs: {gpu['outputs']}")
+    check(gpu["backend"]["chosen"] == "gpu" and gpu["passes"] and gpu["drawn"]["particles"]["count"] > 0,
+          "preview --json (GPU) reports its passes and the body's particles")
 
 
 def main():
@@ -95,7 +112,7 @@ def main():
     with tempfile.TemporaryDirectory() as work:
         check_bodies(binary, source, work)
         check_reports(binary, source, work)
-    print("schemas_test: body.json and the info, sdf, sample, sim, export and frames reports meet docs/schemas/")
+    print("schemas_test: body.json and the info, sdf, sample, sim, export, preview and frames reports meet docs/schemas/")
 
 
 if __name__ == "__main__":

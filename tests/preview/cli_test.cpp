@@ -7,6 +7,8 @@
 #include <openvdb/tools/LevelSetSphere.h>
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <utility>
 
 #include "core/atomic_file.h"
@@ -156,6 +158,36 @@ TEST(CliPreview, BadInputsExitWithClearMessages) {
   std::string out;
   EXPECT_EQ(test::run_tetrasand("preview " + q(dir / "sphere.obj") + " -o " + q(dir / "sphere.obj") + " --size 8x8 --resolution 16", &out), 1) << out;
   EXPECT_EQ(read_file(dir / "sphere.obj"), read_file(test::asset("sphere.obj")));
+}
+
+// --json: standard output is the report alone (the backend line goes to the log), naming each PNG of a
+// turntable and the renderer's passes (docs/schemas/preview-report.schema.json has the whole form).
+TEST(CliPreview, JsonReportNamesEachTurntableViewAndTheRenderersPasses) {
+  const auto dir = test::temp_dir();
+  std::string log;
+  ASSERT_EQ(test::run_tetrasand("preview " + q(test::asset("cube.obj")) + " -o " + q(dir / "t.png") +
+                                    " --size 24x16 --resolution 16 --turntable 3 --backend cpu --json > " +
+                                    q(dir / "report.json"),
+                                &log),
+            0)
+      << log;
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "report.json"));
+  ASSERT_EQ(report["outputs"].size(), 3u) << report.dump(2);
+  for (int k = 0; k < 3; ++k) {
+    const std::filesystem::path png = dir / ("t_00" + std::to_string(k) + ".png");
+    EXPECT_EQ(report["outputs"][k].get<std::string>(), png.string());
+    EXPECT_EQ(preview::read_png(png).width, 24);
+  }
+  EXPECT_EQ(report["image"]["width"], 24);
+  EXPECT_EQ(report["image"]["height"], 16);
+  EXPECT_EQ(report["image"]["views"], 3);
+  EXPECT_EQ(report["backend"]["chosen"], "cpu");
+  EXPECT_GT(report["drawn"]["field"]["voxel_size_m"].get<double>(), 0.0);
+  EXPECT_TRUE(report["drawn"]["particles"].is_null());
+  ASSERT_FALSE(report["passes"].empty()) << report.dump(2);
+  for (const auto& pass : report["passes"]) EXPECT_GE(pass["milliseconds"].get<double>(), 0.0);
+  EXPECT_EQ(log.find("backend: cpu"), std::string::npos)
+      << "the backend line went to standard output: " << log;
 }
 
 TEST(CliPreview, SampleWritesAPreviewBesideTheBody) {

@@ -1,0 +1,78 @@
+#include "app/preview_report.h"
+
+#include <regex>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace ts::app {
+
+std::vector<PassTime> parse_pass_times(const std::string& table) {
+  static const std::regex row(R"(^(\S.*?)\s+(\d+)\s+(\d+(?:\.\d+)?)\s+(\d+(?:\.\d+)?)%$)");
+  static const std::regex total(R"(^total\s+\d+(?:\.\d+)?$)");
+  std::vector<PassTime> passes;
+  std::istringstream lines(table);
+  std::string line;
+  bool header = true;
+  while (std::getline(lines, line)) {
+    if (header) {  // "GPU kernel ... calls total ms share" or "CPU pass ..."
+      header = false;
+      continue;
+    }
+    std::smatch m;
+    if (std::regex_match(line, m, row)) {
+      passes.push_back({m[1].str(), std::stoull(m[2].str()), std::stod(m[3].str())});
+    } else if (!std::regex_match(line, total)) {
+      throw Error(ExitCode::Internal,
+                  "preview --json: a per-pass timing line of an unknown form: '" + line + "'");
+    }
+  }
+  return passes;
+}
+
+namespace {
+
+nlohmann::ordered_json or_null(const std::string& text) {
+  return text.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(text);
+}
+
+nlohmann::ordered_json drawn_json(const PreviewReport& r) {
+  nlohmann::ordered_json particles = nullptr;
+  if (r.particles > 0) {
+    particles = {{"count", r.particles}, {"radius_m", r.particle_radius}, {"radius_source", r.radius_source}};
+  }
+  nlohmann::ordered_json field = nullptr;
+  if (!r.field.empty()) field = {{"description", r.field}, {"voxel_size_m", r.voxel_size}};
+  nlohmann::ordered_json colour = nullptr;
+  if (r.colour_pixels > 0) {
+    colour = {{"by", r.colour_by},
+              {"pixels", r.colour_pixels},
+              {"mean", r.colour_mean / static_cast<double>(r.colour_pixels)},
+              {"max", r.colour_max},
+              {"map_max", r.colour_map_max}};
+  }
+  return {{"field", field}, {"particles", particles}, {"colour", colour}};
+}
+
+}  // namespace
+
+nlohmann::ordered_json preview_report_json(const PreviewReport& r) {
+  nlohmann::ordered_json outputs = nlohmann::ordered_json::array();
+  for (const std::filesystem::path& p : r.outputs) outputs.push_back(p.string());
+  nlohmann::ordered_json passes = nlohmann::ordered_json::array();
+  for (const PassTime& p : parse_pass_times(r.timing_report)) {
+    passes.push_back({{"name", p.name}, {"calls", p.calls}, {"milliseconds", p.milliseconds}});
+  }
+  return {
+      {"inputs", {{"field", or_null(r.field_input)}, {"particles", or_null(r.particles_input)}}},
+      {"outputs", outputs},
+      {"image",
+       {{"width", r.width}, {"height", r.height}, {"views", r.views}, {"contact_sheet", r.contact_sheet}}},
+      {"backend", {{"requested", r.requested_backend}, {"chosen", r.backend}, {"device", r.device}}},
+      {"drawn", drawn_json(r)},
+      {"render_seconds", r.render_seconds},
+      {"passes", passes},
+  };
+}
+
+}  // namespace ts::app
