@@ -32,6 +32,7 @@ namespace {
 struct Options {
   std::string input, output, particles, size = "800x800", view = "iso", color_by = "none";
   std::string backend = "auto";  // where the picture is drawn (gpu/backend.h's rule)
+  std::string sign;              // MESH: pseudonormal (the default) or winding
   std::vector<double> eye, target, up{0.0, 0.0, 1.0}, light;
   double fov = 30.0, particle_radius = 0.0, color_max = 0.0, voxel = 0.0, band = 3.0, scale = 1.0;
   int resolution = 192, turntable = 1;
@@ -154,6 +155,10 @@ void add_sdf_options(CLI::App* cmd, Options& o) {
   cmd->add_option("--band", o.band, "MESH: narrow-band half-width [voxels], >= 2 for clean normals")
       ->check(finite())
       ->capture_default_str();
+  cmd->add_option("--sign", o.sign,
+                  "MESH: inside/outside by pseudonormals (closed meshes; default) or by the generalised winding "
+                  "number (also open or non-manifold meshes), as `sdf --sign` and `sample --sign`")
+      ->check(CLI::IsMember({"pseudonormal", "winding"}));
   cmd->add_option("--scale", o.scale, "MESH and particles: multiply coordinates by this factor first")
       ->check(positive());
 }
@@ -179,6 +184,9 @@ void check_options(const Options& o) {
   if (o.color_by == "error" && (o.input.empty() || is_vdb(o.input))) {
     throw InputError("--color-by error needs a MESH input: the exact distance comes from the mesh");
   }
+  if (!o.sign.empty() && (o.input.empty() || is_vdb(o.input))) {
+    throw InputError("--sign needs a MESH input: a level set carries its own signs");
+  }
   if (o.color_by == "particle-distance" && o.particles.empty()) {
     throw InputError("--color-by particle-distance needs --particles");
   }
@@ -200,15 +208,17 @@ preview::SdfVolume volume_from_mesh_file(const Options& o, gpu::Context* context
   ReportOptions report_options;
   report_options.self_intersections = false;
   const MeshReport report = analyze_mesh(*mesh, report_options);
-  if (!report.closed()) {
-    log::warn("{}: the mesh is not closed ({}); the SDF's signs may be wrong near the holes", o.input,
-              closed_solid_problems(report));
+  const bool winding = o.sign == "winding";
+  if (!report.closed() && !winding) {
+    log::warn("{}: the mesh is not closed ({}); pseudonormal signs may be wrong near the holes: use --sign winding",
+              o.input, closed_solid_problems(report));
   }
   if (o.band < 2.0) throw InputError(fmt::format("--band {}: the preview needs a band of at least 2 voxels", o.band));
   sdf::SdfSettings grid;
   grid.voxel_size = o.voxel;
   grid.resolution = o.resolution;
   grid.band = o.band;
+  grid.sign = winding ? sdf::SignMethod::Winding : sdf::SignMethod::Pseudonormal;
   return naming_file(o.input, [&] {
     return context ? preview::volume_from_mesh(*context, *mesh, grid) : preview::volume_from_mesh_on_cpu(*mesh, grid);
   });
@@ -235,6 +245,18 @@ void load_field(const Options& o, gpu::Context* context, preview::ImageRenderer&
   content.field = fmt::format("SDF {} x {} x {} voxels of {:.4g} m (band {:.3g}; sparse: {} band voxels, {:.1f} MiB)",
                               volume.spec.dims.x(), volume.spec.dims.y(), volume.spec.dims.z(), content.voxel_size,
                               volume.band, volume.band_voxels, volume.grid.size() / 1048576.0);
+  if (volume.inside_out()) {
+    // Ray-cast, this field is a solid box hiding everything: say so, draw the particles alone.
+    const std::string why = fmt::format(
+        "the SDF reads inside at the corner of its box, so its signs are unreliable ({}) and it is not drawn",
+        is_vdb(o.input) ? "an inverted sign convention, or a flood fill that leaked through a hole"
+                        : "an open mesh under pseudonormal signs? --sign winding signs it by the winding number");
+    if (o.particles.empty()) throw InputError(o.input, why + "; nothing else to draw");
+    log::warn("{}: {}", o.input, why);
+    content.field += "; NOT drawn: signs unreliable (inside at the box's corner)";
+    content.voxel_size = 0.0;
+    return;
+  }
   renderer.load_volume(std::move(volume));
 }
 

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "app/commands.h"
@@ -207,16 +208,42 @@ sampler::SampleSettings settings_of(const Options& o) {
   return settings;
 }
 
-void write_preview(const Options& o, gpu::Context* context, const TriangleMesh& mesh,
-                   const body::ParticleBody& body, const std::string& name) {
-  const std::filesystem::path png = std::filesystem::path(o.in.output) / (name + ".preview.png");
+struct PreviewDone {
+  std::filesystem::path png;
+  preview::BodyPreviewReport report;
+  bool on_gpu = false;
+};
+
+// NAME.preview.png, signed as the body was sampled (`sign`): an open mesh sampled by winding number
+// previews as its particles over its winding-number surface, not as the box pseudonormal signs flood.
+PreviewDone write_preview(const Options& o, gpu::Context* context, const TriangleMesh& mesh,
+                          const body::ParticleBody& body, const std::string& name, sdf::SignMethod sign) {
+  PreviewDone done;
+  done.png = std::filesystem::path(o.in.output) / (name + ".preview.png");
   preview::BodyPreviewSettings look;
   look.up = Eigen::Vector3d(o.up[0], o.up[1], o.up[2]);
+  look.sign = sign;
   // The preview is drawn where --backend runs the relaxation (gpu/backend.h): on the CPU without a device
   // or on a software renderer.
-  const bool on_gpu = gpu::resolve_backend(settings_of(o).backend, context) == gpu::Backend::Gpu;
-  preview::write_body_preview(on_gpu ? context : nullptr, mesh, body, png, {o.mesh}, look);
-  log::info("preview: {}", png.string());
+  done.on_gpu = gpu::resolve_backend(settings_of(o).backend, context) == gpu::Backend::Gpu;
+  done.report = preview::write_body_preview(done.on_gpu ? context : nullptr, mesh, body, done.png, {o.mesh}, look);
+  if (!done.report.field_drawn) {
+    log::warn("{}: the preview's SDF reads inside at the corner of its box (signs unreliable): drawn without it, "
+              "the particles alone", o.mesh);
+  }
+  return done;
+}
+
+// The preview's line of the report (a log line under --json: standard output stays the JSON).
+void report_preview(const Options& o, const PreviewDone& done) {
+  const std::string line = fmt::format("{}, {:.2f} s on the {}{}", done.png.string(), done.report.seconds,
+                                       done.on_gpu ? "GPU" : "CPU",
+                                       done.report.field_drawn ? "" : " (particles only: the SDF's signs are unreliable)");
+  if (o.json) {
+    log::info("preview: {}", line);
+  } else {
+    fmt::print("  preview          {}\n", line);
+  }
 }
 
 // One mesh: sample, write the body (and its preview), report and judge it; `row` gets the batch summary's
@@ -240,6 +267,9 @@ int convert_one(const Options& o, gpu::Context* context, BatchRow& row) {
   const std::string name = std::filesystem::path(o.mesh).stem().string();
   const std::filesystem::path json = body::write_body(o.in.output, name, body);
   seconds.write = since(write_start);
+  std::optional<PreviewDone> previewed;
+  if (o.preview) previewed = write_preview(o, context, mesh, body, name, settings.sign);
+  if (previewed) seconds.preview = previewed->report.seconds;
   seconds.total = since(start) + seconds.context;
   row.status = "ok", row.body_json = json.string(), row.particles = body.positions.size();
   row.quality = body.quality, row.radius = body.particle_radius;
@@ -254,8 +284,8 @@ int convert_one(const Options& o, gpu::Context* context, BatchRow& row) {
     const std::string scan = o.scan_reason.empty() ? "" : fmt::format("scan {} ({})", o.scan, o.scan_reason);
     print_body_report({o.mesh, o.sampling.fill, reason, scan}, result, json, context);
   }
+  if (previewed) report_preview(o, *previewed);
   if (o.sampling.timings) print_timings(result, seconds);
-  if (o.preview) write_preview(o, context, mesh, body, name);
   if (!o.json) fmt::print("verdict: {}: {}\n", row.verdict, fmt::join(verdict.reasons, "; "));
   return o.strict && verdict.verdict != sampler::Verdict::Ok ? 1 : 0;
 }

@@ -129,7 +129,7 @@ std::string backend_text(const sampler::SampleResult& result, const std::string&
 // The stages of one mesh's run in the order they run, with their share of the command's time.
 void print_stage_table(const sampler::SampleResult& result, const CommandSeconds& c) {
   const sampler::StageSeconds& t = result.stages;
-  const std::vector<std::pair<std::string, double>> rows{
+  std::vector<std::pair<std::string, double>> rows{
       {"GPU context creation", c.context},
       {"mesh load and checks", c.load},
       {"plan: exact-distance tree, sizing, mass", t.plan},
@@ -147,6 +147,7 @@ void print_stage_table(const sampler::SampleResult& result, const CommandSeconds
       {"thin features", t.thin_features},
       {"quality, holes, mass properties", t.body},
       {"writing the body", c.write}};
+  if (c.preview) rows.emplace_back("preview (field, drawing, PNG)", *c.preview);
   fmt::print("{:<46} {:>9} {:>7}\n", "stage", "s", "share");
   for (const auto& [name, seconds] : rows) {
     fmt::print("{:<46} {:>9.3f} {:>6.1f}%\n", name, seconds, c.total > 0.0 ? 100.0 * seconds / c.total : 0.0);
@@ -160,39 +161,42 @@ void print_stage_table(const sampler::SampleResult& result, const CommandSeconds
 nlohmann::json run_json(const sampler::SampleResult& result, const CommandSeconds& c,
                         const gpu::Context* context) {
   const sampler::StageSeconds& t = result.stages;
-  return {{"device", device_name(context)},
-          {"software_device", context ? nlohmann::json(context->software()) : nlohmann::json(nullptr)},
-          {"sdf_backend", sampler::sdf_path_name(result.sdf_path)},
-          {"scan", result.sdf_path == sampler::SdfPath::Scan
-                       ? nlohmann::json(sdf::scan_method_name(result.field.scan))
-                       : nlohmann::json(nullptr)},
-          {"relax_backend", result.relax_on_cpu ? "cpu" : "gpu"},
-          {"certificate_backend", result.certificate_on_cpu ? "cpu" : "gpu"},
-          {"probes", result.probes},
-          {"certificate_passes", result.certificate_passes},
-          // The field between the scan and the relaxation: readback_bytes counts field bytes only (the
-          // band read back for the host's level set), not the few counters a scan reads besides.
-          {"sdf",
-           {{"band_voxels", result.field.band_voxels},
-            {"gpu_bytes", result.field.gpu_bytes},
-            {"host_bytes", result.field.host_bytes},
-            {"readback_bytes", result.field.readback_bytes},
-            {"gpu_resident", result.field.gpu_resident}}},
-          {"seconds",
-           {{"context", c.context},
-            {"load", c.load},
-            {"plan", t.plan},
-            {"sdf", t.sdf},
-            {"setup", t.setup},
-            {"relaxation", t.relaxation},
-            {"projection", t.projection},
-            {"certificate", t.certificate},
-            {"injection", t.injection},
-            {"probes", t.probes},
-            {"thin_features", t.thin_features},
-            {"body", t.body},
-            {"write", c.write},
-            {"total", c.total}}}};
+  nlohmann::json run = {
+      {"device", device_name(context)},
+      {"software_device", context ? nlohmann::json(context->software()) : nlohmann::json(nullptr)},
+      {"sdf_backend", sampler::sdf_path_name(result.sdf_path)},
+      {"scan", result.sdf_path == sampler::SdfPath::Scan
+                   ? nlohmann::json(sdf::scan_method_name(result.field.scan))
+                   : nlohmann::json(nullptr)},
+      {"relax_backend", result.relax_on_cpu ? "cpu" : "gpu"},
+      {"certificate_backend", result.certificate_on_cpu ? "cpu" : "gpu"},
+      {"probes", result.probes},
+      {"certificate_passes", result.certificate_passes},
+      // The field between the scan and the relaxation: readback_bytes counts field bytes only (the
+      // band read back for the host's level set), not the few counters a scan reads besides.
+      {"sdf",
+       {{"band_voxels", result.field.band_voxels},
+        {"gpu_bytes", result.field.gpu_bytes},
+        {"host_bytes", result.field.host_bytes},
+        {"readback_bytes", result.field.readback_bytes},
+        {"gpu_resident", result.field.gpu_resident}}},
+      {"seconds",
+       {{"context", c.context},
+        {"load", c.load},
+        {"plan", t.plan},
+        {"sdf", t.sdf},
+        {"setup", t.setup},
+        {"relaxation", t.relaxation},
+        {"projection", t.projection},
+        {"certificate", t.certificate},
+        {"injection", t.injection},
+        {"probes", t.probes},
+        {"thin_features", t.thin_features},
+        {"body", t.body},
+        {"write", c.write},
+        {"total", c.total}}}};
+  if (c.preview) run["seconds"]["preview"] = *c.preview;
+  return run;
 }
 
 void print_json(const std::filesystem::path& json, const sampler::BodyVerdict& verdict,

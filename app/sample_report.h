@@ -4,6 +4,7 @@
 // body.json with the verdict, the thin features and the run's own figures), and the --timings figures (the
 // sparse SDF's memory, the kernels, the stage table).
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -17,6 +18,7 @@ namespace ts::app {
 // Wall time of the command's own stages of one mesh [s]; sample_mesh's are in SampleResult::stages.
 struct CommandSeconds {
   double context = 0.0, load = 0.0, write = 0.0, total = 0.0;
+  std::optional<double> preview;  // --preview: its field, drawing and PNG
 };
 
 // What the report says beside the result: the mesh, whether the inside was filled, and why the relaxation and

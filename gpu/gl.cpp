@@ -5,12 +5,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <map>
 #include <mutex>
 #include <stdexcept>
 #include <utility>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "gpu/host_sync.h"
 
 namespace ts::gpu {
@@ -86,9 +88,9 @@ ProgramCache& program_cache() {
   return cache;
 }
 
-// The current context's program for `key`, linked by `make` the first time.
+// The current context's program for `key`, linked by `make` the first time; `name` for the log.
 template <typename Make>
-GLuint cached_program(const std::string& key, Make&& make) {
+GLuint cached_program(const std::string& key, const std::string& name, Make&& make) {
   ProgramCache& cache = program_cache();
   const EGLContext current = eglGetCurrentContext();
   {
@@ -96,8 +98,13 @@ GLuint cached_program(const std::string& key, Make&& make) {
     const auto& programs = cache.programs[current];
     if (const auto it = programs.find(key); it != programs.end()) return it->second;
   }
+  const auto start = std::chrono::steady_clock::now();
   const GLuint program = make();  // GL calls outside the lock: contexts on other threads go on
   ++cache.links;
+  // What a cold start costs, program by program (docs/benchmarks/preview.md, "Cold start"): compile
+  // and link; a driver that builds machine code on first use (llvmpipe) adds that to the first pass.
+  log::debug("gpu: compiled and linked {} in {:.3f} s",
+             name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   const std::lock_guard lock(cache.mutex);
   cache.programs[current].emplace(key, program);
   return program;
@@ -228,7 +235,7 @@ Program Program::compute(const ShaderLibrary& library, const std::string& relati
   const ShaderSource source = library.load(relative, defines);
   Program p;
   p.name_ = relative;
-  p.id_ = cached_program("comp\n" + source.text, [&] {
+  p.id_ = cached_program("comp\n" + source.text, relative, [&] {
     return link({compile_stage(library, GL_COMPUTE_SHADER, relative, source)}, relative);
   });
   return p;
@@ -247,7 +254,7 @@ Program Program::graphics(const ShaderLibrary& library, const std::string& verte
   }
   Program p;
   p.name_ = vertex + "+" + (geometry.empty() ? "" : geometry + "+") + fragment;
-  p.id_ = cached_program(key, [&] {
+  p.id_ = cached_program(key, p.name_, [&] {
     std::vector<GLuint> shaders;
     for (std::size_t s = 0; s < stages.size(); ++s)
       shaders.push_back(compile_stage(library, stages[s].first, stages[s].second, sources[s]));

@@ -7,6 +7,7 @@
 #include "body/particle_body.h"
 #include "core/mesh.h"
 #include "gpu/context.h"
+#include "sdf/settings.h"
 
 namespace ts::preview {
 
@@ -14,12 +15,21 @@ struct BodyPreviewSettings {
   int width = 800, height = 800;  // pixels
   int resolution = 192;           // SDF voxels along the mesh's longest side
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // the mesh's up (sample --up), +z by convention
+  // The body's own sign method (sample --sign): an open mesh sampled by winding number previews by it too.
+  sdf::SignMethod sign = sdf::SignMethod::Pseudonormal;
+};
+
+// What the picture showed, for the command's report.
+struct BodyPreviewReport {
+  bool field_drawn = true;  // false: the field read inside at its box's corner (SdfVolume::inside_out), not drawn
+  double seconds = 0.0;     // s, wall time: the field, the drawing and the PNG
 };
 
 // Scan-converts `mesh` on `context`'s device and renders it there with `body`'s particles, or with a
 // null context builds the exact SDF and renders on the CPU (preview/cpu_renderer.h); writes `png`
-// atomically, never over one of `inputs`.
-void write_body_preview(gpu::Context* context, const TriangleMesh& mesh, const body::ParticleBody& body,
+// atomically, never over one of `inputs`. A field whose signs flood its box is left out (the particles
+// alone), never drawn as a box.
+BodyPreviewReport write_body_preview(gpu::Context* context, const TriangleMesh& mesh, const body::ParticleBody& body,
                         const std::filesystem::path& png, const std::vector<std::filesystem::path>& inputs = {},
                         const BodyPreviewSettings& settings = {});
 

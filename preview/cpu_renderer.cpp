@@ -395,14 +395,7 @@ void CpuRenderer::Impl::colour_surface(const RenderSettings& s, const Frame& f, 
       texel.albedo = quantise(viridis(value / s.surface_scalar.max_value));
     }
   });
-  double sum = 0.0;
-  for (double v : values) {
-    if (std::isnan(v)) continue;
-    ++result.scalar.pixels;
-    sum += v;
-    result.scalar.max = std::max(result.scalar.max, v);
-  }
-  if (result.scalar.pixels) result.scalar.mean = sum / static_cast<double>(result.scalar.pixels);
+  result.scalar = summarize_scalar(values);
 }
 
 // 4. Lighting, into the image (top row first).

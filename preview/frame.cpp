@@ -147,4 +147,17 @@ Frame plan_frame(const RenderSettings& s, const Aabb& content, const std::option
   return f;
 }
 
+ScalarSummary summarize_scalar(const std::vector<double>& values) {
+  ScalarSummary summary;
+  double sum = 0.0;
+  for (double v : values) {
+    if (std::isnan(v)) continue;
+    ++summary.pixels;
+    sum += v;
+    summary.max = std::max(summary.max, v);
+  }
+  if (summary.pixels) summary.mean = sum / static_cast<double>(summary.pixels);
+  return summary;
+}
+
 }  // namespace ts::preview

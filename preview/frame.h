@@ -5,6 +5,7 @@
 // plan, so both draw the same picture from the same settings.
 #include <Eigen/Core>
 #include <optional>
+#include <vector>
 
 #include "core/mesh.h"
 #include "preview/camera.h"
@@ -62,5 +63,9 @@ Eigen::Vector3d default_light(const Camera& camera, const Eigen::Vector3d& up);
 // most `max_texture` texels a side.
 Frame plan_frame(const RenderSettings& settings, const Aabb& content, const std::optional<Aabb>& volume_box,
                  int max_texture);
+
+// The surface scalar over one image: `values` per pixel, NaN where no surface was coloured (both
+// renderers fill them so); count, mean and maximum of the others (all 0 for none).
+ScalarSummary summarize_scalar(const std::vector<double>& values);
 
 }  // namespace ts::preview

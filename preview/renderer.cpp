@@ -359,14 +359,7 @@ void Renderer::Impl::colour_surface(const RenderSettings& s, const CameraState& 
     }
   });
   albedo.upload(colours.data(), GL_RGBA, GL_UNSIGNED_BYTE);
-  double sum = 0.0;
-  for (double v : values) {
-    if (std::isnan(v)) continue;
-    ++result.scalar.pixels;
-    sum += v;
-    result.scalar.max = std::max(result.scalar.max, v);
-  }
-  if (result.scalar.pixels) result.scalar.mean = sum / static_cast<double>(result.scalar.pixels);
+  result.scalar = summarize_scalar(values);
 }
 
 Renderer::Renderer(gpu::Context& context, bool timings) : impl_(std::make_unique<Impl>(context, timings)) {}

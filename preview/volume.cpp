@@ -42,6 +42,12 @@ SdfVolume make_volume(const openvdb::FloatGrid& grid, const sdf::GridSpec& spec,
 
 }  // namespace
 
+bool SdfVolume::inside_out() const {
+  if (!level_set) return false;
+  const openvdb::Coord corner(spec.index_offset.x(), spec.index_offset.y(), spec.index_offset.z());
+  return level_set->tree().getValue(corner) < 0.0f;
+}
+
 Aabb SdfVolume::world_box() const {
   Aabb box;
   box.extend(spec.origin);
@@ -90,6 +96,7 @@ SdfVolume volume_from_mesh(gpu::Context& context, const TriangleMesh& mesh, cons
   scan.band = settings.band;
   scan.index_space_grid = true;  // read by index on the GPU: any voxel size
   const sdf::ScanConvertResult result = sdf::scan_convert(context, mesh, sdf::compute_pseudonormals(mesh), spec, scan);
+  if (settings.sign == sdf::SignMethod::Winding) sdf::resign_by_winding_number(*result.grid, sdf::ExactDistance(mesh), &spec);
   return make_volume(*result.grid, spec, settings.band);
 }
 
@@ -97,7 +104,7 @@ SdfVolume volume_from_mesh_on_cpu(const TriangleMesh& mesh, const sdf::SdfSettin
   const sdf::GridSpec spec = sdf::make_grid(bounding_box(mesh), settings);
   const sdf::ExactDistance exact(mesh);
   const openvdb::FloatGrid::Ptr grid =
-      sdf::exact_sdf_grid(exact, mesh, spec, settings.band, sdf::SignMethod::Pseudonormal, true);
+      sdf::exact_sdf_grid(exact, mesh, spec, settings.band, settings.sign, true);
   return make_volume(*grid, spec, settings.band);
 }
 

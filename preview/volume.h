@@ -27,6 +27,10 @@ struct SdfVolume {
 
   bool empty() const { return !grid.grid<float>(); }
   Aabb world_box() const;       // the voxel centres' box [m]
+  // Whether the field reads inside at its box's corner, which lies outside every solid (the box pads
+  // the surface by at least two voxels): signs that flood the whole box, as pseudonormals do through
+  // the holes of an open mesh. Ray-cast, such a field is a solid box, not the surface.
+  bool inside_out() const;
 };
 
 // From the first float level set of a .vdb file: its active voxels' box, padded by two voxels.
@@ -34,10 +38,12 @@ struct SdfVolume {
 // background of zero. Memory follows the band: the box may be any size.
 SdfVolume volume_from_level_set(const openvdb::FloatGrid& grid, const std::filesystem::path& file);
 
-// Scan-converts a mesh on the GPU (sdf::scan_convert into an index-space level set) on make_grid(settings).
+// Scan-converts a mesh on the GPU (sdf::scan_convert into an index-space level set) on make_grid(settings);
+// settings.sign Winding re-signs it by the generalised winding number (sdf::resign_by_winding_number), the
+// signs of an open mesh.
 SdfVolume volume_from_mesh(gpu::Context& context, const TriangleMesh& mesh, const sdf::SdfSettings& settings);
-// The same grid without a GL context: the exact SDF on every core (sdf::exact_sdf_grid, pseudonormal
-// signs, as the scan conversion's), for the CPU renderer.
+// The same grid without a GL context: the exact SDF on every core (sdf::exact_sdf_grid, signed by
+// settings.sign, as the scan conversion's), for the CPU renderer.
 SdfVolume volume_from_mesh_on_cpu(const TriangleMesh& mesh, const sdf::SdfSettings& settings);
 
 }  // namespace ts::preview

@@ -276,13 +276,20 @@ openvdb::FloatGrid::Ptr exact_sdf_grid(const ExactDistance& exact, const Triangl
   return grid;
 }
 
-void resign_by_winding_number(openvdb::FloatGrid& grid, const ExactDistance& exact) {
+void resign_by_winding_number(openvdb::FloatGrid& grid, const ExactDistance& exact, const GridSpec* index_space) {
   std::vector<std::pair<openvdb::Coord, float>> voxels;
   voxels.reserve(grid.activeVoxelCount());
   for (auto it = grid.cbeginValueOn(); it; ++it) voxels.emplace_back(it.getCoord(), *it);
+  const auto world = [&](const openvdb::Coord& c) -> Eigen::Vector3d {
+    if (index_space) {
+      const Eigen::Vector3i& o = index_space->index_offset;
+      return index_space->voxel_center(c.x() - o.x(), c.y() - o.y(), c.z() - o.z());
+    }
+    const openvdb::Vec3d p = grid.indexToWorld(c);
+    return {p.x(), p.y(), p.z()};
+  };
   tbb::parallel_for(std::size_t{0}, voxels.size(), [&](std::size_t i) {
-    const openvdb::Vec3d p = grid.indexToWorld(voxels[i].first);
-    const bool inside = std::abs(exact.winding_number({p.x(), p.y(), p.z()})) >= 0.5;
+    const bool inside = std::abs(exact.winding_number(world(voxels[i].first))) >= 0.5;
     voxels[i].second = inside ? -std::abs(voxels[i].second) : std::abs(voxels[i].second);
   });
   // OpenVDB trees are not safe to write from several threads.

@@ -74,8 +74,11 @@ openvdb::FloatGrid::Ptr exact_sdf_grid(const ExactDistance& exact, const Triangl
 // Re-signs every active voxel of a level set (world units) by the generalised winding number of
 // `exact`'s mesh, |w| >= 1/2 inside, and floods the signs outward again (OpenVDB signedFloodFill):
 // the sign method for open meshes, where pseudonormals are wrong next to the holes. Distances are
-// kept. TBB-parallel over the voxels.
-void resign_by_winding_number(openvdb::FloatGrid& grid, const ExactDistance& exact);
+// kept. TBB-parallel over the voxels. `index_space`: the grid is an index-space one (transform of voxel
+// size 1, as exact_sdf_grid's index_space and ScanConvertOptions::index_space_grid make): voxel
+// positions come from this spec (spec.origin + h * (coord - index_offset)), not from the transform.
+void resign_by_winding_number(openvdb::FloatGrid& grid, const ExactDistance& exact,
+                              const GridSpec* index_space = nullptr);
 
 // The same field, every voxel of `spec` (spec.linear_index order), clamped to +-band * h [m]: the
 // flood-filled level set read back densely, for comparisons with sdf::DenseSdf.

@@ -403,6 +403,30 @@ TEST(CliSample, ReportNamesTheDeviceAndTheStageTimes) {
             0);
 }
 
+// --preview is part of the run's time: a key of run.seconds counted in the total, a row of the
+// --timings stage table and a line of the report with its seconds.
+TEST(CliSample, PreviewTimeIsInTheJsonTheStageTableAndTheReport) {
+  const std::string sphere = quoted(test::asset("sphere.obj"));
+  const auto dir = test::temp_dir();
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("-q sample " + sphere + " -o " + quoted(dir) + kFast + "--preview --json", &out), 0)
+      << out;
+  const auto json = nlohmann::json::parse(out.substr(out.find("{\n")));
+  const auto& t = json.at("run").at("seconds");
+  ASSERT_TRUE(t.contains("preview")) << t.dump();
+  EXPECT_GT(t.at("preview").get<double>(), 0.0);
+  EXPECT_LE(t.at("preview").get<double>() + t.at("write").get<double>(), t.at("total").get<double>());
+  EXPECT_TRUE(std::filesystem::exists(dir / "sphere.preview.png"));
+  ASSERT_EQ(test::run_tetrasand("-q sample " + sphere + " -o " + quoted(dir) + kFast + "--json", &out), 0) << out;
+  EXPECT_FALSE(nlohmann::json::parse(out.substr(out.find("{\n"))).at("run").at("seconds").contains("preview"))
+      << "no preview, no preview time";
+  ASSERT_EQ(test::run_tetrasand("sample " + sphere + " -o " + quoted(dir) + kFast + "--preview --timings", &out), 0)
+      << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(preview \(field, drawing, PNG\) +[0-9.]+ +[0-9.]+%)"))) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(  preview          .*sphere\.preview\.png, [0-9.]+ s on the (CPU|GPU))")))
+      << out;
+}
+
 TEST(CliSample, FillCountsTheInteriorParticlesInTheJsonAndThePly) {
   const auto dir = test::temp_dir();
   std::string out;

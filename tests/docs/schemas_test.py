@@ -48,7 +48,8 @@ def run_json(binary, args, cwd):
 def check_bodies(binary, source, work):
     v = validator(source, "body.schema.json")
     report = run_json(binary, ["sample", os.path.join(source, "assets", "sphere.obj"), "-o", "body", "--count", "150",
-                               "--probes", "20000", "--backend", "cpu", "--json"], work)
+                               "--probes", "20000", "--backend", "cpu", "--preview", "--json"], work)
+    check("preview" in report["run"]["seconds"], "sample --preview --json times the preview (run.seconds.preview)")
     sample = validator(source, "sample-report.schema.json")
     expect_valid(sample, report, "sample --json")
     check(not sample.is_valid(dict(report, surprise=1)), "a sample report with an unknown key fails its schema")

@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "core/error.h"
+#include "preview/frame.h"
 
 namespace ts::preview {
 namespace {
@@ -142,6 +144,19 @@ TEST(Camera, ValidationRejectsDegenerateCameras) {
   flat.ortho = true;
   flat.ortho_height = 0.0;
   EXPECT_THROW(validate(flat), InputError);
+}
+
+// Both renderers summarise --color-by through one helper: the pixels without surface (NaN) do not
+// count, the others give count, mean and maximum.
+TEST(PreviewFrame, ScalarSummaryCountsOnlyTheColouredSurfacePixels) {
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  const ScalarSummary s = summarize_scalar({none, 0.5, 2.0, none, 0.5});
+  EXPECT_EQ(s.pixels, 3u);
+  EXPECT_DOUBLE_EQ(s.mean, 1.0);
+  EXPECT_DOUBLE_EQ(s.max, 2.0);
+  const ScalarSummary empty = summarize_scalar({none, none});
+  EXPECT_EQ(empty.pixels, 0u);
+  EXPECT_EQ(empty.mean, 0.0);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/LevelSetSphere.h>
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -84,7 +85,7 @@ TEST(CliPreview, ANanoVdbLevelSetPreviewsAsItsVdbAndABrokenOneIsAClearError) {
   ASSERT_EQ(test::run_tetrasand("sdf " + sdf_args + q(dir / "b.nvdb"), &out), 0) << out;
   for (const char* name : {"b.vdb", "b.nvdb"}) {
     ASSERT_EQ(test::run_tetrasand("preview " + q(dir / name) + " -o " + q(dir / (std::string(name) + ".png")) +
-                                      " --size 64x48",
+                                      " --size 64x48 --alpha --no-ground",
                                   &out),
               0)
         << name << "\n"
@@ -94,7 +95,11 @@ TEST(CliPreview, ANanoVdbLevelSetPreviewsAsItsVdbAndABrokenOneIsAClearError) {
   const preview::Image nvdb = preview::read_png(dir / "b.nvdb.png");
   ASSERT_EQ(vdb.rgba.size(), nvdb.rgba.size());
   EXPECT_TRUE(vdb.rgba == nvdb.rgba);
-  EXPECT_TRUE(std::any_of(vdb.rgba.begin(), vdb.rgba.end(), [&](std::uint8_t c) { return c != vdb.rgba.front(); }));
+  // Surface pixels: on a transparent background without a ground, the opaque ones; the bunny fills a
+  // good part of the frame.
+  std::size_t opaque = 0;
+  for (std::size_t i = 3; i < vdb.rgba.size(); i += 4) opaque += vdb.rgba[i] > 0 ? 1 : 0;
+  EXPECT_GT(static_cast<double>(opaque), 0.1 * 64 * 48);
 
   const std::string nano = read_file(dir / "b.nvdb");
   write_file_atomically(dir / "cut.nvdb", nano.substr(0, nano.size() / 2));
@@ -207,6 +212,95 @@ TEST(CliPreview, SampleWritesAPreviewBesideTheBody) {
             0)
       << out;
   EXPECT_NE(out.find("(body.json)"), std::string::npos) << out;
+}
+
+// A sphere with its top cap cut away: open, so `sample` needs --sign winding, and pseudonormal signs
+// leak through the hole.
+std::filesystem::path write_open_sphere(const std::filesystem::path& dir) {
+  TriangleMesh mesh = load_mesh(test::asset("sphere.obj"));
+  const Aabb box = bounding_box(mesh);
+  const double cut = box.max.z() - 0.3 * (box.max.z() - box.min.z());
+  std::erase_if(mesh.triangles, [&](const std::array<std::uint32_t, 3>& t) {
+    return (mesh.vertices[t[0]].z() + mesh.vertices[t[1]].z() + mesh.vertices[t[2]].z()) / 3.0 > cut;
+  });
+  write_obj(dir / "open.obj", mesh);
+  return dir / "open.obj";
+}
+
+// Pixels in the particles' orange (preview::RenderSettings::particle_color, 0.93 0.56 0.20): red well
+// above blue. The surface colour, the backdrop and the ground are all bluish grey (blue >= red), so a
+// picture where an SDF box hides the particles has next to none.
+double particle_pixel_share(const preview::Image& image) {
+  std::size_t orange = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const auto* p = image.pixel(x, y);
+      if (static_cast<int>(p[0]) - static_cast<int>(p[2]) > 40) ++orange;
+    }
+  return static_cast<double>(orange) / (static_cast<double>(image.width) * image.height);
+}
+
+// The open mesh: sampled with --sign winding, its preview is signed the same way, so the
+// particles show over the winding-number surface; criterion: at least 5 % of the pixels are particle
+// orange (a field drawn as one box hides every particle: well under 1 %).
+TEST(CliPreview, AnOpenMeshSampledByWindingNumberPreviewsAsItsParticles) {
+  const auto dir = test::temp_dir();
+  const auto open = write_open_sphere(dir);
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sample " + q(open) + " -o " + q(dir) +
+                                    " --count 150 --probes 5000 --sign winding --preview",
+                                &out),
+            0)
+      << out;
+  ASSERT_TRUE(std::filesystem::exists(dir / "open.preview.png")) << out;
+  const double share = particle_pixel_share(preview::read_png(dir / "open.preview.png"));
+  EXPECT_GT(share, 0.05) << out;
+  EXPECT_NE(out.find("  preview          "), std::string::npos) << out;
+}
+
+// `preview --sign`: the open mesh with the body's particles draws by winding number, and by
+// pseudonormals with a warning that names --sign winding. A field that reads inside at its box's
+// corner (here a level set with every sign inverted) is reported, not drawn as a box: the particles
+// alone, and with nothing else to draw an error naming the file.
+TEST(CliPreview, AMeshPreviewsWithEitherSignAndAnInsideOutFieldIsReportedNotDrawn) {
+  const auto dir = test::temp_dir();
+  const auto open = write_open_sphere(dir);
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sample " + q(open) + " -o " + q(dir) + " --count 150 --probes 5000 --sign winding",
+                                &out),
+            0)
+      << out;
+  const std::string particles = " --particles " + q(dir / "open.body.json") + " --size 96x96";
+  ASSERT_EQ(test::run_tetrasand("preview " + q(open) + particles + " --resolution 40 --sign winding -o " +
+                                    q(dir / "w.png"),
+                                &out),
+            0)
+      << out;
+  EXPECT_EQ(out.find("use --sign winding"), std::string::npos) << out;
+  EXPECT_GT(particle_pixel_share(preview::read_png(dir / "w.png")), 0.05) << out;
+  ASSERT_EQ(test::run_tetrasand("preview " + q(open) + particles + " --resolution 40 -o " + q(dir / "p.png"), &out), 0)
+      << out;
+  EXPECT_NE(out.find("pseudonormal signs may be wrong near the holes: use --sign winding"), std::string::npos) << out;
+
+  sdf::ensure_openvdb_initialized();
+  auto inverted = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(0.05f, openvdb::Vec3f(0.0f), 0.004f, 3.0f);
+  for (auto it = inverted->tree().beginValueAll(); it; ++it) it.setValue(-*it);
+  inverted->tree().root().setBackground(-inverted->background(), false);
+  write_grid(dir / "inverted.vdb", inverted);
+  ASSERT_EQ(test::run_tetrasand("preview " + q(dir / "inverted.vdb") + particles + " -o " + q(dir / "i.png"), &out), 0)
+      << out;
+  EXPECT_NE(out.find("signs are unreliable"), std::string::npos) << out;
+  EXPECT_NE(out.find("NOT drawn"), std::string::npos) << out;
+  EXPECT_GT(particle_pixel_share(preview::read_png(dir / "i.png")), 0.05) << out;
+  EXPECT_EQ(test::run_tetrasand("preview " + q(dir / "inverted.vdb") + " --size 32x32 -o " + q(dir / "x.png"), &out), 1)
+      << out;
+  EXPECT_NE(out.find("inverted.vdb"), std::string::npos) << out;
+  EXPECT_NE(out.find("nothing else to draw"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+  EXPECT_EQ(test::run_tetrasand("preview " + q(dir / "inverted.vdb") + " --sign winding -o " + q(dir / "x.png"), &out),
+            1)
+      << out;
+  EXPECT_NE(out.find("--sign needs a MESH input"), std::string::npos) << out;
 }
 
 // sample --backend cpu --preview draws on the CPU and needs no GL context: a device that does not exist
