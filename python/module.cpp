@@ -31,6 +31,8 @@ PYBIND11_MODULE(_core, m) {
   ts::sdf::ensure_openvdb_initialized();
   m.def("_set_shader_root", &ts::gpu::ShaderLibrary::set_host_root, py::arg("root"),
         "Where the kernels are when TETRASAND_SHADER_DIR is not set (the package's __init__ calls it)");
+  m.def("_shader_root", [] { return ts::gpu::ShaderLibrary::default_root(); },
+        "The folder the kernels are read from now (TETRASAND_SHADER_DIR, else the package's)");
   ts::python::add_body_bindings(m);
   ts::python::add_sdf_bindings(m);
   ts::python::add_scene_bindings(m);
