@@ -146,6 +146,16 @@ class SceneTest(unittest.TestCase):
         np.testing.assert_allclose(np.linalg.norm(scene.orientations, axis=1), 1.0, atol=1e-12)
         np.testing.assert_allclose(scene.velocities[:, 0], [0.5, -0.5], atol=1e-12)
 
+    def test_the_gpu_pipeline_steps_as_the_cpu_reference_does(self):
+        # On llvmpipe the GL kernels run on the CPU: the module finds them and the engines agree (the GPU
+        # pipeline computes in float).
+        gpu = tetrasand.Scene(str(COLLISION), backend="gpu")
+        cpu = tetrasand.Scene(str(COLLISION), backend="cpu")
+        gpu.step(300)
+        cpu.step(300)
+        self.assertEqual((gpu.engine, cpu.engine), ("gpu float", "cpu reference"))
+        np.testing.assert_allclose(gpu.positions, cpu.positions, atol=1e-6)
+
     def test_run_scene_from_toml_text_writes_its_outputs(self):
         text = COLLISION.read_text()
         with tempfile.TemporaryDirectory() as out:
