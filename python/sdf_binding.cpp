@@ -15,6 +15,7 @@
 #include "python/bindings.h"
 #include "sdf/exact_sdf.h"
 #include "sdf/grid.h"
+#include "sdf/mesh_signs.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_calibration.h"
 #include "sdf/scan_convert.h"
@@ -74,6 +75,7 @@ Field build_sdf(const py::object& mesh_arg, const SdfArgs& args) {
   const gpu::Backend requested = backend_from(args.backend, "backend");
   Field field;
   TriangleMesh mesh = mesh_from(mesh_arg, field.source);
+  sdf::warn_about_signs(mesh, field.source, settings.sign);
   field.band = args.band, field.sign = args.sign;
   {
     py::gil_scoped_release released;  // the field takes seconds on its own threads

@@ -4,6 +4,8 @@ run on two cores). Run by ctest (Python.Module) with PYTHONPATH=<build>/python."
 import math
 import os
 import pathlib
+import subprocess
+import sys
 import tempfile
 import unittest
 
@@ -119,6 +121,14 @@ class SdfTest(unittest.TestCase):
         cpu = tetrasand.sdf(str(CUBE), resolution=16, band=2, backend="cpu")
         points = np.array([[0.05 + 0.5 * gpu.voxel_size, 0.01, -0.02], [0.0, 0.0, 0.05 - gpu.voxel_size]])
         np.testing.assert_allclose(gpu.sample(points), cpu.sample(points), atol=0.05 * gpu.voxel_size)
+
+    def test_an_open_mesh_gets_the_commands_warning_about_its_signs(self):
+        # The library logs on standard error (the process's, not sys.stderr): a child process shows it.
+        code = ("import sys, tetrasand; sys.path.insert(0, sys.argv[1]); import test_module as t; "
+                "v, f = t.obj_arrays(t.CUBE); tetrasand.sdf((v, f[:-1]), resolution=16, backend='cpu')")
+        run = subprocess.run([sys.executable, "-c", code, str(pathlib.Path(__file__).parent)],
+                             capture_output=True, text=True, check=True)
+        self.assertIn("<arrays>: the mesh is not closed", run.stderr)
 
     def test_saves_vdb_and_nvdb_and_refuses_other_suffixes(self):
         with tempfile.TemporaryDirectory() as out:
