@@ -9,6 +9,7 @@
 #include "body/body_file.h"
 #include "core/error.h"
 #include "core/mesh_io.h"
+#include "core/naming_file.h"
 #include "python/arrays.h"
 #include "python/bindings.h"
 #include "sampler/body_verdict.h"
@@ -93,7 +94,8 @@ Body sample(const py::object& mesh_arg, const SampleArgs& args) {
   {
     py::gil_scoped_release released;  // the sampler runs seconds to minutes on its own threads
     const std::unique_ptr<gpu::Context> context = context_for({settings.backend, settings.sdf_backend});
-    sampler::SampleResult result = sampler::sample_mesh(context.get(), mesh, settings, progress);
+    sampler::SampleResult result =
+        naming_file(name, [&] { return sampler::sample_mesh(context.get(), mesh, settings, progress); });
     out.body = std::move(result.body);
     out.verdict = sampler::judge_body(out.body, result.thin);
   }

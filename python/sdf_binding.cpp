@@ -11,6 +11,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/naming_file.h"
 #include "python/arrays.h"
 #include "python/bindings.h"
 #include "sdf/exact_sdf.h"
@@ -79,7 +80,7 @@ Field build_sdf(const py::object& mesh_arg, const SdfArgs& args) {
   field.band = args.band, field.sign = args.sign;
   {
     py::gil_scoped_release released;  // the field takes seconds on its own threads
-    field.spec = sdf::make_grid(bounding_box(mesh), settings);
+    field.spec = naming_file(field.source, [&] { return sdf::make_grid(bounding_box(mesh), settings); });
     std::unique_ptr<gpu::Context> context = context_for({requested});
     if (gpu::resolve_backend(requested, context.get()) == gpu::Backend::Gpu) {
       field.grid = scanned(*context, mesh, field.spec, settings);

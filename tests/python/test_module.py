@@ -190,6 +190,12 @@ class ErrorTest(unittest.TestCase):
         with self.assertRaisesRegex(tetrasand.InputError, r"<string>:\d+: .*durashun"):
             tetrasand.Scene(text, backend="cpu")
 
+    def test_a_size_the_mesh_cannot_take_names_the_mesh_and_what_fits(self):
+        with self.assertRaisesRegex(tetrasand.InputError, r"cube\.obj: particle radius 10 m is too large.*below"):
+            tetrasand.sample(str(CUBE), radius=10.0, backend="cpu", sdf_backend="cpu")
+        with self.assertRaisesRegex(tetrasand.InputError, r"cube\.obj: a \d+ x .*smallest voxel size that fits"):
+            tetrasand.sdf(str(CUBE), voxel=1e-7, backend="cpu")
+
     def test_an_open_mesh_is_refused_unless_winding_signs(self):
         vertices, faces = obj_arrays(CUBE)
         with self.assertRaisesRegex(tetrasand.InputError, r"<arrays>: is not a closed"):
