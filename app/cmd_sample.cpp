@@ -19,7 +19,6 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mesh_io.h"
-#include "core/mesh_report.h"
 #include "gpu/backend.h"
 #include "preview/body_preview.h"
 #include "sampler/body_verdict.h"
@@ -164,21 +163,7 @@ void add_solid_and_output_options(CLI::App* cmd, Options& o) {
 TriangleMesh load_sample_mesh(const Options& o, sampler::SampleSettings& settings) {
   TriangleMesh mesh = load_mesh(o.mesh);
   if (o.scale != 1.0) scale_mesh(mesh, o.scale);
-  const MeshReport report = analyze_mesh(mesh);
-  const bool winding = o.sign == "winding" || o.allow_open;
-  settings.sign = winding ? sdf::SignMethod::Winding : sdf::SignMethod::Pseudonormal;
-  if (report.watertight()) return mesh;
-  if (!winding) {
-    throw InputError(o.mesh,
-                     "is not a closed, consistently oriented solid (" + closed_solid_problems(report) +
-                         "); `tetrasand info` shows the full report; --sign winding samples it anyway\n" +
-                         format_report(report));
-  }
-  log::warn(
-      "{}: not a closed solid ({}): sampled with winding-number signs; the particles cover the mesh's own "
-      "surface only (holes stay open), mass properties come from the winding-number solid",
-      o.mesh, closed_solid_problems(report));
-  settings.mass_method = body::MassMethod::WindingCells;
+  sampler::check_sample_mesh(mesh, o.mesh, o.sign == "winding" || o.allow_open, settings);
   return mesh;
 }
 

@@ -19,10 +19,10 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mesh_io.h"
-#include "core/mesh_report.h"
 #include "gpu/backend.h"
 #include "sdf/exact_sdf.h"
 #include "sdf/grid.h"
+#include "sdf/mesh_signs.h"
 #include "sdf/openvdb_compare.h"
 #include "sdf/pseudonormals.h"
 #include "sdf/scan_calibration.h"
@@ -104,19 +104,7 @@ void add_options(CLI::App* cmd, Options& o) {
 TriangleMesh load_sdf_mesh(const Options& o) {
   TriangleMesh mesh = load_mesh(o.mesh);
   if (o.scale != 1.0) scale_mesh(mesh, o.scale);
-  ReportOptions report_options;
-  report_options.self_intersections = false;  // signs only need closedness and orientation
-  const MeshReport report = analyze_mesh(mesh, report_options);
-  if (!report.closed() && o.sign != "winding") {
-    log::warn("{}: the mesh is not closed ({}); pseudonormal signs may be wrong near the holes: use --sign winding",
-              o.mesh, closed_solid_problems(report));
-  }
-  if (encloses_no_volume(report)) {
-    log::warn("{}: the mesh {}: the field has no inside", o.mesh, closed_solid_problems(report));
-  }
-  if (is_inside_out(report)) {
-    log::warn("{}: the mesh is inside out (negative volume): inside and outside are swapped", o.mesh);
-  }
+  sdf::warn_about_signs(mesh, o.mesh, o.sign == "winding" ? sdf::SignMethod::Winding : sdf::SignMethod::Pseudonormal);
   return mesh;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/naming_file.h"
 #include "gpu/context.h"
 
 namespace ts::app {
@@ -37,19 +38,6 @@ inline gpu::ContextOptions context_options(const GlobalOptions& global) {
   options.device = global.device;
   options.debug = global.gl_debug;
   return options;
-}
-
-// Runs `step`, work on the input `file`: an InputError whose message does not start with the file's
-// name gets it in front, so an error about a mesh's sizes (a voxel, a radius) says which mesh.
-template <typename Step>
-auto naming_file(const std::string& file, Step&& step) -> decltype(step()) {
-  try {
-    return step();
-  } catch (const InputError& e) {
-    const std::string message = e.what();
-    if (message.rfind(file + ": ", 0) == 0) throw;
-    throw InputError(std::filesystem::path(file), message);
-  }
 }
 
 Runner add_devices_command(CLI::App& app, const GlobalOptions& global);

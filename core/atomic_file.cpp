@@ -253,12 +253,13 @@ std::string read_file(const fs::path& path, std::uint64_t max_bytes, std::string
   return read_regular_file(path, max_bytes, why);
 }
 
-std::string sha256_file(const fs::path& path) {
-  const std::string bytes = read_file(path);
+std::string sha256_file(const fs::path& path) { return sha256_hex(read_file(path)); }
+
+std::string sha256_hex(std::string_view bytes) {
   std::array<unsigned char, EVP_MAX_MD_SIZE> digest{};
   unsigned int length = 0;
   if (EVP_Digest(bytes.data(), bytes.size(), digest.data(), &length, EVP_sha256(), nullptr) != 1) {
-    throw Error(ExitCode::Internal, "SHA-256 failed for " + path.string());
+    throw Error(ExitCode::Internal, "SHA-256 failed");
   }
   static constexpr char hex[] = "0123456789abcdef";
   std::string out;

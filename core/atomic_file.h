@@ -70,5 +70,7 @@ std::string read_file(const std::filesystem::path& path, std::uint64_t max_bytes
 
 // Lowercase hex SHA-256 of a file's bytes (body.json records the source mesh's hash).
 std::string sha256_file(const std::filesystem::path& path);
+// The same of bytes in memory (a mesh handed over as arrays, not as a file).
+std::string sha256_hex(std::string_view bytes);
 
 }  // namespace ts

@@ -29,12 +29,21 @@ std::string read_text(const fs::path& path) {
   return s.str();
 }
 
+// ShaderLibrary::set_host_root's folder; empty: none.
+fs::path& host_root() {
+  static fs::path root;
+  return root;
+}
+
 }  // namespace
+
+void ShaderLibrary::set_host_root(fs::path root) { host_root() = std::move(root); }
 
 fs::path ShaderLibrary::default_root() {
   if (const char* env = std::getenv("TETRASAND_SHADER_DIR"); env && *env) return env;
-  const fs::path beside = executable_directory() / ".." / "share" / "tetrasand" / "shaders";
   std::error_code ec;
+  if (!host_root().empty() && fs::is_directory(host_root(), ec)) return host_root();
+  const fs::path beside = executable_directory() / ".." / "share" / "tetrasand" / "shaders";
   if (fs::is_directory(beside, ec)) return fs::weakly_canonical(beside, ec);
   // A program of another project, linked against the installed package, lives elsewhere: the prefix
   // this library was configured to install to holds the kernels of the same build.

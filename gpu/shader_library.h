@@ -15,10 +15,15 @@ struct ShaderSource {
 
 class ShaderLibrary {
  public:
-  // TETRASAND_SHADER_DIR, else <exe>/../share/tetrasand/shaders (build tree and install tree alike),
-  // else <CMAKE_INSTALL_PREFIX>/share/tetrasand/shaders as configured (programs of other projects
-  // linking the installed package), else the build tree this binary was configured in.
+  // TETRASAND_SHADER_DIR, else the host's folder (set_host_root), else <exe>/../share/tetrasand/shaders
+  // (build tree and install tree alike), else <CMAKE_INSTALL_PREFIX>/share/tetrasand/shaders as
+  // configured (programs of other projects linking the installed package), else the build tree this
+  // binary was configured in.
   static std::filesystem::path default_root();
+  // Where a host that is not beside bin/ finds its shaders: the Python module (python/) sets its
+  // installed folder at import, since <exe> is then the Python interpreter. An existing folder only
+  // counts; TETRASAND_SHADER_DIR still wins. Set before any context is made (not thread-safe).
+  static void set_host_root(std::filesystem::path root);
 
   explicit ShaderLibrary(std::filesystem::path root = default_root());
   const std::filesystem::path& root() const { return root_; }

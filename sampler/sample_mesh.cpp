@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/mass_properties.h"
+#include "core/mesh_report.h"
 #include "core/stopwatch.h"
 #include "gpu/host_sync.h"
 #include "sampler/cpu_coverage_certificate.h"
@@ -797,6 +798,23 @@ SampleResult sample_mesh(gpu::Context* context, const TriangleMesh& mesh, const 
     result.timing_report += round_trip_report(scan_syncs, *relaxer, syncs_at_start);
   }
   return result;
+}
+
+void check_sample_mesh(const TriangleMesh& mesh, const std::string& name, bool winding, SampleSettings& settings) {
+  const MeshReport report = analyze_mesh(mesh);
+  settings.sign = winding ? sdf::SignMethod::Winding : sdf::SignMethod::Pseudonormal;
+  if (report.watertight()) return;
+  if (!winding) {
+    throw InputError(name,
+                     "is not a closed, consistently oriented solid (" + closed_solid_problems(report) +
+                         "); `tetrasand info` shows the full report; --sign winding samples it anyway\n" +
+                         format_report(report));
+  }
+  log::warn(
+      "{}: not a closed solid ({}): sampled with winding-number signs; the particles cover the mesh's own "
+      "surface only (holes stay open), mass properties come from the winding-number solid",
+      name, closed_solid_problems(report));
+  settings.mass_method = body::MassMethod::WindingCells;
 }
 
 }  // namespace ts::sampler

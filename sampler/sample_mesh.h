@@ -160,6 +160,13 @@ SdfPath choose_sdf_path(const gpu::Context* context, const SampleSettings& setti
 // error.
 SampleResult sample_mesh(gpu::Context* context, const TriangleMesh& mesh, const SampleSettings& settings,
                          const std::function<void(const SampleProgress&)>& progress = {});
+
+// Whether `mesh` can be sampled, and the sign and mass methods it allows (sets settings.sign and
+// settings.mass_method): a closed, consistently oriented solid takes `winding` as asked; any other mesh
+// is refused (InputError naming `name`, with the mesh report) unless `winding`, and is then sampled from
+// its winding-number solid with a warning. The one check of `tetrasand sample` and the Python module.
+void check_sample_mesh(const TriangleMesh& mesh, const std::string& name, bool winding, SampleSettings& settings);
+
 inline SampleResult sample_mesh(gpu::Context& context, const TriangleMesh& mesh,
                                 const SampleSettings& settings,
                                 const std::function<void(const SampleProgress&)>& progress = {}) {

@@ -15,6 +15,7 @@ PACKAGES=(
   libcgal-demo assimp-testmodels
   lammps python3
   python3-vtk9 python3-jsonschema
+  pybind11-dev python3-dev python3-numpy
 )
 
 missing=()

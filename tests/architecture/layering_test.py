@@ -27,6 +27,8 @@ ALLOWED = {
     "preview": {"core", "body", "gpu", "sdf", "sampler", "sim", "scene", "shaders"},
     "app": {"core", "body", "gpu", "sdf", "sampler", "sim", "scene", "export", "preview", "shaders"},
     "tools": {"core"},
+    # The Python module: beside app/, the same libraries below it (it never includes app/).
+    "python": {"core", "body", "gpu", "sdf", "sampler", "sim", "scene", "preview"},
 }
 MAX_FUNCTION_LINES = 100
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
