@@ -32,7 +32,8 @@ namespace {
 struct Options {
   std::string input, output, particles, size = "800x800", view = "iso", color_by = "none";
   std::string backend = "auto";  // where the picture is drawn (gpu/backend.h's rule)
-  std::string sign;              // MESH: pseudonormal (the default) or winding
+  std::string sign;               // MESH: pseudonormal (the default) or winding
+  std::string gpu_path = "auto";  // the GPU renderer's shadow map and G-buffer: draws or compute kernels
   std::vector<double> eye, target, up{0.0, 0.0, 1.0}, light;
   double fov = 30.0, particle_radius = 0.0, color_max = 0.0, voxel = 0.0, band = 3.0, scale = 1.0;
   int resolution = 192, turntable = 1;
@@ -98,6 +99,11 @@ void add_input_options(CLI::App* cmd, Options& o) {
                   "core, the field of a MESH by the exact SDF (no GL context); auto: cpu on a software renderer "
                   "such as llvmpipe, else gpu")
       ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
+      ->capture_default_str();
+  cmd->add_option("--gpu-path", o.gpu_path,
+                  "On the GPU, the shadow map and G-buffer by draws (raster) or by compute kernels (compute); "
+                  "auto: compute on a hardware GPU, raster on a software renderer such as llvmpipe")
+      ->check(CLI::IsMember({"auto", "raster", "compute"}))
       ->capture_default_str();
 }
 
@@ -360,6 +366,32 @@ void print_summary(const Options& o, const Eigen::Vector2i& size, const Content&
   fmt::print("  render           {:.3f} s on {}\n", views.seconds, renderer.device());
 }
 
+// A line of the run's summary: on standard output, or to the log under --json (standard output is
+// then the JSON report alone).
+void say(const Options& o, const std::string& line) {
+  if (o.json) {
+    log::info("{}", line);
+  } else {
+    fmt::print("{}\n", line);
+  }
+}
+
+// The GL renderer with the --gpu-path it resolves to, named in one line.
+std::unique_ptr<preview::ImageRenderer> make_gpu_renderer(const Options& o, gpu::Context& context, bool timings) {
+  const preview::GpuPath requested = preview::parse_gpu_path(o.gpu_path).value();  // CLI::IsMember checked it
+  auto renderer = std::make_unique<preview::Renderer>(context, timings);
+  renderer->set_gpu_path(requested);
+  const char* chosen = preview::gpu_path_name(renderer->gpu_path());
+  if (requested != preview::GpuPath::Auto) {
+    say(o, fmt::format("gpu path: {} (asked for)", chosen));
+  } else {
+    say(o, fmt::format("gpu path: {} (auto: compute on a hardware GPU, raster on a software renderer; the GL "
+                       "device is {})",
+                       chosen, gpu::describe(&context).renderer));
+  }
+  return renderer;
+}
+
 // The renderer the backend rule picks (gpu/backend.h); `context` is made only where it asks the
 // device (auto) or draws there (gpu), so --backend cpu runs without EGL.
 std::unique_ptr<preview::ImageRenderer> make_renderer(const Options& o, const GlobalOptions& global,
@@ -370,15 +402,11 @@ std::unique_ptr<preview::ImageRenderer> make_renderer(const Options& o, const Gl
   const gpu::Backend chosen = gpu::resolve_backend(requested, context.get());
   const std::string line =
       gpu::backend_line(requested, chosen, gpu::describe(context.get()), true, "renderer");
-  if (o.json) {
-    log::info("{}", line);  // standard output stays the JSON
-  } else {
-    fmt::print("{}\n", line);
-  }
+  say(o, line);
   report.requested_backend = o.backend;
   report.backend = gpu::backend_name(chosen);
   const bool timings = o.timings || o.json;  // --json reports the per-pass times
-  if (chosen == gpu::Backend::Gpu) return std::make_unique<preview::Renderer>(*context, timings);
+  if (chosen == gpu::Backend::Gpu) return make_gpu_renderer(o, *context, timings);
   context.reset();  // the CPU draws and builds the field: the context is not needed any more
   return std::make_unique<preview::CpuRenderer>(timings);
 }

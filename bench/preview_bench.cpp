@@ -1,9 +1,12 @@
 // Preview rendering times (docs/benchmarks.md, "preview"): an image of a large SDF (ray casting), of
 // many particle impostors, and of both (the hybrid), each with the shadow map, on whatever device
-// the context picks. The SDF is OpenVDB's meshToLevelSet of the mesh (CPU, so the figure is the
-// renderer's, not the scan conversion's), as a sparse NanoVDB grid, as `tetrasand preview SDF.vdb` reads it. Usage:
-//   tetrasand_bench_preview [MESH] [--size 1024] [--resolution 512] [--particles 1000000] [--repeat 3] [--png PREFIX]
-// --png writes the last SDF, hybrid and impostor images as PREFIX-{sdf,hybrid,impostors}.png, to look at.
+// the context picks, by the draws (raster), the compute kernels (compute) or both in one run (the
+// default: same device, same scene, so the two rows compare). The SDF is OpenVDB's meshToLevelSet of
+// the mesh (CPU, so the figure is the renderer's, not the scan conversion's), as a sparse NanoVDB grid,
+// as `tetrasand preview SDF.vdb` reads it. Usage:
+//   tetrasand_bench_preview [MESH] [--size 1024] [--resolution 512] [--particles 1000000] [--repeat 3]
+//                           [--gpu-path raster|compute|both] [--png PREFIX]
+// --png writes the last SDF, hybrid and impostor images as PREFIX-<path>-{sdf,hybrid,impostors}.png.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -48,84 +51,107 @@ Timing time_renders(ts::preview::Renderer& renderer, const ts::preview::RenderSe
   return t;
 }
 
-int run(int argc, char** argv) {
+struct Options {
   std::string mesh_path = TETRASAND_SOURCE_DIR "/assets/bunny.obj";
   int size = 1024, resolution = 512, repeat = 3;
-  std::string png_prefix;
+  std::string png_prefix, gpu_path = "both";
   std::size_t particle_count = 1'000'000;
+};
+
+// false for an unknown argument.
+bool parse(int argc, char** argv, Options& o) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
     if (a == "--size") {
-      size = std::stoi(next());
+      o.size = std::stoi(next());
     } else if (a == "--resolution") {
-      resolution = std::stoi(next());
+      o.resolution = std::stoi(next());
     } else if (a == "--particles") {
-      particle_count = std::stoull(next());
+      o.particle_count = std::stoull(next());
     } else if (a == "--repeat") {
-      repeat = std::stoi(next());
+      o.repeat = std::stoi(next());
     } else if (a == "--png") {
-      png_prefix = next();
+      o.png_prefix = next();
+    } else if (a == "--gpu-path") {
+      o.gpu_path = next();
+      if (o.gpu_path != "both" && !ts::preview::parse_gpu_path(o.gpu_path)) return false;
     } else if (!a.empty() && a[0] != '-') {
-      mesh_path = a;
+      o.mesh_path = a;
     } else {
-      fmt::print(stderr, "usage: tetrasand_bench_preview [MESH] [--size N] [--resolution N] [--particles N] [--repeat N] [--png PREFIX]\n");
-      return 2;
+      return false;
     }
   }
-  const ts::TriangleMesh mesh = ts::load_mesh(mesh_path);
+  return true;
+}
+
+// The three scenes by one path: the SDF alone and the hybrid in one renderer, the impostors alone in another.
+void measure(const Options& o, ts::gpu::Context& context, const openvdb::FloatGrid& level_set,
+             const ts::preview::Particles& particles, ts::preview::GpuPath path) {
+  const char* name = ts::preview::gpu_path_name(path);
+  ts::preview::Renderer renderer(context, true), particles_only(context, true);
+  renderer.set_gpu_path(path);
+  particles_only.set_gpu_path(path);
+  renderer.set_volume(ts::preview::volume_from_level_set(level_set, o.mesh_path));
+  ts::preview::RenderSettings s;
+  s.width = s.height = o.size;
+  s.camera = ts::preview::frame_box(renderer.content_box(), ts::preview::view_direction(ts::preview::View::Iso, s.up),
+                                    s.up, 1.0, false, 30.0);
+  const Timing sdf_only = time_renders(renderer, s, o.repeat);
+  renderer.set_particles(particles);
+  const Timing hybrid = time_renders(renderer, s, o.repeat);
+  particles_only.set_particles(particles);
+  const Timing impostors = time_renders(particles_only, s, o.repeat);
+  if (!o.png_prefix.empty()) {
+    const std::string prefix = o.png_prefix + "-" + name;
+    ts::preview::write_png(prefix + "-sdf.png", sdf_only.last);
+    ts::preview::write_png(prefix + "-hybrid.png", hybrid.last);
+    ts::preview::write_png(prefix + "-impostors.png", impostors.last);
+  }
+  fmt::print("| image {0} x {0}, --gpu-path {2} | first render [s] | median of {1} [s] |\n|---|---:|---:|\n", o.size,
+             o.repeat, name);
+  fmt::print("| SDF {}^3-class ray cast | {:.3f} | {:.3f} |\n", o.resolution, sdf_only.first, sdf_only.median);
+  fmt::print("| {} particle impostors | {:.3f} | {:.3f} |\n", o.particle_count, impostors.first, impostors.median);
+  fmt::print("| hybrid: both | {:.3f} | {:.3f} |\n\n", hybrid.first, hybrid.median);
+  fmt::print("per-pass GPU time ({}), all renders of the SDF and the hybrid:\n{}\n", name, renderer.timing_report());
+  fmt::print("per-pass GPU time ({}), all renders of the impostors:\n{}\n", name, particles_only.timing_report());
+}
+
+int run(int argc, char** argv) {
+  Options o;
+  if (!parse(argc, argv, o)) {
+    fmt::print(stderr, "usage: tetrasand_bench_preview [MESH] [--size N] [--resolution N] [--particles N] [--repeat N] "
+                       "[--gpu-path raster|compute|both] [--png PREFIX]\n");
+    return 2;
+  }
+  const ts::TriangleMesh mesh = ts::load_mesh(o.mesh_path);
   ts::gpu::Context context;
-  ts::preview::Renderer renderer(context, true);
 
   // The SDF: OpenVDB level set, as a sparse NanoVDB grid.
   auto t = Clock::now();
-  const double h = ts::bounding_box(mesh).size().maxCoeff() / resolution;
+  const double h = ts::bounding_box(mesh).size().maxCoeff() / o.resolution;
   const auto grid = ts::sdf::openvdb_level_set(mesh, h, 3.0);
-  ts::preview::SdfVolume volume = ts::preview::volume_from_level_set(*grid, mesh_path);
+  const ts::preview::SdfVolume volume = ts::preview::volume_from_level_set(*grid, o.mesh_path);
   const double build = since(t);
   const Eigen::Vector3i d = volume.spec.dims;
-  const std::size_t band_voxels = volume.band_voxels;
-  const double sparse_mib = volume.grid.size() / 1048576.0;
-  const double dense_mib = volume.spec.voxel_count() * 4.0 / 1048576.0;
-  t = Clock::now();
-  renderer.set_volume(std::move(volume));
-  const double upload = since(t);
 
   // The particles: area-uniform on the mesh, sized to cover it.
   std::mt19937_64 rng(1);
-  const auto points = ts::sampler::sample_surface_points(mesh, particle_count, rng);
+  const auto points = ts::sampler::sample_surface_points(mesh, o.particle_count, rng);
   ts::preview::Particles particles;
   particles.centers = points.positions;
-  particles.radii = {static_cast<float>(1.2 * std::sqrt(ts::surface_area(mesh) / (3.14159 * particle_count)))};
+  particles.radii = {static_cast<float>(1.2 * std::sqrt(ts::surface_area(mesh) / (3.14159 * o.particle_count)))};
 
-  ts::preview::RenderSettings s;
-  s.width = s.height = size;
-  s.camera = ts::preview::frame_box(renderer.content_box(), ts::preview::view_direction(ts::preview::View::Iso, s.up),
-                                    s.up, 1.0, false, 30.0);
-  const Timing sdf_only = time_renders(renderer, s, repeat);
-  renderer.set_particles(particles);
-  const Timing hybrid = time_renders(renderer, s, repeat);
-  ts::preview::Renderer particles_only(context, true);
-  particles_only.set_particles(particles);
-  const Timing impostors = time_renders(particles_only, s, repeat);
-
-  if (!png_prefix.empty()) {
-    ts::preview::write_png(png_prefix + "-sdf.png", sdf_only.last);
-    ts::preview::write_png(png_prefix + "-hybrid.png", hybrid.last);
-    ts::preview::write_png(png_prefix + "-impostors.png", impostors.last);
-  }
   fmt::print("renderer: {}\n", context.summary());
   fmt::print("mesh {}: SDF {} x {} x {} voxels (sparse NanoVDB: {} band voxels, {:.1f} MiB on the GPU, against "
-             "{:.1f} MiB for a dense R32F texture; {} storage block(s); built by OpenVDB in {:.2f} s, uploaded in {:.2f} s), "
+             "{:.1f} MiB for a dense R32F texture; built by OpenVDB in {:.2f} s), "
              "{} particles of radius {:.3g} m, images {} x {}, shadow map {} texels\n\n",
-             mesh_path, d.x(), d.y(), d.z(), band_voxels, sparse_mib, dense_mib, renderer.field_chunks(), build, upload, particle_count,
-             particles.radii[0], size, size, std::clamp(size, 512, 4096));
-  fmt::print("| image {0} x {0} | first render [s] | median of {1} [s] |\n|---|---:|---:|\n", size, repeat);
-  fmt::print("| SDF {}^3-class ray cast | {:.3f} | {:.3f} |\n", resolution, sdf_only.first, sdf_only.median);
-  fmt::print("| {} particle impostors | {:.3f} | {:.3f} |\n", particle_count, impostors.first, impostors.median);
-  fmt::print("| hybrid: both | {:.3f} | {:.3f} |\n\n", hybrid.first, hybrid.median);
-  fmt::print("per-pass GPU time, all renders of the SDF and the hybrid:\n{}\n", renderer.timing_report());
-  fmt::print("per-pass GPU time, all renders of the impostors:\n{}", particles_only.timing_report());
+             o.mesh_path, d.x(), d.y(), d.z(), volume.band_voxels, volume.grid.size() / 1048576.0,
+             volume.spec.voxel_count() * 4.0 / 1048576.0, build, o.particle_count, particles.radii[0], o.size, o.size,
+             std::clamp(o.size, 512, 4096));
+  for (ts::preview::GpuPath path : {ts::preview::GpuPath::Raster, ts::preview::GpuPath::Compute}) {
+    if (o.gpu_path == "both" || o.gpu_path == ts::preview::gpu_path_name(path)) measure(o, context, *grid, particles, path);
+  }
   return 0;
 }
 

@@ -157,6 +157,13 @@ void Texture::upload(const void* pixels, GLenum pixel_format, GLenum type, int f
   }
 }
 
+void Texture::upload_from(const Buffer& pixels, GLenum pixel_format, GLenum type) {
+  if (target_ != GL_TEXTURE_2D) throw GpuError(what_ + ": uploads from a buffer are for 2D textures");
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, pixels.id());
+  glTextureSubImage2D(id(), 0, 0, 0, width_, height_, pixel_format, type, nullptr);
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+}
+
 void Texture::read(void* pixels, std::size_t bytes, GLenum pixel_format, GLenum type, int first,
                    int count) const {
   const int n = layer_count(first, count, "read");

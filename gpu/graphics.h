@@ -71,6 +71,9 @@ class Texture {
   // Writes layers (slices) [first, first + count) from host memory, x fastest, then y, then layer,
   // as `pixel_format`/`type` (GL_RED/GL_FLOAT, ...). count < 0: up to the last layer.
   void upload(const void* pixels, GLenum pixel_format, GLenum type, int first = 0, int count = -1);
+  // The same from a GPU buffer, tightly packed from its start, copied on the GPU (a pixel-unpack
+  // upload: no host round trip). Writes by kernels need GL_PIXEL_BUFFER_BARRIER_BIT before it. 2D only.
+  void upload_from(const Buffer& pixels, GLenum pixel_format, GLenum type);
   // Reads layers [first, first + count) into `pixels` (`bytes` long), in the same order.
   void read(void* pixels, std::size_t bytes, GLenum pixel_format, GLenum type, int first = 0,
             int count = -1) const;

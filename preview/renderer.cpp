@@ -98,6 +98,7 @@ struct Renderer::Impl {
   void lighting_pass(const RenderSettings& s, const Frame& f);
   void bind_lighting_params(const RenderSettings& s, const Frame& f);
   void read_back(const RenderSettings& s, RenderResult& result) const;
+  void compute_passes(const RenderSettings& s, const Frame& f);
   void check(const char* what) const {
     if (context.debug()) gpu::check_gl(what);
   }
@@ -131,6 +132,11 @@ struct Renderer::Impl {
   std::size_t particle_count = 0;
   bool per_particle_color = false;
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+
+  // The compute shadow map and G-buffer (set_gpu_path), compiled on first use.
+  GpuPath path = GpuPath::Raster;
+  std::unique_ptr<ComputePasses> compute;
+  gpu::ParamBlock<gpu::params::PreviewComputeParams> compute_block, compute_shadow_block;
 
   // Targets.
   int width = 0, height = 0, shadow_size = 0;
@@ -275,6 +281,29 @@ void Renderer::Impl::raycast_pass(const RenderSettings& s, const Frame& f) {
   });
 }
 
+// 1 and 2 by compute kernels (preview/compute_passes.h): the shadow map from the light, depth only,
+// then the G-buffer; the lighting pass reads them as it reads the draws'.
+void Renderer::Impl::compute_passes(const RenderSettings& s, const Frame& f) {
+  if (!compute) compute = std::make_unique<ComputePasses>(library, volume_defines);
+  if (particle_count > 0) {
+    spheres.bind(TS_PREVIEW_SPHERES);
+    colors.bind(TS_PREVIEW_COLORS);
+  }
+  if (has_volume) bind_volume();
+  ComputeScene scene{particle_count, per_particle_color, s.particle_color, s.surface_color, has_volume};
+  if (s.shadows) {
+    ensure_shadow_map(f.shadow_size);
+    queue.timed("preview/shadow map (compute)", [&] {
+      bind_camera(light_camera_block, f.light_camera);
+      compute->draw(queue, scene, {&shadow_depth, nullptr, nullptr}, compute_shadow_block);
+    });
+  }
+  queue.timed("preview/G-buffer (compute)", [&] {
+    bind_camera(camera_block, f.camera);
+    compute->draw(queue, scene, {&depth, &albedo, &normal}, compute_block);
+  });
+}
+
 // 4. Lighting: one full-screen triangle over the G-buffer.
 void Renderer::Impl::lighting_pass(const RenderSettings& s, const Frame& f) {
   queue.timed("preview/shade", [&] {
@@ -380,6 +409,7 @@ void Renderer::set_volume(SdfVolume volume, std::size_t field_block_bytes) {
         gpu::Program::graphics(m.library, "preview/raycast.vert", "", "preview/raycast.frag", m.volume_defines);
     m.shade_program = gpu::Program::graphics(m.library, "preview/shade.vert", "", "preview/shade.frag", m.volume_defines);
   }
+  if (m.compute) m.compute->set_volume_defines(m.library, m.volume_defines);
   m.volume_spec = volume.spec;
   m.volume_band = volume.band;
   m.volume_box = volume.world_box();
@@ -437,9 +467,13 @@ RenderResult Renderer::render(const RenderSettings& s) {
 
   gpu::StateScope state;
   state.vertex_array(m.vao).depth_test(GL_LESS).no_cull().no_blend();
-  if (s.shadows) m.shadow_pass(frame);
-  m.particle_pass(s, frame);
-  m.raycast_pass(s, frame);
+  if (m.path == GpuPath::Compute) {
+    m.compute_passes(s, frame);
+  } else {
+    if (s.shadows) m.shadow_pass(frame);
+    m.particle_pass(s, frame);
+    m.raycast_pass(s, frame);
+  }
   RenderResult result;
   // 3. CPU colouring of the surface.
   if (s.surface_scalar.value && m.has_volume) m.colour_surface(s, frame.camera, result);
@@ -448,6 +482,10 @@ RenderResult Renderer::render(const RenderSettings& s) {
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
+
+void Renderer::set_gpu_path(GpuPath path) { impl_->path = resolve_gpu_path(path, &impl_->context); }
+
+GpuPath Renderer::gpu_path() const { return impl_->path; }
 
 std::string Renderer::timing_report() { return impl_->queue.timing_report(); }
 

@@ -20,6 +20,7 @@
 
 #include "core/mesh.h"
 #include "gpu/context.h"
+#include "preview/compute_passes.h"
 #include "preview/image_renderer.h"
 
 namespace ts::preview {
@@ -53,6 +54,11 @@ class Renderer final : public ImageRenderer {
 
   // ts::InputError for a bad image size (check_image_size), a bad camera, or nothing to draw.
   RenderResult render(const RenderSettings& settings) override;
+
+  // How the shadow map and G-buffer are made: draws or compute kernels (preview/compute_passes.h);
+  // Auto resolves by resolve_gpu_path. The raster path until set.
+  void set_gpu_path(GpuPath path);
+  GpuPath gpu_path() const;  // Raster or Compute
 
   // Per-pass GPU times so far (when constructed with timings).
   std::string timing_report() override;

@@ -216,6 +216,19 @@ TS_PARAMS(RaycastParams) {
   vec4 surface_color;     // xyz: sRGB; w unused
 };
 
+// ---- preview/splat.comp, trace.comp: the compute shadow map and G-buffer.
+// flags.z and steps.x mean what RaycastParams' do: preview/march.glsl reads them from either.
+TS_PARAMS(PreviewComputeParams) {
+  ivec4 flags;            // x: 1 colours from the per-particle buffer, else particle_color; y: 1 depth
+                          // only (shadow map); z: most refinement steps per crossing; w: 1 has a volume
+  uvec4 sizes;            // x: spheres, y: 8 x 8 tiles along x, z: image width, w: image height [pixels]
+  vec4 steps;             // x: shortest step [voxels] (grazing rays still advance); yzw unused
+  vec4 surface_color;     // xyz: sRGB; w unused
+  vec4 particle_color;    // xyz: sRGB; w unused
+  ivec4 mode;             // x: splat.comp's pass, 0 depths, 1 ids (one program, so both passes
+                          // compute bit-identical depths); yzw unused
+};
+
 // ---- preview/shade.frag: the lighting pass.
 TS_PARAMS(ShadeParams) {
   mat4 light_view_projection;  // relative world -> the light's clip space

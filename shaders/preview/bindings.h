@@ -8,6 +8,10 @@
 //   shade (shade.vert + shade.frag; the lighting pass):
 //     buffers TS_PREVIEW_SPARSE_FIELD, TS_PREVIEW_FIELD_ROOTS, units TS_PREVIEW_UNIT_ALBEDO, TS_PREVIEW_UNIT_NORMAL, TS_PREVIEW_UNIT_DEPTH,
 //     TS_PREVIEW_UNIT_SHADOW
+//   compute shadow map and G-buffer (preview/compute_passes.cpp; --gpu-path compute):
+//     splat.comp: buffers TS_PREVIEW_SPHERES, TS_PREVIEW_DEPTH_BITS, TS_PREVIEW_PARTICLE_IDS
+//     trace.comp: buffers TS_PREVIEW_SPHERES, TS_PREVIEW_COLORS, TS_PREVIEW_DEPTH_BITS, TS_PREVIEW_PARTICLE_IDS,
+//       TS_PREVIEW_SPARSE_FIELD, TS_PREVIEW_FIELD_ROOTS, images TS_PREVIEW_IMAGE_ALBEDO, TS_PREVIEW_IMAGE_NORMAL
 //
 // The buffers sit at 27 and up because the simulator's kernels use bindings 0-26
 // (shaders/common/layouts.h) and share the context in `tetrasand sim`, which renders its frames with
@@ -36,6 +40,16 @@
 #define TS_PREVIEW_FIELD_CHUNK_6 35
 #define TS_PREVIEW_FIELD_CHUNK_7 36
 #define TS_PREVIEW_FIELD_ROOTS 37  // FieldRootTile[]: the field's root table (sdf::SparseField, common/sparse_field.glsl)
+
+// The compute passes' per-pixel buffers, zero-filled before a frame (preview/splat.glsl says why the
+// complements): while splatting ~floatBitsToUint(window depth) and ~(sphere id), after trace.comp
+// the plain float bits of the pixel's window depth (1.0: nothing), ready to upload into a depth texture.
+#define TS_PREVIEW_DEPTH_BITS 38    // uint[]: per pixel, bottom row first
+#define TS_PREVIEW_PARTICLE_IDS 39  // uint[]: per pixel, bottom row first
+
+// Image units (a namespace of their own) the compute G-buffer writes.
+#define TS_PREVIEW_IMAGE_ALBEDO 0  // rgba8: as the G-buffer's albedo target
+#define TS_PREVIEW_IMAGE_NORMAL 1  // rgba16f: as the G-buffer's normal target (w: layer)
 
 #define TS_PREVIEW_UNIT_PARTICLE_DEPTH 1  // sampler2D: window depth of the particle layer
 #define TS_PREVIEW_UNIT_ALBEDO 2          // sampler2D: G-buffer albedo (sRGB)

@@ -68,7 +68,10 @@ def quick(build):
     check(all(r["status"] == "ok" and r["relax_backend"] == "gpu" and "sampler/relax.comp" in r["timings"]
               and r["scan"] in ("compute", "geometry") for r in sampler),
           "sampler: every count ok on the GPU path (scan, relaxation kernels), with their timings")
-    check(len(res["parts"]["preview"]["rows"]) == 3, "preview: SDF, impostor and hybrid rows")
+    preview = res["parts"]["preview"]["rows"]
+    check(sorted((r["path"], r["image"].split()[0]) for r in preview)
+          == sorted((p, k) for p in ("raster", "compute") for k in ("SDF", "2000", "hybrid:")),
+          "preview: SDF, impostor and hybrid rows by both GPU paths")
     md = open(os.path.join(out, "device-bench.md")).read()
     check(all(f"### {t} on an NVIDIA GPU" in md for t in ("GPU self-test", "SDF", "Sampling", "Simulation", "Preview")),
           "device-bench.md has the five sections")

@@ -264,6 +264,19 @@ TEST_F(GpuParams, PreviewProgramsMatchCpp) {
            TS_MEMBER(params, ShadeParams, background_bottom)}}});
 }
 
+BlockSpec preview_compute() {
+  return {"ComputeBlock",
+          sizeof(PreviewComputeParams),
+          {TS_MEMBER(params, PreviewComputeParams, flags), TS_MEMBER(params, PreviewComputeParams, sizes),
+           TS_MEMBER(params, PreviewComputeParams, steps), TS_MEMBER(params, PreviewComputeParams, surface_color),
+           TS_MEMBER(params, PreviewComputeParams, particle_color), TS_MEMBER(params, PreviewComputeParams, mode)}};
+}
+
+TEST_F(GpuParams, PreviewComputeKernelsMatchCpp) {
+  check(compute("preview/splat.comp"), {camera(), preview_compute()});
+  check(compute("preview/trace.comp"), {camera(), volume(), field(), preview_compute()});
+}
+
 TEST_F(GpuParams, TestKernelsMatchCpp) {
   check(compute("test/saxpy.comp"),
         {{"SaxpyBlock",
