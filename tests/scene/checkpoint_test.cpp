@@ -233,8 +233,8 @@ TEST(Checkpoint, MissingCorruptAndMismatchedCheckpointsAreRefusedNamingTheFile) 
   flipped[flipped.size() / 3] ^= 0x10;
   refused_with(flipped, "corrupt");
   std::string version = good;
-  version[8] = 2;  // the version follows the 8-byte magic
-  refused_with(version, "checkpoint format version 2");
+  version[8] = static_cast<char>(kCheckpointVersion + 1);  // the version follows the 8-byte magic
+  refused_with(version, fmt::format("checkpoint format version {}", kCheckpointVersion + 1));
   refused_with("hello", "not a tetrasand checkpoint");
 
   write_file_atomically(file, good);
