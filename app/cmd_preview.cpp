@@ -438,7 +438,7 @@ void print_json(const Options& o, const Eigen::Vector2i& size, const Content& co
   r.colour_max = views.scalar.max;
   r.colour_map_max = settings.surface_scalar.max_value;
   r.render_seconds = views.seconds;
-  r.timing_report = renderer.timing_report();
+  r.passes = renderer.pass_times();
   fmt::print("{}\n", preview_report_json(r).dump(2));
 }
 

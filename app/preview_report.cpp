@@ -1,35 +1,6 @@
 #include "app/preview_report.h"
 
-#include <regex>
-#include <sstream>
-
-#include "core/error.h"
-
 namespace ts::app {
-
-std::vector<PassTime> parse_pass_times(const std::string& table) {
-  static const std::regex row(R"(^(\S.*?)\s+(\d+)\s+(\d+(?:\.\d+)?)\s+(\d+(?:\.\d+)?)%$)");
-  static const std::regex total(R"(^total\s+\d+(?:\.\d+)?$)");
-  std::vector<PassTime> passes;
-  std::istringstream lines(table);
-  std::string line;
-  bool header = true;
-  while (std::getline(lines, line)) {
-    if (header) {  // "GPU kernel ... calls total ms share" or "CPU pass ..."
-      header = false;
-      continue;
-    }
-    std::smatch m;
-    if (std::regex_match(line, m, row)) {
-      passes.push_back({m[1].str(), std::stoull(m[2].str()), std::stod(m[3].str())});
-    } else if (!std::regex_match(line, total)) {
-      throw Error(ExitCode::Internal,
-                  "preview --json: a per-pass timing line of an unknown form: '" + line + "'");
-    }
-  }
-  return passes;
-}
-
 namespace {
 
 nlohmann::ordered_json or_null(const std::string& text) {
@@ -60,7 +31,7 @@ nlohmann::ordered_json preview_report_json(const PreviewReport& r) {
   nlohmann::ordered_json outputs = nlohmann::ordered_json::array();
   for (const std::filesystem::path& p : r.outputs) outputs.push_back(p.string());
   nlohmann::ordered_json passes = nlohmann::ordered_json::array();
-  for (const PassTime& p : parse_pass_times(r.timing_report)) {
+  for (const preview::PassTime& p : r.passes) {
     passes.push_back({{"name", p.name}, {"calls", p.calls}, {"milliseconds", p.milliseconds}});
   }
   return {

@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "preview/image_renderer.h"
+
 namespace ts::app {
 
 struct PreviewReport {
@@ -28,20 +30,8 @@ struct PreviewReport {
   std::size_t colour_pixels = 0;  // surface pixels coloured, all views
   double colour_mean = 0.0, colour_max = 0.0, colour_map_max = 0.0;
   double render_seconds = 0.0;  // wall time of every view's render
-  std::string timing_report;    // the renderer's per-pass table (ImageRenderer::timing_report)
+  std::vector<preview::PassTime> passes;  // the renderer's per-pass times (ImageRenderer::pass_times)
 };
-
-// One row of a renderer's per-pass table: a GL kernel or draw (GPU timer queries) or a CPU pass.
-struct PassTime {
-  std::string name;
-  std::size_t calls = 0;
-  double milliseconds = 0.0;
-};
-
-// The rows of the table gpu::Queue::timing_report and preview::CpuRenderer::timing_report print (a
-// header, "NAME CALLS TOTAL_MS SHARE%" rows, a total); throws Error(Internal) on a line of another form,
-// so a change of that table fails the tests instead of dropping passes from the report.
-std::vector<PassTime> parse_pass_times(const std::string& table);
 
 nlohmann::ordered_json preview_report_json(const PreviewReport& report);
 

@@ -477,6 +477,14 @@ RenderResult CpuRenderer::render(const RenderSettings& s) {
   return result;
 }
 
+std::vector<PassTime> CpuRenderer::pass_times() {
+  std::vector<PassTime> passes;
+  for (const auto& [name, entry] : impl_->pass_seconds) {
+    passes.push_back({name, static_cast<std::size_t>(entry.first), 1e3 * entry.second});
+  }
+  return passes;
+}
+
 std::string CpuRenderer::timing_report() {
   double sum = 0.0;
   for (const auto& [name, entry] : impl_->pass_seconds) sum += entry.second;

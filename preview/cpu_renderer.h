@@ -35,6 +35,7 @@ class CpuRenderer final : public ImageRenderer {
   void check_image_size(int width, int height) const override;
   RenderResult render(const RenderSettings& settings) override;
   // Per-pass wall times, in the GL renderer's table layout.
+  std::vector<PassTime> pass_times() override;
   std::string timing_report() override;
   std::string device() const override;  // "the CPU (N TBB threads)"
 

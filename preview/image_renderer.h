@@ -62,6 +62,14 @@ struct RenderResult {
   double seconds = 0.0;                 // wall time of render()
 };
 
+// One row of a renderer's per-pass times: a GL kernel or draw (GPU timer queries) or a CPU pass (wall
+// time), accumulated over the renderer's life.
+struct PassTime {
+  std::string name;
+  std::size_t calls = 0;
+  double milliseconds = 0.0;
+};
+
 // What a preview renderer does, on the GL device (Renderer) or on the CPU (CpuRenderer,
 // preview/cpu_renderer.h): the commands load the scene and draw views through this, whichever runs.
 class ImageRenderer {
@@ -78,7 +86,8 @@ class ImageRenderer {
   virtual void check_image_size(int width, int height) const = 0;
   // ts::InputError for a bad image size, a bad camera, or nothing to draw.
   virtual RenderResult render(const RenderSettings& settings) = 0;
-  // Per-pass times so far (when constructed with timings).
+  // Per-pass times so far (when constructed with timings): as rows, and as the --timings table.
+  virtual std::vector<PassTime> pass_times() = 0;
   virtual std::string timing_report() = 0;
   // What draws: "llvmpipe (...)", "the CPU (16 TBB threads)".
   virtual std::string device() const = 0;

@@ -487,6 +487,12 @@ void Renderer::set_gpu_path(GpuPath path) { impl_->path = resolve_gpu_path(path,
 
 GpuPath Renderer::gpu_path() const { return impl_->path; }
 
+std::vector<PassTime> Renderer::pass_times() {
+  std::vector<PassTime> passes;
+  for (const gpu::KernelTiming& t : impl_->queue.timings()) passes.push_back({t.name, t.calls, t.milliseconds});
+  return passes;
+}
+
 std::string Renderer::timing_report() { return impl_->queue.timing_report(); }
 
 std::string Renderer::device() const { return impl_->context.summary(); }

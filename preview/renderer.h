@@ -61,6 +61,7 @@ class Renderer final : public ImageRenderer {
   GpuPath gpu_path() const;  // Raster or Compute
 
   // Per-pass GPU times so far (when constructed with timings).
+  std::vector<PassTime> pass_times() override;
   std::string timing_report() override;
   std::string device() const override;  // the context's summary
 
