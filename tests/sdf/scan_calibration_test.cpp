@@ -88,8 +88,10 @@ TEST_F(ScanCalibration, EntryOfAnotherRendererOrDriverIsNotUsedButKept) {
   EXPECT_EQ(file["entries"].size(), 3u);
 }
 
-TEST_F(ScanCalibration, EntryOfAnotherBuildIsNotUsedAndIsReplaced) {
-  // A rebuilt tetrasand may scan at other speeds: its own calibration replaces the stale one.
+TEST_F(ScanCalibration, EntryOfAnotherBuildIsNotUsedButKept) {
+  // A rebuilt tetrasand may scan at other speeds: it times its own. The other build's entry stays, as
+  // two executables (the tool and a test program) may share the cache and would otherwise evict each
+  // other's entry on every run.
   ASSERT_NE(scan_build_id(), "unknown");
   write_cache(
       nlohmann::json::array({entry(context.renderer(), context.version(), 2.0, 1.0, "1 bytes, written 0")}));
@@ -97,8 +99,27 @@ TEST_F(ScanCalibration, EntryOfAnotherBuildIsNotUsedAndIsReplaced) {
   EXPECT_EQ(calibrations, 1);
   EXPECT_EQ(choice.method, ScanMethod::Compute);
   const nlohmann::json file = nlohmann::json::parse(read_file(cache));
-  ASSERT_EQ(file["entries"].size(), 1u);
-  EXPECT_EQ(file["entries"][0]["build"], scan_build_id());
+  ASSERT_EQ(file["entries"].size(), 2u);
+  EXPECT_EQ(file["entries"][0]["build"], "1 bytes, written 0");
+  EXPECT_EQ(file["entries"][1]["build"], scan_build_id());
+  choose();
+  EXPECT_EQ(calibrations, 1);
+}
+
+TEST_F(ScanCalibration, ADeviceKeepsItsNewestFourBuildsAndEveryOtherDevice) {
+  nlohmann::json entries = nlohmann::json::array();
+  for (int i = 0; i < 5; ++i)
+    entries.push_back(entry(context.renderer(), context.version(), 2.0, 1.0, "build " + std::to_string(i)));
+  entries.push_back(entry("Some Other GPU/PCIe/SSE2", context.version(), 2.0, 1.0, "build 0"));
+  write_cache(entries);
+  choose();
+  EXPECT_EQ(calibrations, 1);
+  const nlohmann::json kept = nlohmann::json::parse(read_file(cache))["entries"];
+  ASSERT_EQ(kept.size(), 5u);  // builds 2, 3, 4 of this device, the other device's, and this build's
+  EXPECT_EQ(kept[0]["build"], "build 2");
+  EXPECT_EQ(kept[2]["build"], "build 4");
+  EXPECT_EQ(kept[3]["renderer"], "Some Other GPU/PCIe/SSE2");
+  EXPECT_EQ(kept[4]["build"], scan_build_id());
 }
 
 TEST_F(ScanCalibration, ExplicitMethodsNeitherCalibrateNorTouchTheCache) {
