@@ -20,6 +20,7 @@
 #include "preview/cpu_renderer.h"
 #include "preview/image.h"
 #include "preview/inputs.h"
+#include "preview/path_calibration.h"
 #include "preview/renderer.h"
 #include "preview/volume.h"
 #include "sampler/point_grid.h"
@@ -102,7 +103,7 @@ void add_input_options(CLI::App* cmd, Options& o) {
       ->capture_default_str();
   cmd->add_option("--gpu-path", o.gpu_path,
                   "On the GPU, the shadow map and G-buffer by draws (raster) or by compute kernels (compute); "
-                  "auto: compute on a hardware GPU, raster on a software renderer such as llvmpipe")
+                  "auto: whichever a calibration on this GL device found faster (timed once, cached), compute on a tie")
       ->check(CLI::IsMember({"auto", "raster", "compute"}))
       ->capture_default_str();
 }
@@ -377,18 +378,14 @@ void say(const Options& o, const std::string& line) {
 }
 
 // The GL renderer with the --gpu-path it resolves to, named in one line.
-std::unique_ptr<preview::ImageRenderer> make_gpu_renderer(const Options& o, gpu::Context& context, bool timings) {
+std::unique_ptr<preview::ImageRenderer> make_gpu_renderer(const Options& o, gpu::Context& context, bool timings,
+                                                          PreviewReport& report) {
   const preview::GpuPath requested = preview::parse_gpu_path(o.gpu_path).value();  // CLI::IsMember checked it
+  const preview::GpuPathChoice choice = preview::choose_gpu_path(context, requested);
   auto renderer = std::make_unique<preview::Renderer>(context, timings);
-  renderer->set_gpu_path(requested);
-  const char* chosen = preview::gpu_path_name(renderer->gpu_path());
-  if (requested != preview::GpuPath::Auto) {
-    say(o, fmt::format("gpu path: {} (asked for)", chosen));
-  } else {
-    say(o, fmt::format("gpu path: {} (auto: compute on a hardware GPU, raster on a software renderer; the GL "
-                       "device is {})",
-                       chosen, gpu::describe(&context).renderer));
-  }
+  renderer->set_gpu_path(choice.path);
+  say(o, "gpu path: " + choice.describe());
+  report.gpu_path = choice.describe();
   return renderer;
 }
 
@@ -406,7 +403,7 @@ std::unique_ptr<preview::ImageRenderer> make_renderer(const Options& o, const Gl
   report.requested_backend = o.backend;
   report.backend = gpu::backend_name(chosen);
   const bool timings = o.timings || o.json;  // --json reports the per-pass times
-  if (chosen == gpu::Backend::Gpu) return make_gpu_renderer(o, *context, timings);
+  if (chosen == gpu::Backend::Gpu) return make_gpu_renderer(o, *context, timings, report);
   context.reset();  // the CPU draws and builds the field: the context is not needed any more
   return std::make_unique<preview::CpuRenderer>(timings);
 }

@@ -222,7 +222,7 @@ PreviewDone write_preview(const Options& o, gpu::Context* context, const Triangl
 // The preview's line of the report (a log line under --json: standard output stays the JSON).
 void report_preview(const Options& o, const PreviewDone& done) {
   const std::string line = fmt::format("{}, {:.2f} s on the {}{}", done.png.string(), done.report.seconds,
-                                       done.on_gpu ? "GPU" : "CPU",
+                                       done.on_gpu ? "GPU, " + done.report.gpu_path : "CPU",
                                        done.report.field_drawn ? "" : " (particles only: the SDF's signs are unreliable)");
   if (o.json) {
     log::info("preview: {}", line);

@@ -21,6 +21,7 @@ struct PreviewReport {
   int views = 1;                               // --turntable
   bool contact_sheet = false;
   std::string requested_backend, backend, device;  // --backend, the one chosen, the renderer's device
+  std::string gpu_path;  // on the GPU: the --gpu-path taken and why ("compute (asked for)"); empty on the CPU
   std::string field;        // what the SDF is (dimensions, voxel, band); empty without one
   double voxel_size = 0.0;  // m, of the SDF (0 without one)
   std::size_t particles = 0;

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "preview/cpu_renderer.h"
+#include "preview/path_calibration.h"
 #include "preview/renderer.h"
 
 namespace ts::preview {
@@ -15,7 +16,11 @@ BodyPreviewReport write_body_preview(gpu::Context* context, const TriangleMesh& 
   BodyPreviewReport report;
   std::unique_ptr<ImageRenderer> drawn;
   if (context) {
-    drawn = std::make_unique<Renderer>(*context);
+    const GpuPathChoice path = choose_gpu_path(*context, GpuPath::Auto);
+    auto gl = std::make_unique<Renderer>(*context);
+    gl->set_gpu_path(path.path);
+    report.gpu_path = path.describe();
+    drawn = std::move(gl);
   } else {
     drawn = std::make_unique<CpuRenderer>();
   }

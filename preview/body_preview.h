@@ -2,6 +2,7 @@
 // `tetrasand sample --preview`: NAME.preview.png beside the body, the mesh's SDF ray-cast with the
 // particles over it (the thesis's figure 6.13), from the iso view, +z up unless told otherwise.
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "body/particle_body.h"
@@ -23,10 +24,12 @@ struct BodyPreviewSettings {
 struct BodyPreviewReport {
   bool field_drawn = true;  // false: the field read inside at its box's corner (SdfVolume::inside_out), not drawn
   double seconds = 0.0;     // s, wall time: the field, the drawing and the PNG
+  std::string gpu_path;     // on the GPU: the path taken and why (preview/path_calibration.h); empty on the CPU
 };
 
 // Scan-converts `mesh` on `context`'s device and renders it there with `body`'s particles, or with a
-// null context builds the exact SDF and renders on the CPU (preview/cpu_renderer.h); writes `png`
+// null context builds the exact SDF and renders on the CPU (preview/cpu_renderer.h); on the GPU the
+// shadow map and G-buffer take the calibrated --gpu-path auto choice (preview/path_calibration.h); writes `png`
 // atomically, never over one of `inputs`. A field whose signs flood its box is left out (the particles
 // alone), never drawn as a box.
 BodyPreviewReport write_body_preview(gpu::Context* context, const TriangleMesh& mesh, const body::ParticleBody& body,

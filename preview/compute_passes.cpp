@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "gpu/backend.h"
 #include "gpu/context.h"
 #include "shaders/preview/bindings.h"
 
@@ -34,11 +33,6 @@ std::optional<GpuPath> parse_gpu_path(std::string_view text) {
     if (text == gpu_path_name(p)) return p;
   }
   return std::nullopt;
-}
-
-GpuPath resolve_gpu_path(GpuPath requested, const gpu::Context* context) {
-  if (requested != GpuPath::Auto) return requested;
-  return gpu::describe(context).kind == gpu::DeviceKind::Hardware ? GpuPath::Compute : GpuPath::Raster;
 }
 
 ComputePasses::ComputePasses(const gpu::ShaderLibrary& library, const std::vector<std::string>& volume_defines)

@@ -35,11 +35,6 @@ enum class GpuPath { Auto, Raster, Compute };
 const char* gpu_path_name(GpuPath path);
 // The inverse of gpu_path_name; nullopt for any other text.
 std::optional<GpuPath> parse_gpu_path(std::string_view text);
-// Raster or Compute: `requested` unless Auto, which is the stated rule: compute on a hardware GPU
-// (raster units are few there: 4 of 132 SMs on GH100), raster on a software renderer (llvmpipe,
-// where the draws measured faster: docs/benchmarks/preview.md) or without a context.
-GpuPath resolve_gpu_path(GpuPath requested, const gpu::Context* context);
-
 // What a compute image draws; the caller has bound the camera, the spheres and colours, and (with
 // has_volume) the sparse field and its VolumeParams at the preview's slots (shaders/preview/bindings.h).
 struct ComputeScene {

@@ -14,6 +14,7 @@
 #include "gpu/params.h"
 #include "preview/colors.h"
 #include "preview/frame.h"
+#include "preview/path_calibration.h"
 #include "shaders/preview/bindings.h"
 
 namespace ts::preview {
@@ -483,7 +484,9 @@ RenderResult Renderer::render(const RenderSettings& s) {
   return result;
 }
 
-void Renderer::set_gpu_path(GpuPath path) { impl_->path = resolve_gpu_path(path, &impl_->context); }
+void Renderer::set_gpu_path(GpuPath path) {
+  impl_->path = path == GpuPath::Auto ? choose_gpu_path(impl_->context, path).path : path;
+}
 
 GpuPath Renderer::gpu_path() const { return impl_->path; }
 

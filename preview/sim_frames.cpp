@@ -7,8 +7,10 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "preview/colors.h"
 #include "preview/image.h"
+#include "preview/path_calibration.h"
 
 namespace ts::preview {
 namespace {
@@ -58,6 +60,10 @@ SimFrameWriter::SimFrameWriter(gpu::Context& context, const scene::Scene& scene,
       walls_(scene),
       props_(scene.props.size()),
       gravity_(scene.gravity.norm()) {
+  // The shadow map and G-buffer by whichever path a calibration found faster on this device.
+  const GpuPathChoice path = choose_gpu_path(context, GpuPath::Auto);
+  renderer_.set_gpu_path(path.path);
+  log::info("frames: gpu path {}", path.describe());
   try {
     renderer_.check_image_size(settings_.camera.width, settings_.camera.height);
   } catch (const InputError& e) {

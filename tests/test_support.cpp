@@ -58,11 +58,22 @@ std::string quoted(const std::filesystem::path& p) {
   return out;
 }
 
+namespace {
+
+// --scan auto and --gpu-path auto calibrate once per renderer, driver and build into cache files
+// (gpu/path_calibration.h): the build tree's, not the user's, shared by every test and every CLI run a
+// test makes. Set before main, so in-process renderers (sim frames) read them too.
+const bool kCalibrationCachesInBuildTree = [] {
+  const std::filesystem::path bin = std::filesystem::path(TETRASAND_BINARY).parent_path();
+  ::setenv("TETRASAND_SCAN_CACHE", (bin / "test_scan_calibration.json").c_str(), 0);
+  ::setenv("TETRASAND_PREVIEW_CACHE", (bin / "test_preview_calibration.json").c_str(), 0);
+  return true;
+}();
+
+}  // namespace
+
 int run_tetrasand(const std::string& args, std::string* output) {
-  // --scan auto calibrates once per renderer and driver into a cache file: the build tree's, not the
-  // user's, and shared by every CLI test (sdf/scan_calibration.h).
-  const std::filesystem::path cache = std::filesystem::path(TETRASAND_BINARY).parent_path() / "test_scan_calibration.json";
-  ::setenv("TETRASAND_SCAN_CACHE", cache.c_str(), 0);
+  (void)kCalibrationCachesInBuildTree;
   const std::string cmd = std::string("'") + TETRASAND_BINARY + "' " + args + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (!pipe) throw std::runtime_error("popen failed");

@@ -131,11 +131,7 @@ TEST(PreviewComputePasses, OverlappingSpheresResolveToTheNearestWhateverTheirOrd
   }
 }
 
-TEST(PreviewComputePasses, AutoTakesComputeOnHardwareAndTheDrawsOnASoftwareRenderer) {
-  EXPECT_EQ(resolve_gpu_path(GpuPath::Auto, nullptr), GpuPath::Raster);
-  EXPECT_EQ(resolve_gpu_path(GpuPath::Compute, nullptr), GpuPath::Compute);
-  EXPECT_EQ(resolve_gpu_path(GpuPath::Auto, &context()),
-            context().software() ? GpuPath::Raster : GpuPath::Compute);
+TEST(PreviewComputePasses, GpuPathSpellingsRoundTripAndOthersAreRefused) {
   for (GpuPath path : {GpuPath::Auto, GpuPath::Raster, GpuPath::Compute}) {
     EXPECT_EQ(parse_gpu_path(gpu_path_name(path)), path);
   }
