@@ -187,6 +187,7 @@ TEST(CliPreview, JsonReportNamesEachTurntableViewAndTheRenderersPasses) {
   EXPECT_EQ(report["image"]["height"], 16);
   EXPECT_EQ(report["image"]["views"], 3);
   EXPECT_EQ(report["backend"]["chosen"], "cpu");
+  EXPECT_TRUE(report["backend"]["gpu_path"].is_null());  // drawn on the CPU: no GPU path
   EXPECT_GT(report["drawn"]["field"]["voxel_size_m"].get<double>(), 0.0);
   EXPECT_TRUE(report["drawn"]["particles"].is_null());
   ASSERT_FALSE(report["passes"].empty()) << report.dump(2);
@@ -240,22 +241,33 @@ double particle_pixel_share(const preview::Image& image) {
   return static_cast<double>(orange) / (static_cast<double>(image.width) * image.height);
 }
 
-// The issue's open mesh: sampled with --sign winding, its preview is signed the same way, so the
-// particles show over the winding-number surface; criterion: at least 5 % of the pixels are particle
-// orange (a field drawn as one box hides every particle: well under 1 %).
+// The issue's open mesh, CGAL's double-torus-3-holes: pseudonormal signs flood its whole box (the
+// grey box the issue saw), so a preview that ignored the body's sign would leave the field out ("particles
+// only") or draw the box. Sampled with --sign winding, its preview is signed the same way: the field is
+// drawn and the particles show over it. Criteria: the report has no "particles only", and at least 5 % of
+// the pixels are particle orange (a field drawn as one box hides every particle: well under 1 %). The
+// control: the same mesh previewed by pseudonormals is reported as flooded, so the first check can fail.
 TEST(CliPreview, AnOpenMeshSampledByWindingNumberPreviewsAsItsParticles) {
   const auto dir = test::temp_dir();
-  const auto open = write_open_sphere(dir);
+  const auto open = test::cgal_mesh("double-torus-3-holes");
   std::string out;
   ASSERT_EQ(test::run_tetrasand("sample " + q(open) + " -o " + q(dir) +
-                                    " --count 150 --probes 5000 --sign winding --preview",
+                                    " --count 300 --probes 5000 --sign winding --preview",
                                 &out),
             0)
       << out;
-  ASSERT_TRUE(std::filesystem::exists(dir / "open.preview.png")) << out;
-  const double share = particle_pixel_share(preview::read_png(dir / "open.preview.png"));
-  EXPECT_GT(share, 0.05) << out;
+  const auto png = dir / "double-torus-3-holes.preview.png";
+  ASSERT_TRUE(std::filesystem::exists(png)) << out;
   EXPECT_NE(out.find("  preview          "), std::string::npos) << out;
+  EXPECT_EQ(out.find("particles only"), std::string::npos) << out;
+  EXPECT_GT(particle_pixel_share(preview::read_png(png)), 0.05) << out;
+
+  ASSERT_EQ(test::run_tetrasand("preview " + q(open) + " --particles " + q(dir / "double-torus-3-holes.body.json") +
+                                    " --size 96x96 --resolution 48 --sign pseudonormal -o " + q(dir / "p.png"),
+                                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("NOT drawn"), std::string::npos) << "pseudonormal signs no longer flood this mesh: " << out;
 }
 
 // `preview --sign`: the open mesh with the body's particles draws by winding number, and by
