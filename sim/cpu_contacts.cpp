@@ -130,17 +130,28 @@ bool CpuContacts::pair_contact(const ParticleState& a, const ParticleState& b, d
   return true;
 }
 
+// Three passes: the touching test on every pair, the touching ones numbered in pair order, the law
+// on those alone.
 void CpuContacts::compute_pair_contacts() {
   const CandidatePairs& pairs = lists_.pairs();
   const auto count = static_cast<std::uint32_t>(pairs.size());
   const double cap = overlap_ratio_cap();
-  pair_touching_.resize(count);
-  pair_contacts_.resize(count);
+  contact_of_pair_.resize(count);
   for_each_index(count, [&](std::uint32_t p) {
-    pair_touching_[p] = 0;
-    if (!spheres_touch(pairs.first[p], pairs.second[p])) return;
-    const bool touching = pair_contact(state_[pairs.first[p]], state_[pairs.second[p]], cap, pair_contacts_[p]);
-    pair_touching_[p] = touching ? 1 : 0;
+    contact_of_pair_[p] = spheres_touch(pairs.first[p], pairs.second[p]) ? 0 : kNotTouching;
+  });
+  touching_pairs_.clear();
+  for (std::uint32_t p = 0; p < count; ++p) {
+    if (contact_of_pair_[p] == kNotTouching) continue;
+    contact_of_pair_[p] = static_cast<std::uint32_t>(touching_pairs_.size());
+    touching_pairs_.push_back(p);
+  }
+  pair_contacts_.resize(touching_pairs_.size());
+  for_each_index(static_cast<std::uint32_t>(touching_pairs_.size()), [&](std::uint32_t k) {
+    const std::uint32_t p = touching_pairs_[k];
+    if (!pair_contact(state_[pairs.first[p]], state_[pairs.second[p]], cap, pair_contacts_[k])) {
+      contact_of_pair_[p] = kNotTouching;
+    }
   });
 }
 
@@ -151,8 +162,9 @@ void CpuContacts::compute_pair_contacts() {
 // when the two particles swap), so either side sums what computing it from its own side gives.
 void CpuContacts::add_pair_contacts(std::uint32_t slot, ParticleContacts& out) const {
   for (const ListEntry& entry : lists_.candidates(slot)) {
-    if (!pair_touching_[entry.pair]) continue;
-    const PairContact& c = pair_contacts_[entry.pair];
+    const std::uint32_t contact = contact_of_pair_[entry.pair];
+    if (contact == kNotTouching) continue;
+    const PairContact& c = pair_contacts_[contact];
     ++out.touching;
     if (!entry.first) {
       const Eigen::Vector3d force = -c.force;

@@ -106,7 +106,7 @@ class CpuContacts {
   template <typename Fn>
   void visit_contacts(const World& world, std::uint32_t slot, Fn&& fn, SpringSlots* springs = nullptr) const;
   class SpringLookup;
-  // Every candidate pair's contact into pair_contacts_ (no springs).
+  // Every touching candidate pair's contact into pair_contacts_ (no springs).
   void compute_pair_contacts();
   // Whether the two touch; if so, their contact into `out`.
   bool pair_contact(const ParticleState& first, const ParticleState& second, double cap, PairContact& out) const;
@@ -132,8 +132,11 @@ class CpuContacts {
   std::vector<Eigen::Vector3d> position_, velocity_;  // world order
   std::vector<ParticleState> state_;                  // cell order
   std::vector<ParticleContacts> particle_contacts_;   // world order
-  // As lists_.pairs(): whether the pair touches, and its contact (only where it does).
-  std::vector<std::uint8_t> pair_touching_;
+  // As lists_.pairs(): the pair's place in pair_contacts_, or kNotTouching. Only touching pairs keep
+  // a contact (about one in five candidates on a settled bed), in pair order.
+  static constexpr std::uint32_t kNotTouching = 0xffffffffu;
+  std::vector<std::uint32_t> contact_of_pair_;
+  std::vector<std::uint32_t> touching_pairs_;
   std::vector<PairContact> pair_contacts_;
   // Cell order, what the touching test reads: half a cache line a particle.
   struct Sphere {
