@@ -1,11 +1,12 @@
 #include "sim/cpu_contacts.h"
 
 #include <fmt/format.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+
+#include "sim/cpu_parallel.h"
 
 namespace ts::sim {
 
@@ -105,6 +106,81 @@ void CpuContacts::visit_neighbours(std::uint32_t slot, Fn& fn, SpringLookup& loo
   }
 }
 
+// The test visit_neighbours makes before the contact law, on the compact copy (the same bits).
+bool CpuContacts::spheres_touch(std::uint32_t first_slot, std::uint32_t second_slot) const {
+  const Sphere& a = sphere_[first_slot];
+  const Sphere& b = sphere_[second_slot];
+  const double reach = a.radius + b.radius;  // m
+  return !((a.centre - b.centre).squaredNorm() >= reach * reach);
+}
+
+bool CpuContacts::pair_contact(const ParticleState& a, const ParticleState& b, double cap, PairContact& out) const {
+  const auto& coefficients = pairs_[a.material * material_count_ + b.material];
+  const ContactForce<double> f =
+      sphere_sphere_contact(a.position, a.velocity, a.angular_velocity, a.radius, a.inverse_mass, b.position,
+                            b.velocity, b.angular_velocity, b.radius, b.inverse_mass,
+                            cap * std::min(a.radius, b.radius), coefficients, settings_.dt);
+  if (!f.touching) return false;
+  const double smaller = std::min(a.radius, b.radius);  // m
+  // The second particle's arm as sphere_sphere_contact forms it (the same operations, so the same bits).
+  const Eigen::Vector3d d = a.position - b.position;
+  const double distance = d.norm();
+  const Eigen::Vector3d arm_second = (b.radius - 0.5 * (a.radius + b.radius - distance)) * (d / distance);
+  out = {f.force, f.arm, arm_second, f.overlap / smaller, f.elastic_energy, f.overlap_clamped};
+  return true;
+}
+
+// Three passes: the touching test on every pair, the touching ones numbered in pair order, the law
+// on those alone.
+void CpuContacts::compute_pair_contacts() {
+  const CandidatePairs& pairs = lists_.pairs();
+  const auto count = static_cast<std::uint32_t>(pairs.size());
+  const double cap = overlap_ratio_cap();
+  contact_of_pair_.resize(count);
+  for_each_index(count, [&](std::uint32_t p) {
+    contact_of_pair_[p] = spheres_touch(pairs.first[p], pairs.second[p]) ? 0 : kNotTouching;
+  });
+  touching_pairs_.clear();
+  for (std::uint32_t p = 0; p < count; ++p) {
+    if (contact_of_pair_[p] == kNotTouching) continue;
+    contact_of_pair_[p] = static_cast<std::uint32_t>(touching_pairs_.size());
+    touching_pairs_.push_back(p);
+  }
+  pair_contacts_.resize(touching_pairs_.size());
+  for_each_index(static_cast<std::uint32_t>(touching_pairs_.size()), [&](std::uint32_t k) {
+    const std::uint32_t p = touching_pairs_[k];
+    if (!pair_contact(state_[pairs.first[p]], state_[pairs.second[p]], cap, pair_contacts_[k])) {
+      contact_of_pair_[p] = kNotTouching;
+    }
+  });
+}
+
+// The particle's list by increasing partner id, as visit_neighbours and the gather's ParticleContacts
+// updates, but each contact read from its pair: the first side (the one that counts it) takes the force
+// as computed, the second its negation about its own arm. The contact law is antisymmetric bit for bit
+// (sim/contact_model.h: the difference vectors, the normal and the relative velocity only change sign
+// when the two particles swap), so either side sums what computing it from its own side gives.
+void CpuContacts::add_pair_contacts(std::uint32_t slot, ParticleContacts& out) const {
+  for (const ListEntry& entry : lists_.candidates(slot)) {
+    const std::uint32_t contact = contact_of_pair_[entry.pair];
+    if (contact == kNotTouching) continue;
+    const PairContact& c = pair_contacts_[contact];
+    ++out.touching;
+    if (!entry.first) {
+      const Eigen::Vector3d force = -c.force;
+      out.force += force;
+      out.torque += c.arm_second.cross(force);
+      continue;
+    }
+    out.force += c.force;
+    out.torque += c.arm_first.cross(c.force);
+    out.max_overlap_ratio = std::max(out.max_overlap_ratio, c.overlap_ratio);
+    out.elastic_energy += c.elastic_energy;
+    out.overlap_clamps += c.overlap_clamped ? 1 : 0;
+    ++out.pairs;
+  }
+}
+
 // Smooth walls, in declaration order: planes, then cylinders (partner -1 - wall index).
 template <typename Fn>
 void CpuContacts::visit_walls(const World& world, std::uint32_t slot, Fn& fn, SpringLookup& lookup) const {
@@ -144,7 +220,7 @@ void CpuContacts::prepare_particles(const World& world) {
   position_.resize(n);
   velocity_.resize(n);
   // Particle world positions and velocities from the body poses (eqs. 3.42, 3.43).
-  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
+  for_each_index(n, [&](std::uint32_t i) {
     const std::uint32_t k = p.body[i];
     const Eigen::Vector3d arm = b.orientation[k] * p.offset[i];
     position_[i] = b.position[k] + arm;
@@ -157,11 +233,13 @@ void CpuContacts::prepare_particles(const World& world) {
   }
   // The step's state in cell order: a list's partners sit near their particle in memory.
   state_.resize(n);
+  sphere_.resize(n);
   const std::vector<std::uint32_t>& order = lists_.order();
-  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t s) {
+  for_each_index(n, [&](std::uint32_t s) {
     const std::uint32_t i = order[s];
     const std::uint32_t k = p.body[i];
     state_[s] = {position_[i], velocity_[i], b.angular_velocity[k], p.radius[i], b.inverse_mass[k], p.material[i]};
+    sphere_[s] = {position_[i], p.radius[i]};
   });
 }
 
@@ -199,7 +277,7 @@ double CpuContacts::elastic_energy(const World& world) {
   prepare_particles(world);
   const auto n = static_cast<std::uint32_t>(world.particles.size());
   std::vector<double> energy(n, 0.0);
-  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
+  for_each_index(n, [&](std::uint32_t i) {
     if (world.bodies.inverse_mass[world.particles.body[i]] == 0) return;
     SpringSlots slots = read_only_slots(world, i);
     visit_contacts(
@@ -230,9 +308,12 @@ void CpuContacts::gather(const World& world, GatheredForces& out_forces, StepSta
   }
   particle_contacts_.assign(n, ParticleContacts{});
   overflows_.assign(springs ? n : 0, 0);
+  // Without springs each pair's contact is computed once, then summed per particle below; a spring
+  // belongs to one side of its pair, so with springs each side computes its own.
+  if (!springs) compute_pair_contacts();
   const std::vector<std::uint32_t>& order = lists_.order();
   // In cell order, so that neighbouring particles, and their lists' partners, are visited together.
-  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t s) {
+  for_each_index(n, [&](std::uint32_t s) {
     const std::uint32_t i = order[s];
     ParticleContacts& out = particle_contacts_[i];
     // Static and kinematic particles need no force: their partners compute their own side.
@@ -246,18 +327,22 @@ void CpuContacts::gather(const World& world, GatheredForces& out_forces, StepSta
       slots.new_partner = &out_forces.springs.partner[i * K];
       slots.new_displacement = &out_forces.springs.displacement[i * K];
     }
-    visit_contacts(
-        world, s,
-        [&](const ContactForce<double>& f, std::int64_t partner, double smaller_radius) {
-          const bool wall = partner < 0;
-          const bool counted = counted_here(world, i, partner);
-          out.add(f, smaller_radius, counted);
-          out.pairs += (!wall && counted) ? 1 : 0;
-          out.walls += wall ? 1 : 0;
-          out.touching += wall ? 0 : 1;
-          if (f.passed_through && out.passed_wall < 0) out.passed_wall = -1 - partner;
-        },
-        springs ? &slots : nullptr);
+    auto add = [&](const ContactForce<double>& f, std::int64_t partner, double smaller_radius) {
+      const bool wall = partner < 0;
+      const bool counted = counted_here(world, i, partner);
+      out.add(f, smaller_radius, counted);
+      out.pairs += (!wall && counted) ? 1 : 0;
+      out.walls += wall ? 1 : 0;
+      out.touching += wall ? 0 : 1;
+      if (f.passed_through && out.passed_wall < 0) out.passed_wall = -1 - partner;
+    };
+    if (springs) {
+      visit_contacts(world, s, add, &slots);
+    } else {
+      add_pair_contacts(s, out);
+      SpringLookup no_springs(nullptr);
+      visit_walls(world, s, add, no_springs);
+    }
     if (springs) overflows_[i] = slots.overflows;
   });
   reduce(out_forces, stats);

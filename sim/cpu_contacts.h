@@ -78,6 +78,15 @@ class CpuContacts {
 
     void add(const ContactForce<double>& c, double smaller_radius, bool count);
   };
+  // One candidate pair's contact (CandidatePairs), computed once for both sides: viscous friction
+  // only, as a spring belongs to one side of a pair.
+  struct PairContact {
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();  // N, on the first particle; the second takes -force
+    Eigen::Vector3d arm_first = Eigen::Vector3d::Zero(), arm_second = Eigen::Vector3d::Zero();  // m
+    double overlap_ratio = 0;   // overlap (after the clamp) / the smaller radius
+    double elastic_energy = 0;  // J
+    bool overlap_clamped = false;
+  };
   // Particle i's spring slots: the old ones it reads and, when stepping, the new ones it writes.
   struct SpringSlots {
     const std::int64_t* old_partner = nullptr;
@@ -97,6 +106,14 @@ class CpuContacts {
   template <typename Fn>
   void visit_contacts(const World& world, std::uint32_t slot, Fn&& fn, SpringSlots* springs = nullptr) const;
   class SpringLookup;
+  // Every touching candidate pair's contact into pair_contacts_ (no springs).
+  void compute_pair_contacts();
+  // Whether the two touch; if so, their contact into `out`.
+  bool pair_contact(const ParticleState& first, const ParticleState& second, double cap, PairContact& out) const;
+  bool spheres_touch(std::uint32_t first_slot, std::uint32_t second_slot) const;
+  // As ParticleContacts::add for each touching partner of the particle at `slot`, by increasing
+  // partner id, the contacts read from pair_contacts_.
+  void add_pair_contacts(std::uint32_t slot, ParticleContacts& out) const;
   template <typename Fn>
   void visit_neighbours(std::uint32_t slot, Fn& fn, SpringLookup& lookup) const;
   template <typename Fn>
@@ -115,6 +132,18 @@ class CpuContacts {
   std::vector<Eigen::Vector3d> position_, velocity_;  // world order
   std::vector<ParticleState> state_;                  // cell order
   std::vector<ParticleContacts> particle_contacts_;   // world order
+  // As lists_.pairs(): the pair's place in pair_contacts_, or kNotTouching. Only touching pairs keep
+  // a contact (about one in five candidates on a settled bed), in pair order.
+  static constexpr std::uint32_t kNotTouching = 0xffffffffu;
+  std::vector<std::uint32_t> contact_of_pair_;
+  std::vector<std::uint32_t> touching_pairs_;
+  std::vector<PairContact> pair_contacts_;
+  // Cell order, what the touching test reads: half a cache line a particle.
+  struct Sphere {
+    Eigen::Vector3d centre;  // m
+    double radius = 0;       // m
+  };
+  std::vector<Sphere> sphere_;
   std::vector<std::size_t> overflows_;                // world order
   // For report(): steps gathered, touching particle partners summed over them (both sides of a
   // pair), and seconds spent building lists and gathering in all.

@@ -10,10 +10,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <stdexcept>
 #include <utility>
 
 #include "core/morton.h"
 #include "sim/contact_lists.h"
+#include "sim/cpu_parallel.h"
 
 namespace ts::sim {
 
@@ -39,7 +41,7 @@ void build_neighbour_grid(const std::vector<Eigen::Vector3d>& positions, double 
   grid.table_size = std::bit_ceil(std::max<std::uint32_t>(2 * n, 4));
   grid.cell.resize(n);
   std::vector<std::uint32_t> bucket(n);
-  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
+  for_each_index(n, [&](std::uint32_t i) {
     // A blown-up state still gets a cell (NaN or huge coordinates would overflow the int cast);
     // the stability check rejects it after the step.
     const Eigen::Array3d cell = (positions[i] / cell_size).array().floor();
@@ -59,16 +61,20 @@ void build_neighbour_grid(const std::vector<Eigen::Vector3d>& positions, double 
 bool CpuContactLists::stale(const std::vector<Eigen::Vector3d>& positions) const {
   if (!built_ || positions.size() != built_position_.size()) return true;
   // The largest squared displacement since the build; a non-finite one counts as infinite.
-  const double largest = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, positions.size()), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& r, double m) {
-        for (std::size_t i = r.begin(); i < r.end(); ++i) {
-          const double d = (positions[i] - built_position_[i]).squaredNorm();
-          m = std::isfinite(d) ? std::max(m, d) : std::numeric_limits<double>::infinity();
-        }
-        return m;
-      },
-      [](double a, double b) { return std::max(a, b); });
+  auto largest_in = [&](std::size_t begin, std::size_t end, double m) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const double d = (positions[i] - built_position_[i]).squaredNorm();
+      m = std::isfinite(d) ? std::max(m, d) : std::numeric_limits<double>::infinity();
+    }
+    return m;
+  };
+  const double largest =
+      positions.size() < kSerialBelow
+          ? largest_in(0, positions.size(), 0.0)
+          : tbb::parallel_reduce(
+                tbb::blocked_range<std::size_t>(0, positions.size(), kSerialBelow / 4), 0.0,
+                [&](const tbb::blocked_range<std::size_t>& r, double m) { return largest_in(r.begin(), r.end(), m); },
+                [](double a, double b) { return std::max(a, b); });
   return lists_need_rebuild(std::sqrt(largest), skin_);
 }
 
@@ -84,6 +90,7 @@ void CpuContactLists::build(const World& world, const std::vector<Eigen::Vector3
   bonded_ = bonded_partners(world.bonds, positions.size());
   sort_by_cell();
   fill_lists();
+  fill_pairs();
   built_position_ = positions;
   built_ = true;
   ++builds_;
@@ -94,7 +101,7 @@ void CpuContactLists::fill_grid_entries(const World& world, const std::vector<Ei
   const auto n = static_cast<std::uint32_t>(positions.size());
   grid_entries_.resize(n);
   grid_slot_.resize(n);
-  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t s) {
+  for_each_index(n, [&](std::uint32_t s) {
     const std::uint32_t j = grid_.sorted[s];
     const std::uint32_t body = p.body[j];
     grid_entries_[s] = {positions[j], p.radius[j], grid_.cell[j],
@@ -112,7 +119,7 @@ void CpuContactLists::sort_by_cell() {
   Eigen::Vector3i low = Eigen::Vector3i::Constant(std::numeric_limits<int>::max());
   for (const Eigen::Vector3i& c : grid_.cell) low = low.cwiseMin(c);
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
-  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t i) {
+  for_each_index(n, [&](std::uint32_t i) {
     std::uint64_t key = 0;
     for (int axis = 0; axis < 3; ++axis) {
       const std::int64_t from_low = std::int64_t{grid_.cell[i][axis]} - low[axis];
@@ -167,7 +174,7 @@ void CpuContactLists::search(const GridEntry& self, Fn&& fn) const {
 void CpuContactLists::fill_lists() {
   const auto n = static_cast<std::uint32_t>(order_.size());
   offsets_.assign(std::size_t{n} + 1, 0);
-  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t s) {
+  for_each_index(n, [&](std::uint32_t s) {
     const GridEntry& self = grid_entries_[grid_slot_[order_[s]]];
     if (!self.receives_force) return;
     std::uint32_t count = 0;
@@ -176,13 +183,55 @@ void CpuContactLists::fill_lists() {
   });
   for (std::uint32_t s = 0; s < n; ++s) offsets_[s + 1] += offsets_[s];
   entries_.resize(offsets_[n]);
-  tbb::parallel_for(std::uint32_t{0}, n, [&](std::uint32_t s) {
+  for_each_index(n, [&](std::uint32_t s) {
     const GridEntry& self = grid_entries_[grid_slot_[order_[s]]];
     if (!self.receives_force) return;
     ListEntry* out = entries_.data() + offsets_[s];
     search(self, [&](std::uint32_t j) { *out++ = {slot_[j], j}; });
     std::sort(entries_.data() + offsets_[s], out,
               [](const ListEntry& a, const ListEntry& b) { return a.particle < b.particle; });
+  });
+}
+
+bool CpuContactLists::first_of_pair(std::uint32_t particle, std::uint32_t partner) const {
+  return !grid_entries_[grid_slot_[partner]].receives_force || particle < partner;
+}
+
+void CpuContactLists::fill_pairs() {
+  const auto n = static_cast<std::uint32_t>(order_.size());
+  // Pairs by first slot (CSR): count, scan, fill.
+  std::vector<std::uint32_t> pair_offsets(std::size_t{n} + 1, 0);
+  for_each_index(n, [&](std::uint32_t s) {
+    for (const ListEntry& e : candidates(s)) pair_offsets[s + 1] += first_of_pair(order_[s], e.particle) ? 1 : 0;
+  });
+  for (std::uint32_t s = 0; s < n; ++s) pair_offsets[s + 1] += pair_offsets[s];
+  pairs_.first.resize(pair_offsets[n]);
+  pairs_.second.resize(pair_offsets[n]);
+  for_each_index(n, [&](std::uint32_t s) {
+    std::uint32_t p = pair_offsets[s];
+    for (ListEntry& e : std::span(entries_.data() + offsets_[s], entries_.data() + offsets_[s + 1])) {
+      e.first = first_of_pair(order_[s], e.particle);
+      if (!e.first) continue;
+      pairs_.first[p] = s;
+      pairs_.second[p] = e.slot;
+      e.pair = p++;
+    }
+  });
+  // The second side's entry of each pair between two particles that take a force. The search is
+  // symmetric (the same reach both ways), so the entry is there; a miss would be a bug here.
+  const auto pair_count = static_cast<std::uint32_t>(pairs_.size());
+  for_each_index(pair_count, [&](std::uint32_t p) {
+    const std::uint32_t second = pairs_.second[p];
+    const std::uint32_t first_particle = order_[pairs_.first[p]];
+    ListEntry* begin = entries_.data() + offsets_[second];
+    ListEntry* end = entries_.data() + offsets_[second + 1];
+    if (!grid_entries_[grid_slot_[order_[second]]].receives_force) return;  // no list of its own
+    ListEntry* e = std::lower_bound(begin, end, first_particle,
+                                    [](const ListEntry& a, std::uint32_t id) { return a.particle < id; });
+    if (e == end || e->particle != first_particle) {
+      throw std::logic_error("CpuContactLists: a candidate pair is listed on one side only");
+    }
+    e->pair = p;
   });
 }
 

@@ -43,6 +43,17 @@ std::uint32_t hash_cell(const Eigen::Vector3i& cell, std::uint32_t table_size);
 struct ListEntry {
   std::uint32_t slot = 0;      // the partner's place in cell order (where a step keeps its state)
   std::uint32_t particle = 0;  // the partner's world id (the order forces are summed in)
+  std::uint32_t pair = 0;      // the pair's index in CpuContactLists::pairs()
+  bool first = false;          // whether this list's particle is the pair's first
+};
+
+// Every candidate pair once (half lists, as LAMMPS's "newton on"), so that a step computes each
+// contact once and applies it to both sides. The first particle of a pair is the side that counts the
+// contact in the statistics: the lower world id of two particles that take a force, else the one that
+// does. Pairs are grouped by their first particle, in cell order. Slots of the cell order.
+struct CandidatePairs {
+  std::vector<std::uint32_t> first, second;
+  std::size_t size() const { return first.size(); }
 };
 
 class CpuContactLists {
@@ -67,6 +78,8 @@ class CpuContactLists {
   std::span<const ListEntry> candidates(std::uint32_t slot) const {
     return {entries_.data() + offsets_[slot], entries_.data() + offsets_[slot + 1]};
   }
+  // The same candidates, each pair once; every list entry names its pair.
+  const CandidatePairs& pairs() const { return pairs_; }
 
   double skin() const { return skin_; }                          // m
   double largest_diameter() const { return largest_diameter_; }  // m, of the last build
@@ -89,6 +102,10 @@ class CpuContactLists {
   void fill_grid_entries(const World& world, const std::vector<Eigen::Vector3d>& positions);
   void sort_by_cell();
   void fill_lists();
+  // The half lists from the full ones: a pair for each entry on its first side, then each second
+  // side's entry pointed at it.
+  void fill_pairs();
+  bool first_of_pair(std::uint32_t particle, std::uint32_t partner) const;
   // Calls fn(world id) for each particle of another body within the skin of `self`'s surface (and
   // not both unable to receive a force, nor bonded to it by an intact bond), in grid order.
   template <typename Fn>
@@ -100,6 +117,7 @@ class CpuContactLists {
   std::vector<std::uint32_t> order_, slot_;  // cell order -> world id, world id -> cell order
   std::vector<std::uint32_t> offsets_;       // CSR by slot: size + 1 entries
   std::vector<ListEntry> entries_;
+  CandidatePairs pairs_;
   std::vector<Eigen::Vector3d> built_position_;  // m, world order, at the build
   BondedPartners bonded_;                        // of the build: pairs the contact law leaves to their bond
   double skin_ = 0, largest_diameter_ = 0;

@@ -1,13 +1,13 @@
 #include "sim/cpu_stepper.h"
 
 #include <fmt/format.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
 #include "sim/cpu_bonds.h"
+#include "sim/cpu_parallel.h"
 #include "sim/state_bytes.h"
 
 namespace ts::sim {
@@ -107,7 +107,7 @@ void CpuStepper::integrate(World& world, StepStats& stats) {
   const auto count = static_cast<std::uint32_t>(b.size());
   clamped_.assign(count, 0);  // bit 0: linear, bit 1: angular
 
-  tbb::parallel_for(std::uint32_t{0}, count, [&](std::uint32_t k) {
+  for_each_index(count, [&](std::uint32_t k) {
     if (b.motion[k] == MotionType::Static) return;
     if (b.motion[k] == MotionType::Kinematic) {
       b.position[k] += b.linear_velocity[k] * dt;

@@ -8,6 +8,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "sim/cpu_stepper.h"
 #include "sim/grain.h"
@@ -153,6 +154,40 @@ TEST(CpuContactLists, ListsAreSortedByPartnerIdAndPointAtTheirCellOrderSlots) {
     }
   }
   EXPECT_GT(listed, order.size() / 2);
+}
+
+// The half lists: every candidate pair once, its first particle the side that counts the contact
+// (the lower id of two that take a force, else the one that does), and both sides' entries naming it.
+TEST(CpuContactLists, EachCandidatePairIsListedOnceAndBothSidesPointAtIt) {
+  const World w = chaotic_box(1.0);  // with a kinematic paddle: pairs with one side that takes no force
+  CpuContactLists lists;
+  StepSettings s;
+  s.skin = 2 * kRadius;
+  lists.build(w, particle_positions(w), s);
+  const auto& order = lists.order();
+  const CandidatePairs& pairs = lists.pairs();
+  auto takes_force = [&](std::uint32_t id) { return w.bodies.inverse_mass[w.particles.body[id]] != 0; };
+  std::vector<int> entries_naming(pairs.size(), 0);
+  std::size_t entries = 0, one_sided = 0;
+  for (std::uint32_t slot = 0; slot < order.size(); ++slot) {
+    for (const ListEntry& e : lists.candidates(slot)) {
+      ++entries;
+      ASSERT_LT(e.pair, pairs.size());
+      ++entries_naming[e.pair];
+      const std::uint32_t self = order[slot];
+      const bool counts_here = !takes_force(e.particle) || self < e.particle;
+      ASSERT_EQ(e.first, counts_here);
+      ASSERT_EQ(e.first ? pairs.first[e.pair] : pairs.second[e.pair], slot);
+      ASSERT_EQ(e.first ? pairs.second[e.pair] : pairs.first[e.pair], e.slot);
+      one_sided += takes_force(e.particle) ? 0 : 1;
+    }
+  }
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
+    const bool both_take_force = takes_force(order[pairs.first[p]]) && takes_force(order[pairs.second[p]]);
+    ASSERT_EQ(entries_naming[p], both_take_force ? 2 : 1) << "pair " << p;
+  }
+  EXPECT_EQ(2 * pairs.size() - one_sided, entries);
+  EXPECT_GT(pairs.size(), order.size());
 }
 
 // The same run with lists built at other steps (another skin; a stepper restored mid-run, which
