@@ -323,7 +323,7 @@ TEST(Checkpoint, CraftedSceneConstantsOrMetricsAreRefusedAtResume) {
       {"its gravity differ from the scene's", [](RunState& s) { s.world.gravity.z() = -1e231; }},
       {"its materials differ from the scene's", [](RunState& s) { s.world.materials.at(0).friction = 5; }},
       {"its smooth walls differ from the scene's", [](RunState& s) { s.world.walls.planes.at(0).point.z() = 1; }},
-      {"metrics_csv: row 1 is not 14 finite numbers",
+      {"metrics_csv: row 1 is not 18 finite numbers",
        [](RunState& s) { s.metrics_csv.replace(s.metrics_csv.find('\n') + 1, 1, "x"); }},
       {"metrics_csv: its header is not metrics.csv's", [](RunState& s) { s.metrics_csv[0] = 'S'; }},
   };
