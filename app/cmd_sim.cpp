@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <tuple>
 #include <utility>
@@ -123,18 +124,27 @@ std::string requested_backend(const Options& o) {
 // (sim/cpu_stepper.h), by the rule of gpu/backend.h, named in its one line. A device that cannot
 // make a context at all stays an error (exit 3) under auto, as under --backend gpu: a broken driver on
 // a GPU machine should say so, not turn into a much slower run.
-gpu::Backend choose_backend(const Options& o, const GlobalOptions& global, bool frames,
+// A scene with bonds (breakable props) runs on the CPU reference under auto until the GPU pipeline
+// steps bonds; --backend gpu keeps the pipeline's own refusal.
+gpu::Backend choose_backend(const Options& o, const GlobalOptions& global, const scene::Scene& scene,
                             std::unique_ptr<gpu::Context>& context) {
+  const bool frames = scene.output.frames;
   const gpu::Backend requested = gpu::parse_backend(requested_backend(o)).value();  // IsMember checked it
-  if (requested != gpu::Backend::Cpu || frames) context = std::make_unique<gpu::Context>(context_options(global));
-  const gpu::Backend chosen = gpu::resolve_backend(requested, context.get());
+  const bool bonds_on_cpu = requested == gpu::Backend::Auto && scene.has_bonds();
+  if ((requested != gpu::Backend::Cpu && !bonds_on_cpu) || frames)
+    context = std::make_unique<gpu::Context>(context_options(global));
+  const gpu::Backend chosen = bonds_on_cpu ? gpu::Backend::Cpu : gpu::resolve_backend(requested, context.get());
   const bool cpu = chosen == gpu::Backend::Cpu;
   const bool precision_ignored = cpu && !o.precision.empty();  // auto only: --cpu with it is refused
-  const std::string line = gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
-                                             cpu ? "the CPU reference" : "the GPU pipeline",
-                                             precision_ignored ? "--precision applies to the GPU pipeline only, "
-                                                                 "the CPU reference computes in double"
-                                                               : "");
+  const std::string precision_note =
+      precision_ignored ? "--precision applies to the GPU pipeline only, the CPU reference computes in double" : "";
+  const std::string line =
+      bonds_on_cpu
+          ? fmt::format("backend: cpu, the CPU reference (auto: the scene has a breakable prop, whose bonds only "
+                        "the CPU reference steps for now{}{})",
+                        precision_note.empty() ? "" : "; ", precision_note)
+          : gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
+                              cpu ? "the CPU reference" : "the GPU pipeline", precision_note);
   if (o.json) {
     log::info("{}", line);  // standard output stays the JSON
   } else {
@@ -147,6 +157,17 @@ gpu::Backend choose_backend(const Options& o, const GlobalOptions& global, bool 
 
 const std::string& output_dir(const Options& o) { return o.resume.empty() ? o.output : o.resume; }
 
+// ", set by bonds (bound: t_c/20 = ..., bonds = ...)" for an automatic step; " (by hand; ...)" otherwise.
+std::string describe_bound(const scene::Scene& scene, const scene::RunResult& result) {
+  const sim::TimeStepBound& b = result.bound;
+  const std::string bonds = std::isfinite(b.bonds) ? fmt::format(", bonds {:.3g} s", b.bonds) : "";
+  const std::string terms = fmt::format("t_c/20 = {:.3g} s at {:.3g} m/s, 0.2 t_R = {:.3g} s, m_t/gamma_s = {:.3g} s{}",
+                                        b.contact_duration / 20, b.max_impact_speed, 0.2 * b.rayleigh, b.tangential,
+                                        bonds);
+  if (scene.simulation.dt > 0) return fmt::format(" (by hand; the bound is {:.3g} s: {})", b.recommended, terms);
+  return fmt::format(", set by {} ({})", sim::limiting_bound(b), terms);
+}
+
 void print_summary(const Options& o, const scene::Scene& scene, const scene::RunResult& result, double seconds,
                    gpu::Backend backend, const gpu::Context* context) {
   // Steps this process ran (a resumed run started at resumed_from).
@@ -155,7 +176,13 @@ void print_summary(const Options& o, const scene::Scene& scene, const scene::Run
              result.steps, result.dt, result.grains, seconds,
              seconds > 0 ? stepped * static_cast<double>(result.grains) / seconds : 0.0,
              backend == gpu::Backend::Cpu ? "CPU reference" : context->summary());
+  fmt::print("time step: {:.3g} s{}\n", result.dt, describe_bound(scene, result));
   fmt::print("bodies: {}\n", describe_bodies(result.bodies));
+  if (scene.has_bonds()) {
+    fmt::print("bonds: {} at the start, {} intact and {} broken at the end; {} fragment{} (the largest {:.4g} kg)\n",
+               result.bonds_at_start, result.bonds.intact, result.bonds.broken, result.bonds.fragments,
+               result.bonds.fragments == 1 ? "" : "s", result.bonds.largest_fragment_mass);
+  }
   fmt::print("clamps: {} velocity, {} angular velocity, {} overlap (each clamp means a less accurate result)\n",
              result.last.velocity_clamps, result.last.angular_velocity_clamps, result.last.overlap_clamps);
   if (scene.simulation.step.tangential == sim::TangentialModel::Spring) {
@@ -175,7 +202,7 @@ void print_summary(const Options& o, const scene::Scene& scene, const scene::Run
 
 // The summary of print_summary, and the last step's state, as one JSON object (--json).
 void print_json(const Options& o, const scene::RunResult& result, double seconds, const std::string& engine,
-                const std::string& timing_report) {
+                const std::string& timing_report, bool scene_dt_by_hand) {
   const auto stepped = static_cast<double>(result.steps - std::max<std::int64_t>(result.resumed_from, 0));
   const scene::BodyCounts& b = result.bodies;
   nlohmann::ordered_json outputs = nlohmann::ordered_json::array();
@@ -193,6 +220,7 @@ void print_json(const Options& o, const scene::RunResult& result, double seconds
       {"steps", result.steps},
       {"resumed_from", result.resumed_from >= 0 ? nlohmann::ordered_json(result.resumed_from) : nullptr},
       {"dt_s", result.dt},
+      {"dt_set_by", scene_dt_by_hand ? std::string("hand") : sim::limiting_bound(result.bound)},
       {"time_step_warning", result.time_step_warning.empty() ? nlohmann::ordered_json(nullptr)
                                                              : nlohmann::ordered_json(result.time_step_warning)},
       {"grains", result.grains},
@@ -209,6 +237,9 @@ void print_json(const Options& o, const scene::RunResult& result, double seconds
        {{"kinetic_translational_J", last.energy.translational}, {"kinetic_rotational_J", last.energy.rotational},
         {"potential_J", last.energy.potential}, {"contacts", last.contacts}, {"wall_contacts", last.wall_contacts},
         {"max_overlap_ratio", last.max_overlap_ratio}}},
+      {"bonds",
+       {{"at_start", result.bonds_at_start}, {"intact", result.bonds.intact}, {"broken", result.bonds.broken},
+        {"fragments", result.bonds.fragments}, {"largest_fragment_kg", result.bonds.largest_fragment_mass}}},
       {"checkpoints", result.checkpoints},
       {"outputs", outputs},
       {"timings", timing_report.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(timing_report)},
@@ -220,7 +251,7 @@ int run_sim(const Options& o, const GlobalOptions& global) {
   requested_backend(o);  // a usage error before any work
   const scene::Scene scene = scene::load_scene(o.scene);
   std::unique_ptr<gpu::Context> context;
-  const gpu::Backend backend = choose_backend(o, global, scene.output.frames, context);
+  const gpu::Backend backend = choose_backend(o, global, scene, context);
   scene::StepperFactory make_stepper;  // empty: the CPU reference
   if (backend == gpu::Backend::Gpu) {
     const auto precision = o.precision == "double" ? sim::Precision::Double : sim::Precision::Float;
@@ -260,7 +291,7 @@ int run_sim(const Options& o, const GlobalOptions& global) {
   if (!result.time_step_warning.empty()) log::warn("{}", result.time_step_warning);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (o.json) {
-    print_json(o, result, seconds, engine, timing_report);
+    print_json(o, result, seconds, engine, timing_report, scene.simulation.dt > 0);
     return 0;
   }
   print_summary(o, scene, result, seconds, backend, context.get());

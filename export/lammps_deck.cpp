@@ -234,6 +234,10 @@ void check_exportable(const Scene& scene, const World& w) {
     refuse(scene, "simulation.normal_damping = \"thesis\" has no LAMMPS equivalent (use \"tsuji\")");
   }
   if (s.angular_damping_rate > 0) refuse(scene, "simulation.angular_damping_rate has no LAMMPS equivalent");
+  if (scene.has_bonds()) {
+    refuse(scene, "a breakable prop (its bonds would need LAMMPS' BPM package, which Debian's LAMMPS is built "
+                  "without; run the scene with tetrasand sim --backend cpu)");
+  }
   if (!w.tracks.empty()) {
     refuse(scene, "a keyframed kinematic prop (this export writes LAMMPS fix move linear/rotate, not a path)");
   }

@@ -11,6 +11,7 @@
 #include "preview/colors.h"
 #include "preview/image.h"
 #include "preview/path_calibration.h"
+#include "scene/fragments.h"
 
 namespace ts::preview {
 namespace {
@@ -58,7 +59,6 @@ SimFrameWriter::SimFrameWriter(gpu::Context& context, const scene::Scene& scene,
     : renderer_(context),
       settings_(settings),
       walls_(scene),
-      props_(scene.props.size()),
       gravity_(scene.gravity.norm()) {
   // The shadow map and G-buffer by whichever path a calibration found faster on this device.
   const GpuPathChoice path = choose_gpu_path(context, GpuPath::Auto);
@@ -69,7 +69,12 @@ SimFrameWriter::SimFrameWriter(gpu::Context& context, const scene::Scene& scene,
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", scene::scene_location(scene, "output.camera.size"), e.what()));
   }
-  for (const auto& p : scene.props) dynamic_props_ += p.motion == sim::MotionType::Dynamic ? 1 : 0;
+  for (const auto& p : scene.props) {
+    const std::size_t bodies = scene::prop_body_count(p);
+    prop_ranges_.push_back({static_cast<std::uint32_t>(props_), static_cast<std::uint32_t>(bodies), p.breakable});
+    props_ += bodies;
+    dynamic_props_ += p.motion == sim::MotionType::Dynamic ? bodies : 0;
+  }
   for (const auto& e : scene.emitters) {
     if (e.type != scene::EmitterType::Pour) continue;  // fill and column grains are there from the start
     emitter_box_.extend(e.min);
@@ -103,6 +108,14 @@ Particles SimFrameWriter::particles_of(const sim::World& world) {
     speed_scale_ =
         from_height > 1e-6 ? from_height : std::max(*std::max_element(speed.begin(), speed.end()), 1.0);
   }
+  // A breakable prop's spheres take their fragment's colour (its lowest particle's body) under "body".
+  std::vector<std::uint32_t> fragment;
+  const bool fragments = settings_.color_by == scene::FrameColoring::Body && !world.bonds.a.empty();
+  if (fragments) {
+    std::vector<scene::BodyRange> ranges_now = prop_ranges_;
+    for (scene::BodyRange& r : ranges_now) r.first += static_cast<std::uint32_t>(ranges.first_prop);
+    fragment = scene::find_fragments(world, ranges_now).label;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t b = world.particles.body[i];
     out.radii[i] = static_cast<float>(world.particles.radius[i]);
@@ -121,7 +134,7 @@ Particles SimFrameWriter::particles_of(const sim::World& world) {
           c = viridis(speed[i] / speed_scale_);
           break;
         case scene::FrameColoring::Body:
-          c = categorical(b);
+          c = categorical(fragments && fragment[i] != scene::Fragments::kNone ? world.particles.body[fragment[i]] : b);
           break;
       }
     }
@@ -132,7 +145,7 @@ Particles SimFrameWriter::particles_of(const sim::World& world) {
 
 Camera SimFrameWriter::follow(const sim::World& world) {
   const BodyRanges ranges = body_ranges(world, props_, dynamic_props_);
-  const std::size_t body = ranges.first_prop + static_cast<std::size_t>(settings_.camera.follow_prop);
+  const std::size_t body = ranges.first_prop + prop_ranges_[static_cast<std::size_t>(settings_.camera.follow_prop)].first;
   const Eigen::Vector3d centre = world.bodies.position[body];
   if (settings_.camera.eye) {
     if (!follow_offset_) follow_offset_ = *settings_.camera.eye - centre;

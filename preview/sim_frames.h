@@ -16,12 +16,14 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <optional>
+#include <vector>
 
 #include "gpu/context.h"
 #include "preview/camera.h"
 #include "preview/frame_walls.h"
 #include "preview/renderer.h"
 #include "scene/scene.h"
+#include "scene/scene_world.h"
 #include "sim/world.h"
 
 namespace ts::preview {
@@ -55,7 +57,8 @@ class SimFrameWriter {
   void write(const sim::World& world, std::int64_t frame, const std::filesystem::path& dir);
 
   // The world's particles coloured by settings.color_by: grains and props by the field (sand: grains
-  // in sand colours varied grain by grain, props steel blue), static bodies (rough walls) grey.
+  // in sand colours varied grain by grain, props steel blue; body: a colour per body, and per fragment
+  // for a breakable prop's spheres), static bodies (rough walls) grey.
   Particles particles_of(const sim::World& world);
 
   // The camera of the last frame written, and the box the default camera framed (tests).
@@ -72,8 +75,10 @@ class SimFrameWriter {
   FrameSettings settings_;
   FrameWalls walls_;
   Aabb emitter_box_;       // m: where pour emitters release grains
-  std::size_t props_ = 0;  // the scene's [[prop]] count
-  std::size_t dynamic_props_ = 0;
+  std::size_t props_ = 0;  // bodies of the scene's [[prop]]s (a breakable prop: one per sphere)
+  std::size_t dynamic_props_ = 0;  // of them, dynamic
+  // Each prop's bodies, `first` counted from the first prop body (scene/scene_world.h BodyRange).
+  std::vector<scene::BodyRange> prop_ranges_;
   double gravity_ = 0;                            // m/s^2, |g|
   std::optional<double> ground_level_;            // m along +z, fixed at the first frame
   std::optional<Aabb> framed_;                    // the default camera's smoothed framing box

@@ -17,6 +17,7 @@
 #include "core/atomic_file.h"
 #include "core/checked_values.h"
 #include "core/error.h"
+#include "body/body_file.h"
 
 namespace ts::scene {
 namespace {
@@ -517,6 +518,84 @@ void read_servo(TableReader& prop, const fs::path& file, Prop& p) {
   p.servo = s;
 }
 
+// [[bond_material]]: the bond law's parameters (sim/bond_model.h), E as [[material]] names Young's modulus.
+void read_bond_material(const toml::table& t, const fs::path& file, Scene& scene) {
+  TableReader r(t, "bond_material", file);
+  BondMaterialSpec spec;
+  spec.line = line_of(t);
+  spec.name = r.required_string("name");
+  for (const BondMaterialSpec& other : scene.bond_materials) {
+    if (other.name == spec.name)
+      r.fail("name", fmt::format("\"{}\" is defined twice (also at line {})", spec.name, other.line));
+  }
+  BondMaterial& m = spec.material;
+  m.youngs_modulus = r.required_number("E");
+  m.stiffness_ratio = r.number("stiffness_ratio", m.stiffness_ratio);
+  m.radius_factor = r.number("radius_factor", m.radius_factor);
+  m.tensile_strength = r.required_number("tensile_strength");
+  m.shear_strength = r.required_number("shear_strength");
+  m.strength_spread = r.number("strength_spread", 0.0);
+  m.bond_distance = r.number("bond_distance", m.bond_distance);
+  spec.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0));
+  r.reject_unknown_keys();
+  if (const std::string problem = validate(m); !problem.empty()) {
+    const std::string key = problem.substr(0, problem.find(':'));
+    r.fail(key == "youngs_modulus" ? "E" : key, problem.substr(problem.find(':') + 2));
+  }
+  if (scene.bond_materials.size() >= 65535) r.fail("", "too many bond materials");
+  scene.bond_materials.push_back(spec);
+}
+
+int bond_material_index(TableReader& r, const Scene& scene, std::string_view key) {
+  const std::string name = r.required_string(key);
+  std::vector<std::string> have;
+  for (std::size_t i = 0; i < scene.bond_materials.size(); ++i) {
+    if (scene.bond_materials[i].name == name) return static_cast<int>(i);
+    have.push_back(fmt::format("\"{}\"", scene.bond_materials[i].name));
+  }
+  r.fail(key, fmt::format("no [[bond_material]] named \"{}\" ({})", name,
+                          have.empty() ? "the scene has none: add a [[bond_material]] table"
+                                       : fmt::format("have: {}", fmt::join(have, ", "))));
+}
+
+// A prop's name when the table gives none: its body file without ".body.json" ("cube").
+std::string body_stem(const fs::path& body_file) {
+  std::string name = body_file.filename().string();
+  for (const std::string_view suffix : {".body.json", ".json"}) {
+    if (name.size() > suffix.size() && name.ends_with(suffix))
+      return name.substr(0, name.size() - suffix.size());
+  }
+  return name;
+}
+
+// breakable = true: a dynamic prop whose body has interior particles (`sample --fill`), with a bond
+// material; its particle count is read here, as each particle becomes a body of the world.
+void read_breakable(TableReader& r, Prop& p, const Scene& scene) {
+  p.breakable = r.boolean("breakable", false);
+  if (!p.breakable) {
+    for (const char* key : {"bond_material", "bind_to", "bind_material"}) {
+      if (r.has(key)) r.fail(key, "only a breakable prop has bonds (breakable = true)");
+    }
+    return;
+  }
+  if (p.motion != MotionType::Dynamic)
+    r.fail("breakable", "a breakable prop moves as its spheres do: it must be motion = \"dynamic\"");
+  p.bond_material = bond_material_index(r, scene, "bond_material");
+  const body::ParticleBody body = body::read_body(p.body_file, body::BodyKeys::Physical);
+  if (body.interior_count == 0) {
+    r.fail("breakable",
+           fmt::format("{} has no interior particles: a breakable prop is filled with bonded spheres; resample "
+                       "its mesh with `tetrasand sample MESH --fill ...`",
+                       p.body_file.string()));
+  }
+  p.spheres = body.positions.size();
+  if (r.has("bind_to")) {
+    p.bind_material = bond_material_index(r, scene, "bind_material");
+  } else if (r.has("bind_material")) {
+    r.fail("bind_material", "binds the prop to the prop named by bind_to: add bind_to = \"NAME\"");
+  }
+}
+
 void read_prop(const toml::table& t, const fs::path& file, Scene& scene) {
   TableReader r(t, "prop", file);
   Prop p;
@@ -524,6 +603,14 @@ void read_prop(const toml::table& t, const fs::path& file, Scene& scene) {
   const std::string body = r.required_string("body");
   p.body_file = file.parent_path() / body;
   if (!fs::exists(p.body_file)) r.fail("body", fmt::format("{} does not exist", p.body_file.string()));
+  p.name = r.optional_string("name").value_or(body_stem(p.body_file));
+  if (r.has("name")) {
+    if (p.name.empty()) r.fail("name", "must not be empty");
+    for (const Prop& other : scene.props) {
+      if (other.name == p.name)
+        r.fail("name", fmt::format("\"{}\" is also the [[prop]] at line {}: names must differ", p.name, other.line));
+    }
+  }
   p.position = r.vector<3>("position", Eigen::Vector3d::Zero());
   p.orientation = r.quaternion("orientation");
   p.motion = static_cast<MotionType>(r.choice("motion", {"dynamic", "kinematic", "static"}, 2));
@@ -535,8 +622,33 @@ void read_prop(const toml::table& t, const fs::path& file, Scene& scene) {
   p.material = material_index(r, scene, "material");
   read_keyframes(r, file, p);
   read_servo(r, file, p);
+  read_breakable(r, p, scene);
   r.reject_unknown_keys();
   scene.props.push_back(p);
+}
+
+// bind_to = "NAME", once every prop is read (the surface may come after the layer): another prop.
+void resolve_bind_to(const toml::array& tables, const fs::path& file, Scene& scene) {
+  for (std::size_t i = 0; i < scene.props.size(); ++i) {
+    Prop& p = scene.props[i];
+    TableReader r(*tables.get(i)->as_table(), "prop", file);
+    if (!p.breakable || !r.has("bind_to")) continue;
+    const std::string wanted = r.required_string("bind_to");
+    std::vector<std::string> names;
+    for (std::size_t k = 0; k < scene.props.size(); ++k) {
+      if (k == i) continue;
+      names.push_back(fmt::format("\"{}\"", scene.props[k].name));
+      if (scene.props[k].name != wanted) continue;
+      if (p.bind_to >= 0)
+        r.fail("bind_to", fmt::format("\"{}\" names several props: give them distinct name keys", wanted));
+      p.bind_to = static_cast<int>(k);
+    }
+    if (p.bind_to < 0) {
+      r.fail("bind_to", fmt::format("no other [[prop]] named \"{}\" ({})", wanted,
+                                    names.empty() ? "the scene has no other prop"
+                                                  : fmt::format("have: {}", fmt::join(names, ", "))));
+    }
+  }
 }
 
 void read_roughness(TableReader& r, Boundary& b) {
@@ -619,15 +731,8 @@ void read_simulation(TableReader& root, const fs::path& file, Scene& scene) {
   r.reject_unknown_keys();
 }
 
-// A prop's name in follow = "prop NAME": its body file without ".body.json" ("cube").
-std::string prop_name(const Prop& p) {
-  std::string name = p.body_file.filename().string();
-  for (const std::string_view suffix : {".body.json", ".json"}) {
-    if (name.size() > suffix.size() && name.ends_with(suffix))
-      return name.substr(0, name.size() - suffix.size());
-  }
-  return name;
-}
+// A prop's name in follow = "prop NAME": its name key, or its body file without ".body.json" ("cube").
+const std::string& prop_name(const Prop& p) { return p.name; }
 
 // follow = "scene" | "prop NAME" | "prop INDEX" (the [[prop]] tables in order, from 0): -1 for the
 // scene, else the prop's index.
@@ -643,7 +748,12 @@ int read_follow(TableReader& r, const Scene& scene) {
     r.fail("follow", fmt::format("\"{}\" is not \"scene\" or \"prop NAME\" ({})", *text, available));
   const std::string wanted = text->substr(5);
   for (std::size_t i = 0; i < scene.props.size(); ++i) {
-    if (prop_name(scene.props[i]) == wanted || std::to_string(i) == wanted) return static_cast<int>(i);
+    if (prop_name(scene.props[i]) != wanted && std::to_string(i) != wanted) continue;
+    if (scene.props[i].breakable)
+      r.fail("follow", fmt::format("\"prop {}\" is breakable: its spheres part, so there is no one centre to "
+                                   "follow (follow another prop, or a fixed eye and target)",
+                                   wanted));
+    return static_cast<int>(i);
   }
   r.fail("follow", fmt::format("no [[prop]] \"{}\" ({})", wanted, available));
 }
@@ -723,6 +833,16 @@ void reject_servo_checkpoints(const Scene& scene) {
   }
 }
 
+// Forward Euler adds energy to every undamped oscillation, and a bond is one: bonded spheres would
+// shake themselves apart. Symplectic Euler keeps the bonds' energy bounded at the bond time step.
+void reject_euler_bonds(const Scene& scene) {
+  if (!scene.has_bonds() || scene.simulation.step.integrator != Integrator::ForwardEuler) return;
+  throw InputError(fmt::format("{}: \"euler\" cannot run a breakable prop (forward Euler gains energy in every "
+                               "bond's oscillation until the bonds break by themselves); use integrator = "
+                               "\"symplectic\" (the default)",
+                               scene_location(scene, "simulation.integrator")));
+}
+
 Scene read_scene(const toml::table& root_table, const fs::path& file) {
   Scene scene;
   scene.file = file;
@@ -732,12 +852,16 @@ Scene read_scene(const toml::table& root_table, const fs::path& file) {
   if (scene.materials.empty()) root.fail("material", "no [[material]] table: a scene needs at least one");
   read_grains(root, file, scene);
   for_each_table(root, "emitter", [&](const toml::table& t) { read_emitter(t, file, scene); });
+  for_each_table(root, "bond_material", [&](const toml::table& t) { read_bond_material(t, file, scene); });
   for_each_table(root, "prop", [&](const toml::table& t) { read_prop(t, file, scene); });
+  if (const toml::node* props = root_table.get("prop"); props && props->is_array())
+    resolve_bind_to(*props->as_array(), file, scene);
   for_each_table(root, "boundary", [&](const toml::table& t) { read_boundary(t, file, scene); });
   read_simulation(root, file, scene);
   read_output(root, file, scene);
   root.reject_unknown_keys();
   reject_servo_checkpoints(scene);
+  reject_euler_bonds(scene);
   return scene;
 }
 
@@ -758,6 +882,10 @@ Scene load_scene(const std::filesystem::path& file) {
   // at once instead of reading it (a device or a FIFO is refused by read_file).
   constexpr std::uint64_t kMostSceneBytes = std::uint64_t{64} << 20;
   return parse_scene(read_file(file, kMostSceneBytes, "a scene file is a text of keys"), file);
+}
+
+bool Scene::has_bonds() const {
+  return std::any_of(props.begin(), props.end(), [](const Prop& p) { return p.breakable; });
 }
 
 std::string scene_location(const Scene& scene, std::string_view key, int line) {

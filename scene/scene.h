@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/bond_model.h"
 #include "sim/contact_model.h"
 #include "scene/servo.h"
 #include "sim/stepper.h"
@@ -75,7 +76,18 @@ struct Emitter {
   int line = 0;  // where it was declared, for messages
 };
 
+// A `[[bond_material]]`: the parallel bonds of breakable props (sim/bond_model.h), named for `[[prop]]`
+// bond_material and bind_material, with the seed of its bonds' strength draws.
+struct BondMaterialSpec {
+  std::string name;
+  BondMaterial material;
+  std::uint64_t seed = 1;  // strength_spread's draws (sim::build_bonds)
+  int line = 0;
+};
+
 struct Prop {
+  // `name`, or the body file without ".body.json" ("cube"): what follow = "prop NAME" and bind_to name.
+  std::string name;
   std::filesystem::path body_file;  // NAME.body.json, resolved against the scene's folder
   // Pose of the mesh frame (the body file's coordinates): x_world = position + orientation * x_mesh.
   Eigen::Vector3d position = Eigen::Vector3d::Zero();              // m
@@ -90,8 +102,19 @@ struct Prop {
   // Kinematic props without keyframes only: a stress-controlled piston ([prop.servo], scene/servo.h)
   // that sets `velocity` as the run goes.
   std::optional<Servo> servo;
+  // Breakable props (issue 48): the body's particles become one dynamic sphere body each, joined by the
+  // bonds of Scene::bond_materials[bond_material]; with bind_to, the spheres within that material's
+  // bond_distance of the spheres of prop bind_to are bound to them by bind_material's bonds.
+  bool breakable = false;
+  int bond_material = -1;  // index into Scene::bond_materials (breakable props)
+  int bind_to = -1;        // index into Scene::props; -1: bound to nothing
+  int bind_material = -1;  // index into Scene::bond_materials (with bind_to)
+  std::size_t spheres = 0; // breakable props: the body's particle count, each a body of the world
   int line = 0;
 };
+
+// How many bodies of the world a prop is: one, or one per sphere of a breakable prop.
+inline std::size_t prop_body_count(const Prop& p) { return p.breakable ? p.spheres : 1; }
 
 enum class BoundaryType { Plane, Box, Cylinder };
 
@@ -136,7 +159,8 @@ enum class FrameColoring {
   Sand,    // sand colours varied grain by grain; props steel blue
   Height,  // height of each sphere along +z, viridis from the grains' lowest to highest point
   Speed,   // speed of each sphere, viridis from 0 to the free-fall speed over the first frame's height
-  Body,    // one colour per body (grains and props), hashed from its index
+  Body,    // one colour per body (grains and props), hashed from its index; a breakable prop's
+           // spheres one colour per fragment (the spheres its intact bonds still join)
 };
 
 // The camera of the PNG frames ([output.camera]). Without eye/target a default camera frames the
@@ -147,6 +171,7 @@ struct FrameCamera {
   double fov = 30.0;                              // degrees, vertical field of view
   int width = 960, height = 720;                  // pixels
   // follow = "prop NAME": the body of this [[prop]] (scene order) stays at the image centre; -1: "scene".
+  // A breakable prop cannot be followed (it has no one centre once it breaks).
   int follow_prop = -1;
 };
 
@@ -173,6 +198,7 @@ struct Scene {
   std::vector<GrainSpec> grains;             // `[grain]`, or the `[[grain]]` tables in file order
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2
   std::vector<Emitter> emitters;
+  std::vector<BondMaterialSpec> bond_materials;  // the `[[bond_material]]` tables in file order
   std::vector<Prop> props;
   std::vector<Boundary> boundaries;
   SimulationSettings simulation;
@@ -180,6 +206,8 @@ struct Scene {
   // Line of each top-level, [simulation] and [output] key the file sets ("gravity", "simulation.dt"),
   // for messages about keys that are not read where they are checked.
   std::map<std::string, int, std::less<>> key_lines;
+
+  bool has_bonds() const;  // a breakable prop: bonds in the world, the CPU reference's only for now
 };
 
 // "file:line: key" for messages, the line being `line`, or the key's line from Scene::key_lines when

@@ -19,6 +19,7 @@
 #include "core/log.h"
 #include "core/text_tokens.h"
 #include "scene/checkpoint.h"
+#include "scene/fragments.h"
 #include "scene/scene_checks.h"
 #include "scene/scene_world.h"
 #include "scene/vtk_files.h"
@@ -36,8 +37,9 @@ int line_of_key(const Scene& scene, const std::string& key) {
 
 }  // namespace
 
-double resolve_time_step(const Scene& scene, const World& world, std::string* warning) {
+double resolve_time_step(const Scene& scene, const World& world, std::string* warning, TimeStepBound* bound_used) {
   const TimeStepBound bound = scene_time_step_bound(scene, world);
+  if (bound_used) *bound_used = bound;
   const double dt = scene.simulation.dt <= 0 ? bound.recommended : scene.simulation.dt;
   // Forward Euler gains energy in every contact: about t_c/400 keeps restitution within 2 %
   // (tests/sim/extremes_test.cpp); at t_c/20 e = 0.65 comes out as 0.86.
@@ -113,14 +115,22 @@ std::size_t props_moving(const Scene& scene, MotionType motion) {
                                                 [motion](const Prop& p) { return p.motion == motion; }));
 }
 
+// Dynamic bodies of the props: one a rigid prop, one a sphere of a breakable prop.
+std::size_t dynamic_prop_bodies(const Scene& scene) {
+  std::size_t bodies = 0;
+  for (const Prop& p : scene.props) bodies += p.motion == MotionType::Dynamic ? prop_body_count(p) : 0;
+  return bodies;
+}
+
 // Grains are the dynamic bodies that are not props (emitters only add grains).
 std::size_t grains_of(const Scene& scene, const World& world) {
-  return bodies_moving(world, MotionType::Dynamic) - props_moving(scene, MotionType::Dynamic);
+  return bodies_moving(world, MotionType::Dynamic) - dynamic_prop_bodies(scene);
 }
 
 constexpr std::string_view kMetricsHeader =
     "step,time_s,grains,kinetic_translational_J,kinetic_rotational_J,potential_J,elastic_J,contacts,"
-    "wall_contacts,max_overlap_ratio,velocity_clamps,angular_velocity_clamps,overlap_clamps,spring_overflows\n";
+    "wall_contacts,max_overlap_ratio,velocity_clamps,angular_velocity_clamps,overlap_clamps,spring_overflows,"
+    "bonds,bonds_broken,fragments,largest_fragment_kg\n";
 
 std::vector<std::string_view> split_fields(std::string_view line) {
   std::vector<std::string_view> fields;
@@ -164,11 +174,13 @@ class OutputWriter {
   void write(const World& world, const StepStats& stats, std::int64_t step, Stepper& stepper) {
     const std::string index = fmt::format("{:06d}", frame_);
     if (scene_.output.csv) {
-      csv_ += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{},{},{}\n", step,
+      const BondCounts bonds = count_bonds(scene_, world);
+      csv_ += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{},{},{},{},{},{},{:.9g}\n", step,
                           world.time, grains_of(scene_, world), stats.energy.translational,
                           stats.energy.rotational, stats.energy.potential, stats.elastic_energy,
                           stats.contacts, stats.wall_contacts, stats.max_overlap_ratio, stats.velocity_clamps,
-                          stats.angular_velocity_clamps, stats.overlap_clamps, stats.spring_overflows);
+                          stats.angular_velocity_clamps, stats.overlap_clamps, stats.spring_overflows,
+                          bonds.intact, bonds.broken, bonds.fragments, bonds.largest_fragment_mass);
       write_file_atomically(dir_ / "metrics.csv", csv_);  // whole file each time: valid after any interruption
     }
     if (scene_.output.ply) write_particles_ply(world, dir_ / ("particles_" + index + ".ply"));
@@ -285,7 +297,8 @@ class SceneRun {
 
 // The time step, the force checks, the engine and the pour emitters, from the initial world.
 void SceneRun::prepare(const World& initial) {
-  result_.dt = resolve_time_step(scene_, initial, &result_.time_step_warning);
+  result_.dt = resolve_time_step(scene_, initial, &result_.time_step_warning, &result_.bound);
+  result_.bonds_at_start = count_bonds(scene_, initial).intact;
   if (!result_.time_step_warning.empty())
     log::warn("{}: {}", scene_.file.string(), result_.time_step_warning);
   check_scene_forces(scene_, initial, sources_, result_.dt);
@@ -536,6 +549,7 @@ RunResult SceneRun::run() {
   result_.steps = step_;
   result_.last = stats_;
   result_.bodies = count_bodies(scene_, world_);
+  result_.bonds = count_bonds(scene_, world_);
   result_.grains = result_.bodies.grains;
   result_.outputs = output_->count();
   result_.files = output_->files();
@@ -546,6 +560,17 @@ RunResult SceneRun::run() {
 }
 
 }  // namespace
+
+BondCounts count_bonds(const Scene& scene, const World& world) {
+  BondCounts c;
+  if (!scene.has_bonds()) return c;
+  c.intact = world.bonds.intact_count();
+  c.broken = world.bonds.size() - c.intact;
+  const Fragments f = find_fragments(world, prop_body_ranges(scene, world));
+  c.fragments = f.count;
+  c.largest_fragment_mass = f.largest_mass;
+  return c;
+}
 
 BodyCounts count_bodies(const Scene& scene, const World& world) {
   BodyCounts c;

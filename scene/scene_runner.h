@@ -3,7 +3,8 @@
 // with a warning above the bound), releases pour emitters as time passes, steps through a Stepper
 // (sim/stepper.h: the CPU reference by default, or the GPU pipeline) and writes the [output] files:
 //   metrics.csv                one row per output (energies, contacts, overlap, clamp and spring-slot
-//                              overflow counts since the previous row)
+//                              overflow counts since the previous row; breakable props' intact and broken
+//                              bonds, fragments and the largest fragment's mass)
 //   particles_NNNNNN.ply       binary little-endian: float x y z radius, uint body
 //   particles_NNNNNN.vtp       VTK XML PolyData, binary (scene/vtk_files.h): a vertex per particle with
 //                              radius, body, velocity, angular velocity, orientation, body centre
@@ -61,6 +62,14 @@ struct BodyCounts {
 };
 BodyCounts count_bodies(const Scene& scene, const World& world);
 
+// The bonds of a run's breakable props (all zero without one), as metrics.csv and the summary give them.
+struct BondCounts {
+  std::size_t intact = 0, broken = 0;  // bonds; broken: since the start
+  std::size_t fragments = 0;           // groups of spheres intact bonds join (scene/fragments.h)
+  double largest_fragment_mass = 0;    // kg
+};
+BondCounts count_bonds(const Scene& scene, const World& world);
+
 // One kind of file a run wrote into its output folder: `pattern` as a user would list it
 // ("particles_NNNNNN.ply"), `count` files (or rows, for metrics.csv).
 struct OutputRecord {
@@ -76,6 +85,9 @@ struct RunResult {
   StepStats last;
   std::size_t grains = 0;  // grains at the end (dynamic bodies that are not props)
   BodyCounts bodies;       // at the end
+  TimeStepBound bound;     // of the scene's contacts and bonds (limiting_bound names the term that set it)
+  std::size_t bonds_at_start = 0;  // intact bonds of the initial world (a resumed run: the scene's)
+  BondCounts bonds;                // at the end
   std::int64_t outputs = 0;
   std::vector<OutputRecord> files;  // what the output folder holds after the run, checkpoints apart
   // Contacts over the whole run that found no free spring slot (spring tangential model): each ran
@@ -86,7 +98,9 @@ struct RunResult {
 };
 
 // The time step a scene runs with: its own, or the recommended bound for "auto".
-double resolve_time_step(const Scene& scene, const World& world, std::string* warning);
+// `bound_used`, when given, receives the scene's bound.
+double resolve_time_step(const Scene& scene, const World& world, std::string* warning,
+                         TimeStepBound* bound_used = nullptr);
 
 // `make_stepper` receives the settings with dt filled in (default: the CPU reference).
 RunResult run_scene(const Scene& scene, const std::filesystem::path& output_dir, const RunHooks& hooks = {},

@@ -170,6 +170,77 @@ void add_prop(World& world, const Prop& p) {
   apply_tracks(world, 0.0);
 }
 
+// A breakable prop (issue 48): one dynamic solid sphere per particle of its `--fill` body, each with its
+// share of the body's mass (sim::sphere_masses keeps the total and the centre of mass), moving with the
+// prop's velocity and spin, and the bonds of its bond material between neighbours.
+void add_breakable_prop(World& world, const Scene& scene, const Prop& p) {
+  const body::ParticleBody body = body::read_body(p.body_file, body::BodyKeys::Physical);
+  const std::size_t n = body.positions.size();
+  std::vector<Eigen::Vector3d> mesh_centres;
+  mesh_centres.reserve(n);
+  for (const Eigen::Vector3f& x : body.positions) mesh_centres.emplace_back(x.x(), x.y(), x.z());
+  const std::vector<double> radii(n, body.particle_radius);
+  std::vector<bool> interior(n, false);
+  for (std::size_t i = n - std::min(n, body.interior_count); i < n; ++i) interior[i] = true;
+  std::vector<double> masses;
+  try {
+    masses = sphere_masses(mesh_centres, radii, interior, {body.mass, body.volume, body.center_of_mass});
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: {} cannot be split into spheres: {} (resample it with `tetrasand sample "
+                                 "--fill`)",
+                                 where(scene, p.line, "prop.breakable"), p.body_file.string(), e.what()));
+  }
+  const BondMaterialSpec& spec = scene.bond_materials[static_cast<std::size_t>(p.bond_material)];
+  const auto first = static_cast<std::uint32_t>(world.particles.size());
+  const Eigen::Vector3d centre = p.position + p.orientation * body.center_of_mass;  // m, world
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d x = p.position + p.orientation * mesh_centres[i];
+    BodyDesc desc;
+    desc.position = x;
+    desc.orientation = p.orientation;
+    desc.linear_velocity = p.velocity + p.angular_velocity.cross(x - centre);
+    desc.angular_velocity = p.angular_velocity;
+    desc.inverse_mass = 1.0 / masses[i];
+    desc.inverse_inertia = Eigen::Matrix3d::Identity() / (0.4 * masses[i] * radii[i] * radii[i]);
+    desc.motion = MotionType::Dynamic;
+    add_body(world, desc, {Eigen::Vector3d::Zero()}, {radii[i]}, p.material);
+  }
+  append_bonds(world.bonds, build_bonds(mesh_centres, radii, spec.material, spec.seed), first,
+               static_cast<std::uint16_t>(p.bond_material));
+}
+
+// bind_to: bonds of the bind material between the breakable prop's spheres (particles [layer,
+// layer + layer_count)) and the particles of the prop it is bound to, closer than that material's
+// bond_distance (r_a + r_b); pairs within either side are left out. Sphere order in each bond follows
+// the world's (a < b), as the bond set's.
+void bind_props(World& world, const BondMaterialSpec& spec, std::uint16_t material, std::uint32_t layer,
+                std::uint32_t layer_count, std::uint32_t target, std::uint32_t target_count) {
+  const std::vector<Eigen::Vector3d> positions = particle_positions(world);
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<double> radii;
+  std::vector<std::uint32_t> particle;  // world index of each centre
+  for (const auto& [start, count] : {std::pair{layer, layer_count}, std::pair{target, target_count}}) {
+    for (std::uint32_t i = start; i < start + count; ++i) {
+      centres.push_back(positions[i]);
+      radii.push_back(world.particles.radius[i]);
+      particle.push_back(i);
+    }
+  }
+  const BondSet all = build_bonds(centres, radii, spec.material, spec.seed);
+  BondSet& bonds = world.bonds;
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    if ((all.a[k] < layer_count) == (all.b[k] < layer_count)) continue;  // both on one side
+    const std::uint32_t a = particle[all.a[k]], b = particle[all.b[k]];
+    bonds.a.push_back(std::min(a, b));
+    bonds.b.push_back(std::max(a, b));
+    bonds.material.push_back(material);
+    bonds.tensile_strength.push_back(all.tensile_strength[k]);
+    bonds.shear_strength.push_back(all.shear_strength[k]);
+    bonds.intact.push_back(1);
+    bonds.state.push_back(all.state[k]);
+  }
+}
+
 void add_grains(World& world, const Scene& scene, const std::vector<Eigen::Vector3d>& sites, const Emitter& e,
                 std::mt19937_64& rng) {
   const std::vector<GrainDraw> draws = emitter_grain_draws(e);
@@ -190,6 +261,27 @@ std::vector<Eigen::Vector3d> column_sites(const Emitter& e, double bound, std::m
     std::erase_if(sites, [&](const Eigen::Vector3d& s) { return (s - e.centre).head<2>().norm() > e.radius - bound; });
     if (sites.size() >= e.count) return sites;
     if (height > 1e6 * spacing) return sites;  // the radius holds no grain at all
+  }
+}
+
+// The bond materials go into the world in scene order (BondSet::material indexes both), and each
+// bind_to prop's binding bonds after every prop's own.
+void add_bonds_between_props(World& world, const Scene& scene, const std::vector<std::uint32_t>& prop_bodies) {
+  if (!scene.has_bonds()) return;
+  for (const BondMaterialSpec& spec : scene.bond_materials) world.bond_materials.push_back(spec.material);
+  for (std::size_t i = 0; i < scene.props.size(); ++i) {
+    const Prop& p = scene.props[i];
+    if (p.bind_to < 0) continue;
+    const auto t = static_cast<std::size_t>(p.bind_to);
+    const auto particles_of = [&](std::size_t k) {
+      const std::uint32_t first = world.bodies.first_particle[prop_bodies[k]];
+      const std::uint32_t last_body = prop_bodies[k] + static_cast<std::uint32_t>(prop_body_count(scene.props[k])) - 1;
+      return std::pair{first, world.bodies.first_particle[last_body] + world.bodies.particle_count[last_body] - first};
+    };
+    const auto [layer, layer_count] = particles_of(i);
+    const auto [target, target_count] = particles_of(t);
+    bind_props(world, scene.bond_materials[static_cast<std::size_t>(p.bind_material)],
+               static_cast<std::uint16_t>(p.bind_material), layer, layer_count, target, target_count);
   }
 }
 
@@ -221,10 +313,17 @@ World make_world(const Scene& scene, WorldSources* sources) {
   std::vector<std::uint32_t> prop_bodies;
   for (const Prop& p : scene.props) {
     prop_bodies.push_back(static_cast<std::uint32_t>(world.bodies.size()));
-    add_prop(world, p);
-    names.bodies.push_back(
-        fmt::format("the prop of [[prop]] at line {} ({})", p.line, p.body_file.filename().string()));
+    const std::string prop =
+        fmt::format("the prop of [[prop]] at line {} ({})", p.line, p.body_file.filename().string());
+    if (!p.breakable) {
+      add_prop(world, p);
+      names.bodies.push_back(prop);
+      continue;
+    }
+    add_breakable_prop(world, scene, p);
+    for (std::size_t i = 0; i < p.spheres; ++i) names.bodies.push_back(fmt::format("sphere {} of {}", i, prop));
   }
+  add_bonds_between_props(world, scene, prop_bodies);
   check_world_sizes(scene, world, prop_bodies);
   if (sources) {
     sources->smooth_walls = names.planes;
@@ -314,9 +413,68 @@ std::size_t PourEmitter::emit(World& world) {
 std::size_t fixture_bodies(const Scene& scene, const World& world) {
   std::size_t fixtures = 0;
   for (MotionType m : world.bodies.motion) fixtures += m != MotionType::Dynamic ? 1 : 0;
-  for (const Prop& p : scene.props) fixtures += p.motion == MotionType::Dynamic ? 1 : 0;
+  for (const Prop& p : scene.props) fixtures += p.motion == MotionType::Dynamic ? prop_body_count(p) : 0;
   return std::min(fixtures, world.bodies.size());
 }
+
+std::vector<BodyRange> prop_body_ranges(const Scene& scene, const World& world) {
+  std::size_t total = 0;
+  for (const Prop& p : scene.props) total += prop_body_count(p);
+  std::size_t next = fixture_bodies(scene, world) - std::min(total, fixture_bodies(scene, world));
+  std::vector<BodyRange> ranges;
+  for (const Prop& p : scene.props) {
+    ranges.push_back({static_cast<std::uint32_t>(next), static_cast<std::uint32_t>(prop_body_count(p)), p.breakable});
+    next += prop_body_count(p);
+  }
+  return ranges;
+}
+
+namespace {
+
+const BodyRange* breakable_range_of(const std::vector<BodyRange>& ranges, std::size_t body) {
+  for (const BodyRange& r : ranges) {
+    if (r.breakable && body >= r.first && body < r.first + r.count) return &r;
+  }
+  return nullptr;
+}
+
+// 1/kg of a breakable prop's lightest sphere: the shortest contact it takes part in.
+double largest_inverse_mass(const World& world, const BodyRange& range) {
+  double inverse = 0;
+  for (std::uint32_t b = range.first; b < range.first + range.count; ++b)
+    inverse = std::max(inverse, world.bodies.inverse_mass[b]);
+  return inverse;
+}
+
+// The contacts of a breakable prop's spheres once their bonds break: sphere on sphere (fragments
+// meeting) and sphere on each boundary, for its lightest sphere (solid sphere: a push at the contact
+// point has 1/m_t = 1/m + r^2 / (2/5 m r^2) = 3.5/m).
+void add_breakable_cases(const Scene& scene, const World& world, const std::vector<BodyRange>& ranges,
+                         std::vector<SceneContactCase>& cases) {
+  for (std::size_t i = 0; i < scene.props.size(); ++i) {
+    if (!ranges[i].breakable || ranges[i].count == 0) continue;
+    const Prop& p = scene.props[i];
+    const double m = 1 / largest_inverse_mass(world, ranges[i]);
+    const double r = world.particles.radius[world.bodies.first_particle[ranges[i].first]];
+    const std::string who = fmt::format("a sphere of the breakable prop \"{}\"", p.name);
+    const PairCoefficients self = make_pair_coefficients(scene.materials[p.material], scene.materials[p.material],
+                                                         scene.simulation.step.normal_damping);
+    cases.push_back({{m / 2, r / 2, self.effective_modulus, m / 7, self.tangential_damping}, r, m, who,
+                     "another of its spheres"});
+    for (const Boundary& b : scene.boundaries) {
+      const PairCoefficients c = make_pair_coefficients(scene.materials[p.material], scene.materials[b.material],
+                                                        scene.simulation.step.normal_damping);
+      const double radius = b.rough ? r * b.particle_radius / (r + b.particle_radius) : r;
+      cases.push_back({{m, radius, c.effective_modulus, m / 3.5, c.tangential_damping},
+                       b.rough ? std::min(r, b.particle_radius) : r,
+                       m,
+                       who,
+                       fmt::format("the {}boundary at line {}", b.rough ? "rough " : "", b.line)});
+    }
+  }
+}
+
+}  // namespace
 
 std::vector<SceneContactCase> scene_contact_cases(const Scene& scene, const World& world,
                                                   const WorldSources* sources) {
@@ -327,6 +485,8 @@ std::vector<SceneContactCase> scene_contact_cases(const Scene& scene, const Worl
                                   scene.simulation.step.normal_damping);
   };
   std::vector<SceneContactCase> cases;
+  const std::vector<BodyRange> ranges = prop_body_ranges(scene, world);
+  add_breakable_cases(scene, world, ranges, cases);
   for (std::size_t i = 0; i < kinds.size(); ++i) {
     const GrainShape& g = kinds[i].shape;
     const std::uint16_t sand = scene.grains[kinds[i].type].material;
@@ -359,10 +519,13 @@ std::vector<SceneContactCase> scene_contact_cases(const Scene& scene, const Worl
                        fmt::format("the {}boundary at line {}", b.rough ? "rough " : "", b.line)});
     }
     for (std::size_t k = 0; k < fixture_bodies(scene, world); ++k) {
+      // A breakable prop's spheres are alike but for their mass: one case, its lightest sphere's.
+      const BodyRange* breakable = breakable_range_of(ranges, k);
+      if (breakable && k != breakable->first) continue;
       const std::uint32_t first = world.bodies.first_particle[k];
       const PairCoefficients c = pair(sand, world.particles.material[first]);
       const double rp = world.particles.radius[first];
-      const double inverse_mass = world.bodies.inverse_mass[k];
+      const double inverse_mass = breakable ? largest_inverse_mass(world, *breakable) : world.bodies.inverse_mass[k];
       const bool named = sources && k < sources->bodies.size();
       cases.push_back({{1 / (1 / g.mass + inverse_mass), r * rp / (r + rp), c.effective_modulus,
                         1 / inverse_tangential, c.tangential_damping},
@@ -426,11 +589,41 @@ std::vector<ParticleKind> scene_particle_kinds(const Scene& scene) {
   return kinds;
 }
 
+BondStepBound scene_bond_time_step(const World& world) {
+  BondStepBound bound;
+  if (world.bonds.size() == 0) return bound;
+  std::vector<double> masses(world.particles.size()), radii = world.particles.radius;
+  for (std::size_t i = 0; i < masses.size(); ++i) masses[i] = 1.0 / world.bodies.inverse_mass[world.particles.body[i]];
+  // One material at a time (sim::bond_time_step takes one): the bonds of each, then the shortest.
+  for (std::size_t m = 0; m < world.bond_materials.size(); ++m) {
+    BondSet of_material;
+    for (std::size_t k = 0; k < world.bonds.size(); ++k) {
+      if (world.bonds.material[k] != m) continue;
+      of_material.a.push_back(world.bonds.a[k]);
+      of_material.b.push_back(world.bonds.b[k]);
+    }
+    const double step = bond_time_step(of_material, masses, radii, world.bond_materials[m]);
+    if (step < bound.step) bound = {step, static_cast<int>(m)};
+  }
+  return bound;
+}
+
 TimeStepBound scene_time_step_bound(const Scene& scene, const World& world, double impact_speed) {
   std::vector<ContactCase> cases;
   for (const SceneContactCase& c : scene_contact_cases(scene, world)) cases.push_back(c.contact);
   const double speed = impact_speed > 0 ? impact_speed : scene_design_speed(scene, world).speed;
-  return time_step_bound(cases, scene_particle_kinds(scene), speed);
+  TimeStepBound bound = time_step_bound(cases, scene_particle_kinds(scene), speed);
+  const BondStepBound bonds = scene_bond_time_step(world);
+  if (bonds.material >= 0 && !(bonds.step >= kShortestBondTimeStep)) {
+    const BondMaterialSpec& spec = scene.bond_materials[static_cast<std::size_t>(bonds.material)];
+    throw InputError(fmt::format(
+        "{}: the bonds of this material need a time step of {:.3g} s, below the {:g} s a run can take (a run "
+        "of a second would take over a billion steps): lower E, or use larger spheres (resample with a larger "
+        "--radius)",
+        scene_location(scene, "bond_material.E", spec.line), bonds.step, kShortestBondTimeStep));
+  }
+  add_bond_bound(bound, bonds.step);
+  return bound;
 }
 
 }  // namespace ts::scene

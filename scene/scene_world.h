@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -37,6 +38,13 @@ World make_world(const Scene& scene, WorldSources* sources = nullptr);
 // bodies from this index on (emitters only append grains).
 std::size_t fixture_bodies(const Scene& scene, const World& world);
 
+// The bodies of each [[prop]] in the world (scene order): one, or one per sphere of a breakable prop.
+struct BodyRange {
+  std::uint32_t first = 0, count = 0;
+  bool breakable = false;
+};
+std::vector<BodyRange> prop_body_ranges(const Scene& scene, const World& world);
+
 // A kind of contact a grain of the scene will see, and what it is with.
 struct SceneContactCase {
   ContactCase contact;
@@ -63,7 +71,19 @@ DesignSpeed scene_design_speed(const Scene& scene, const World& world);
 // The particle kinds of the Rayleigh bound: each GrainKind's spheres and each rough boundary's.
 std::vector<ParticleKind> scene_particle_kinds(const Scene& scene);
 
-// The time-step bound for the scene's contact kinds at `impact_speed` (m/s; 0: the design speed).
+// The bonds' share of the time-step bound: the shortest sim::bond_time_step over the bond materials.
+struct BondStepBound {
+  double step = std::numeric_limits<double>::infinity();  // s; +inf without bonds
+  int material = -1;                                     // the [[bond_material]] that sets it
+};
+BondStepBound scene_bond_time_step(const World& world);
+
+// The shortest bond time step a scene may need (s): below it a bond material is refused, naming its E.
+inline constexpr double kShortestBondTimeStep = 1e-9;
+
+// The time-step bound for the scene's contact kinds at `impact_speed` (m/s; 0: the design speed), and
+// its bonds' (TimeStepBound::bonds). Throws ts::InputError naming bond_material.E when the bonds need
+// a step below kShortestBondTimeStep.
 TimeStepBound scene_time_step_bound(const Scene& scene, const World& world, double impact_speed = 0);
 
 // Offsets from the hole's centre of fixed spheres of `radius` lining a round hole in a rough plane

@@ -45,11 +45,25 @@ TimeStepBound time_step_bound(const std::vector<ContactCase>& cases, const std::
   return b;
 }
 
+void add_bond_bound(TimeStepBound& bound, double bond_step) {
+  bound.bonds = bond_step;
+  bound.recommended = std::min(bound.recommended, bond_step);
+}
+
+std::string limiting_bound(const TimeStepBound& b) {
+  if (b.recommended == b.contact_duration / 20) return "t_c/20";
+  if (b.recommended == 0.2 * b.rayleigh) return "0.2 t_R";
+  if (b.recommended == b.tangential) return "m_t/gamma_s";
+  return "bonds";
+}
+
 std::string check_time_step(double dt, const TimeStepBound& b) {
   if (dt <= b.recommended) return {};
+  const std::string bonds = std::isfinite(b.bonds) ? fmt::format(", bonds {:.3g} s", b.bonds) : "";
   return fmt::format("dt = {:.3g} s exceeds the stable bound {:.3g} s (t_c/20 = {:.3g} s at {:.3g} m/s impacts, "
-                     "0.2 t_R = {:.3g} s, m_t/gamma_s = {:.3g} s)",
-                     dt, b.recommended, b.contact_duration / 20, b.max_impact_speed, 0.2 * b.rayleigh, b.tangential);
+                     "0.2 t_R = {:.3g} s, m_t/gamma_s = {:.3g} s{})",
+                     dt, b.recommended, b.contact_duration / 20, b.max_impact_speed, 0.2 * b.rayleigh, b.tangential,
+                     bonds);
 }
 
 }  // namespace ts::sim

@@ -1,5 +1,6 @@
 #pragma once
 // Time-step bounds for Hertz contacts (thesis 3.2.3; notes/formulas.md).
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -39,8 +40,16 @@ struct TimeStepBound {
   double rayleigh = 0;          // s: shortest t_R over the particle materials
   double tangential = 0;        // s: shortest m_t / gamma_s over the cases (inf without friction damping)
   double max_impact_speed = 0;  // m/s
-  double recommended = 0;       // s: min(t_c / 20, 0.2 t_R, m_t / gamma_s)
+  // s: the bonds' step (sim/bonds.h bond_time_step; +inf without bonds), joined by add_bond_bound
+  double bonds = std::numeric_limits<double>::infinity();
+  double recommended = 0;       // s: min(t_c / 20, 0.2 t_R, m_t / gamma_s, bonds)
 };
+
+// Joins the bonds' step (s) to the bound: recommended becomes the smaller of the two.
+void add_bond_bound(TimeStepBound& bound, double bond_step);
+
+// Which term sets `recommended`: "t_c/20", "0.2 t_R", "m_t/gamma_s" or "bonds" (the first of equals).
+std::string limiting_bound(const TimeStepBound& bound);
 
 // `particles`: radius (m) and material of each kind of particle in the scene (for t_R).
 struct ParticleKind {

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   ts::write_obj(out / "torus.obj", ts::make_torus(0.06, 0.02, 64, 24));                     // 3072 tris
   ts::write_obj(out / "trefoil.obj", ts::make_trefoil_tube(0.02, 0.012, 192, 16));           // 6144 tris
   ts::write_obj(out / "plate.obj", ts::make_plate(0.1, 0.06, 0.002, 10, 6));                // 2 mm thin plate
-  fmt::print("wrote sphere, cube, torus, trefoil, plate to {}\n", out.string());
+  ts::write_obj(out / "slab.obj", ts::make_box({-0.04, -0.025, 0.0}, {0.04, 0.025, 0.016}));  // 8 x 5 x 1.6 cm layer
+  fmt::print("wrote sphere, cube, torus, trefoil, plate, slab to {}\n", out.string());
   return 0;
 }

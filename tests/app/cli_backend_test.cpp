@@ -95,6 +95,30 @@ TEST(SimBackend, JsonSummaryIsAllOfStandardOutputAndNamesTheEngineAndTheOutputs)
   EXPECT_TRUE(summary.at("last_step").contains("kinetic_translational_J"));
 }
 
+// A breakable prop (issue 48): auto takes the CPU reference whatever the device, saying why, and the
+// summary names the bonds and the bound that set the step; --backend gpu refuses the bonds.
+TEST(SimBackend, AutoRunsAWorldWithBondsOnTheCpuReferenceAndGpuRefusesIt) {
+  const auto dir = test::temp_dir();
+  const std::string scene = quoted(test::asset("scenes/crumble.toml"));
+  test::run_tetrasand("sim " + scene + " -o " + quoted(dir / "out") + " --duration 0.0001 --json 2> " +
+                      quoted(dir / "log.txt") + " | cat > " + quoted(dir / "summary.json"));
+  const std::string log = read_file(dir / "log.txt");
+  EXPECT_NE(log.find("backend: cpu, the CPU reference (auto: the scene has a breakable prop"), std::string::npos)
+      << log;
+  std::ifstream in(dir / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
+  ASSERT_FALSE(summary.is_discarded()) << log;
+  EXPECT_EQ(summary.at("engine"), "cpu reference");
+  EXPECT_EQ(summary.at("dt_set_by"), "bonds");
+  EXPECT_EQ(summary.at("bonds").at("at_start"), 1913);
+  EXPECT_EQ(summary.at("bonds").at("fragments"), 1);
+  std::string out;
+  EXPECT_NE(test::run_tetrasand("sim " + scene + " -o " + quoted(dir / "gpu") + " --duration 0.0001 --backend gpu",
+                                &out),
+            0);
+  EXPECT_NE(out.find("run on the CPU reference only for now"), std::string::npos) << out;
+}
+
 TEST(SimBackend, CpuFlagIsAnAliasOfBackendCpu) {
   for (const std::string flags : {"--cpu", "--backend cpu"}) {
     std::string out;

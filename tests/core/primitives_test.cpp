@@ -89,6 +89,7 @@ TEST(Primitives, BundledAssetsMatchTheirGenerators) {
       {"torus.obj", make_torus(0.06, 0.02, 64, 24)},
       {"trefoil.obj", make_trefoil_tube(0.02, 0.012, 192, 16)},
       {"plate.obj", make_plate(0.1, 0.06, 0.002, 10, 6)},
+      {"slab.obj", make_box({-0.04, -0.025, 0.0}, {0.04, 0.025, 0.016})},
   };
   for (const auto& [file, generated] : assets) {
     const TriangleMesh loaded = load_mesh(test::asset(file));

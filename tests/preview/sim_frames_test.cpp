@@ -263,3 +263,30 @@ TEST(SimFrames, ColoringsAndAFixedCameraRender) {
 
 }  // namespace
 }  // namespace ts
+
+namespace ts {
+namespace {
+
+// color_by = "body" colours a breakable prop's spheres by fragment: the whole ball one colour while its
+// bonds hold, and once the bonds of one sphere break, that sphere a colour of its own (issue 48).
+TEST(SimFrames, BodyColouringGivesEachFragmentOfABreakablePropOneColour) {
+  const scene::Scene scene = scene::load_scene(test::asset("scenes/crumble.toml"));
+  sim::World world = scene::make_world(scene);
+  const std::vector<scene::BodyRange> ranges = scene::prop_body_ranges(scene, world);
+  const std::uint32_t first = world.bodies.first_particle[ranges[0].first];
+  const std::uint32_t end = first + ranges[0].count;
+  preview::SimFrameWriter writer(context(), scene);
+  const preview::Particles whole = writer.particles_of(world);
+  for (std::uint32_t i = first; i < end; ++i) ASSERT_EQ(whole.colors[i], whole.colors[first]) << i;
+  // Free the ball's last sphere: every bond it has breaks.
+  const std::uint32_t freed = end - 1;
+  for (std::size_t k = 0; k < world.bonds.size(); ++k) {
+    if (world.bonds.a[k] == freed || world.bonds.b[k] == freed) world.bonds.intact[k] = 0;
+  }
+  const preview::Particles apart = writer.particles_of(world);
+  EXPECT_NE(apart.colors[freed], apart.colors[first]);
+  for (std::uint32_t i = first; i < freed; ++i) ASSERT_EQ(apart.colors[i], apart.colors[first]) << i;
+}
+
+}  // namespace
+}  // namespace ts

@@ -121,6 +121,29 @@ TEST(Checkpoint, ResumedCpuRunIsBitwiseTheUninterruptedOne) {
   expect_resume_is_bitwise(write_scene(dir), {}, dir);
 }
 
+// Bonds (issue 48): the scrape scene with its tool already at the layer, so bonds break within the
+// short run; the bonds' loads, strengths and broken flags are in the checkpoint, and a resumed run
+// breaks the same bonds in the same steps.
+TEST(Checkpoint, ResumedRunWithBreakingBondsIsBitwiseTheUninterruptedOne) {
+  const fs::path dir = test::temp_dir();
+  Scene scene = load_scene(test::asset("scenes/scrape.toml"));
+  for (Keyframe& k : scene.props.at(2).keyframes) k.position.x() += 0.008;  // m: touching at t = 0
+  scene.simulation.duration = 0.003;
+  scene.output.every = 250;
+  scene.output.ply = true;
+  scene.output.checkpoint_every = 180;
+  expect_resume_is_bitwise(scene, {}, dir);
+  const std::string csv = read_file(dir / "plain" / "metrics.csv");
+  const std::string last = csv.substr(csv.rfind('\n', csv.size() - 2) + 1);
+  std::vector<std::string> fields;
+  for (std::size_t at = 0, comma; at <= last.size(); at = comma + 1) {
+    comma = std::min(last.find(',', at), last.size());
+    fields.push_back(last.substr(at, comma - at));
+  }
+  ASSERT_EQ(fields.size(), 18u);
+  EXPECT_GT(std::stoi(fields[15]), 0) << "no bond broke: " << last;  // bonds_broken
+}
+
 // Poured grains of varying size (issue 18): each has its own mass and inertia, which the checkpoint
 // keeps with the bodies; the emitter's sizes still to come follow from its seed and release count.
 TEST(Checkpoint, ResumedPolydispersePourIsBitwiseTheUninterruptedOne) {
@@ -323,7 +346,7 @@ TEST(Checkpoint, CraftedSceneConstantsOrMetricsAreRefusedAtResume) {
       {"its gravity differ from the scene's", [](RunState& s) { s.world.gravity.z() = -1e231; }},
       {"its materials differ from the scene's", [](RunState& s) { s.world.materials.at(0).friction = 5; }},
       {"its smooth walls differ from the scene's", [](RunState& s) { s.world.walls.planes.at(0).point.z() = 1; }},
-      {"metrics_csv: row 1 is not 14 finite numbers",
+      {"metrics_csv: row 1 is not 18 finite numbers",
        [](RunState& s) { s.metrics_csv.replace(s.metrics_csv.find('\n') + 1, 1, "x"); }},
       {"metrics_csv: its header is not metrics.csv's", [](RunState& s) { s.metrics_csv[0] = 'S'; }},
   };

@@ -121,7 +121,7 @@ TEST(SceneChecks, ImpactTheAutomaticStepCannotResolveIsRefusedWithTheLargestSpee
 
 TEST(SceneChecks, EveryBundledAndReferenceSceneStartsWithoutTrippingACheck) {
   for (const char* name : {"free_fall", "two_grain_collision", "pile", "hourglass", "prop_drop", "blade",
-                           "reference/bed", "reference/bed_tile", "reference/bounce", "reference/coarse_bed",
+                           "crumble", "scrape", "reference/bed", "reference/bed_tile", "reference/bounce", "reference/coarse_bed",
                            "reference/coarse_pile", "reference/column", "reference/elastic_box",
                            "reference/heap", "reference/silo", "reference/silo_mankoc"}) {
     const Scene scene = load_scene(test::asset(std::string("scenes/") + name + ".toml"));
