@@ -152,6 +152,33 @@ TEST_F(GpuBonds, BondedSpheresAreNoContactsUntilTheirBondBreaks) {
   EXPECT_EQ(slide.advance(two, 1).contacts, 1u) << "the broken pair meets through the contact law";
 }
 
+// Spheres crowded past the list's capacity walk the grid instead (list_build.comp); their intact bonded
+// partners, listed in their rows, are still no contacts there: one step agrees with the CPU reference
+// on the contacts and on every body's velocity change.
+TEST_F(GpuBonds, BondedSpheresWhoseListsOverflowStillSkipTheirBondedPartners) {
+  World w = bonded_block(3, cement());
+  for (V& p : w.bodies.position) p *= 0.6;  // bonds made touching, then crowded into each other
+  World cpu_world = w;
+  StepSettings s = symplectic(1e-10);
+  s.check_energy = false;  // crowded this far, the overlaps are a test's, not a run's
+  CpuStepper cpu(cpu_world, s);
+  const StepStats cpu_stats = cpu.step(cpu_world);
+  World gpu_world = w;
+  GpuStepper gpu(context, gpu_world, s, Precision::Double);
+  const StepStats gpu_stats = gpu.advance(gpu_world, 1);
+  EXPECT_GT(gpu.list_stats().overflows, 0u) << "the test needs lists that overflow";
+  ASSERT_GT(cpu_stats.contacts, 0u);
+  EXPECT_EQ(gpu_stats.contacts, cpu_stats.contacts);
+  double worst = 0.0, scale = 0.0;
+  for (std::size_t k = 0; k < w.bodies.size(); ++k) {
+    const V dv_cpu = cpu_world.bodies.linear_velocity[k] - w.bodies.linear_velocity[k];
+    const V dv_gpu = gpu_world.bodies.linear_velocity[k] - w.bodies.linear_velocity[k];
+    worst = std::max(worst, (dv_cpu - dv_gpu).norm());
+    scale = std::max(scale, dv_cpu.norm());
+  }
+  EXPECT_LT(worst / scale, 1e-4);  // the float contact law of the mixed pipeline (GpuStepperTest's bound)
+}
+
 // The GPU twin of CpuBonds.BrokenOverlappingPairGainsNoEnergy: the contact kernel takes only the
 // overlap beyond the broken bond's rest overlap.
 TEST_F(GpuBonds, BrokenOverlappingPairGainsNoEnergy) {
