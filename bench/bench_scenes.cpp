@@ -46,6 +46,39 @@ sim::World settling_box(std::uint32_t grains, std::uint64_t seed) {
   return world;
 }
 
+BondedBlock bonded_block(std::uint32_t spheres) {
+  constexpr double radius = 1e-3;  // m
+  BondedBlock out;
+  sim::World& world = out.world;
+  world.materials = {sim::Material{}};
+  const auto n = static_cast<int>(std::max(1.0, std::round(std::cbrt(spheres / 4.0))));
+  const double edge = 2.0 * std::sqrt(2.0) * radius;  // the FCC cell of touching spheres
+  const Eigen::Vector3d basis[4] = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}};
+  std::vector<Eigen::Vector3d> centres;
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        for (const Eigen::Vector3d& b : basis)
+          centres.push_back(edge * (Eigen::Vector3d(x, y, z) + b) + Eigen::Vector3d(0, 0, radius));
+  const double mass = world.materials[0].density * 4.0 * std::sqrt(2.0) * std::pow(radius, 3);  // a lattice cell's
+  for (const Eigen::Vector3d& c : centres) {
+    sim::BodyDesc d;
+    d.position = c;
+    d.inverse_mass = 1.0 / mass;
+    d.inverse_inertia = Eigen::Matrix3d::Identity() / (0.4 * mass * radius * radius);
+    sim::add_body(world, d, {Eigen::Vector3d::Zero()}, {radius}, 0);
+  }
+  sim::BondMaterial cement;
+  cement.youngs_modulus = 1e8;
+  cement.tensile_strength = cement.shear_strength = 1e12;  // Pa: never breaks here
+  const std::vector<double> radii(centres.size(), radius);
+  world.bonds = sim::build_bonds(centres, radii, cement, 1);
+  world.bond_materials = {cement};
+  world.walls.planes = {{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0}};
+  out.dt = sim::bond_time_step(world.bonds, std::vector<double>(centres.size(), mass), radii, cement);
+  return out;
+}
+
 std::string grain_centres_csv(const sim::World& world) {
   std::string csv = "x_m,y_m,z_m\n";
   for (std::size_t b = 0; b < world.bodies.size(); ++b) {

@@ -23,6 +23,16 @@ sim::World settling_box(std::uint32_t grains, std::uint64_t seed);
 // The dynamic bodies' centres as CSV "x_m,y_m,z_m" (the heap files that the Python reports measure).
 std::string grain_centres_csv(const sim::World& world);
 
+// A bonded FCC block of about `spheres` spheres (n^3 cells of 4, r = 1 mm, touching neighbours bonded:
+// 12 bonds a sphere inside), each sphere its own body, resting on a floor plane under gravity, with
+// bonds (E = 100 MPa) too strong to break: the steady cost of the bond law (issue 48). `dt` is the
+// bonds' time-step bound (sim::bond_time_step).
+struct BondedBlock {
+  sim::World world;
+  double dt = 0;  // s
+};
+BondedBlock bonded_block(std::uint32_t spheres);
+
 // A world with the step settings it runs with (dt resolved from the scene).
 struct BenchWorld {
   sim::World world;

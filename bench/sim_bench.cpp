@@ -2,7 +2,7 @@
 // same scenes, in one run, as ratios, from 1k to 1M grains; memory per grain of both. Usage:
 //   tetrasand_bench_sim [--grains 1000,8000,64000,512000,1000000] [--seconds 2] [--min-steps 2]
 //                       [--cpu-min-steps N] [--precision float|double|full-double (a list)] [--csv FILE]
-//                       [--timings]
+//                       [--timings] [--bonded 256,2048] [--bonded-csv FILE]
 // --cpu-min-steps: the CPU reference's own minimum (default --min-steps), so a device run can time 10 GPU
 // steps a size without spending its time cap on 10 CPU steps of 4M grains. --timings prints each engine's
 // timing_report() (per-kernel GPU times, the contact lists' skin, builds and candidates) on stderr.
@@ -12,6 +12,11 @@
 // double is the mixed-precision pipeline of `--precision double`; full-double keeps the contact kernel
 // in double too (sim::Precision::FullDouble), to time what the mixed pipeline saves.
 // The CSV is rewritten (atomically) after every size, so a run stopped at its time cap keeps its rows.
+// --bonded 256,2048 (sphere counts, default none) adds, after the grain rows, a row per size of
+// bonded spheres (bench_scenes.h bonded_block: breakable-prop spheres resting on a floor, the bond law
+// in both steppers, issue 48): sphere-steps per second of both, and the memory per bond of both (GPU:
+// its buffers with the bonds less the same world's without; CPU: the bonds' arrays and the step's load
+// scratch, counted from their element sizes). --bonded-csv FILE writes those rows (atomically).
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -41,7 +46,16 @@ struct Options {
   std::vector<ts::sim::Precision> precisions{ts::sim::Precision::Float};
   std::string csv;
   bool timings = false;  // per-kernel GPU times and host round trips of each size, on stderr
+  std::vector<std::uint32_t> bonded;  // sphere counts of the bonded rows
+  std::string bonded_csv;
 };
+
+std::vector<std::uint32_t> parse_counts(const std::string& text) {
+  std::vector<std::uint32_t> out;
+  std::stringstream list(text);
+  for (std::string item; std::getline(list, item, ',');) out.push_back(static_cast<std::uint32_t>(std::stoul(item)));
+  return out;
+}
 
 Options parse(int argc, char** argv) {
   Options o;
@@ -52,9 +66,7 @@ Options parse(int argc, char** argv) {
       return argv[++i];
     };
     if (arg == "--grains") {
-      o.grains.clear();
-      std::stringstream list(next());
-      for (std::string item; std::getline(list, item, ',');) o.grains.push_back(static_cast<std::uint32_t>(std::stoul(item)));
+      o.grains = parse_counts(next());
     } else if (arg == "--seconds") {
       o.seconds = std::stod(next());
     } else if (arg == "--min-steps") {
@@ -73,6 +85,10 @@ Options parse(int argc, char** argv) {
       }
     } else if (arg == "--csv") {
       o.csv = next();
+    } else if (arg == "--bonded") {
+      o.bonded = parse_counts(next());
+    } else if (arg == "--bonded-csv") {
+      o.bonded_csv = next();
     } else if (arg == "--timings") {
       o.timings = true;
     } else {
@@ -158,6 +174,58 @@ Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Optio
   return row;
 }
 
+const char* precision_name(ts::sim::Precision p);
+
+// Bytes a bond takes in the CPU reference: its BondSet entries, its load scratch of a step
+// (sim/cpu_bonds.cpp) and its two entries in the lists' bonded partners.
+double cpu_bytes_per_bond() {
+  return 2 * sizeof(std::uint32_t) + sizeof(std::uint16_t) + 2 * sizeof(double) + sizeof(std::uint8_t) +
+         sizeof(ts::sim::BondState<double>) + sizeof(double) + sizeof(ts::sim::BondLoad<double>) +
+         2 * sizeof(std::uint32_t);
+}
+
+// One size of bonded spheres: sphere-steps per second of the CPU reference and of each GPU precision,
+// and bytes per bond. Returns its CSV rows.
+std::string measure_bonded(ts::gpu::Context& context, std::uint32_t requested, const Options& options) {
+  const ts::bench::BondedBlock block = ts::bench::bonded_block(requested);
+  ts::sim::StepSettings settings;
+  settings.dt = block.dt;
+  settings.integrator = ts::sim::Integrator::SemiImplicitEuler;
+  const double spheres = static_cast<double>(block.world.particles.size());
+  const double bonds = static_cast<double>(block.world.bonds.size());
+  const int batch = std::clamp(static_cast<int>(200000 / spheres), 1, 100);
+  ts::sim::World world = block.world;
+  ts::sim::CpuStepper cpu(world, settings);
+  const Rate c = measure(
+      [&](int n) {
+        for (int s = 0; s < n; ++s) cpu.step(world);
+      },
+      [] {}, options.seconds, options.cpu_min_steps > 0 ? options.cpu_min_steps : options.min_steps,
+      std::max(1, batch / 10));
+  std::string rows;
+  for (const ts::sim::Precision precision : options.precisions) {
+    ts::sim::GpuStepper gpu(context, block.world, settings, precision, options.timings);
+    const Rate g = measure([&](int n) { gpu.step(n); }, [&] { context.finish(); }, options.seconds, options.min_steps,
+                           batch);
+    if (options.timings) fmt::print(stderr, "{} bonded spheres:\n{}", spheres, gpu.timing_report());
+    ts::sim::World unbonded = block.world;
+    unbonded.bonds = {};
+    unbonded.bond_materials.clear();
+    const ts::sim::GpuStepper plain(context, unbonded, settings, precision);
+    const double gpu_per_bond = (static_cast<double>(gpu.gpu_bytes()) - static_cast<double>(plain.gpu_bytes())) / bonds;
+    const double gs = g.steps_per_second * spheres, cs = c.steps_per_second * spheres;
+    fmt::print("bonded spheres {:>6} ({} bonds): GPU {} {:.3g} sphere-steps/s ({} steps), CPU reference {:.3g} "
+               "sphere-steps/s ({} steps), ratio {:.2f}; memory per bond GPU {:.0f} B, CPU {:.0f} B\n",
+               spheres, bonds, precision_name(precision), gs, g.steps, cs, c.steps, gs / cs, gpu_per_bond,
+               cpu_bytes_per_bond());
+    std::fflush(stdout);
+    rows += fmt::format("{},{},{:.4g},{},{:.5g},{},{:.5g},{:.4f},{:.1f},{:.1f},{},\"{}\"\n", spheres, bonds, block.dt,
+                        g.steps, gs, c.steps, cs, gs / cs, gpu_per_bond, cpu_bytes_per_bond(),
+                        precision_name(precision), context.summary());
+  }
+  return rows;
+}
+
 const char* precision_name(ts::sim::Precision p) {
   return p == ts::sim::Precision::Double ? "double" : p == ts::sim::Precision::FullDouble ? "full-double" : "float";
 }
@@ -193,6 +261,13 @@ int main(int argc, char** argv) {
       for (std::size_t k = 0; k < options.precisions.size(); ++k)
         csv += report_row(r, k, options.precisions[k], context.summary());
       if (!options.csv.empty()) ts::write_file_atomically(options.csv, csv);
+    }
+    std::string bonded_csv =
+        "spheres,bonds,dt_s,gpu_steps,gpu_sphere_steps_per_s,cpu_steps,cpu_sphere_steps_per_s,gpu_over_cpu,"
+        "gpu_bytes_per_bond,cpu_bytes_per_bond,precision,renderer\n";
+    for (std::uint32_t requested : options.bonded) {
+      bonded_csv += measure_bonded(context, requested, options);
+      if (!options.bonded_csv.empty()) ts::write_file_atomically(options.bonded_csv, bonded_csv);
     }
     return 0;
   } catch (const std::exception& e) {

@@ -101,6 +101,8 @@ static_assert(offsetof(SimContactParams, lists) == 64);
 static_assert(sizeof(SimContactParams64) == 96);
 static_assert(offsetof(SimContactParams64, limits) == 32 && offsetof(SimContactParams64, step) == 64);
 static_assert(offsetof(SimContactParams64, lists) == 48);
+static_assert(sizeof(SimBondParams) == 32 && offsetof(SimBondParams, step) == 16);
+static_assert(sizeof(SimBondParams64) == 64 && offsetof(SimBondParams64, step) == 32);
 static_assert(sizeof(SimListParams) == 32 && offsetof(SimListParams, lengths) == 16);
 static_assert(sizeof(SimIntegrateParams) == 80);
 static_assert(offsetof(SimIntegrateParams, gravity_dt) == 48 && offsetof(SimIntegrateParams, time) == 64);

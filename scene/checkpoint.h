@@ -19,7 +19,7 @@
 
 namespace ts::scene {
 
-inline constexpr std::uint32_t kCheckpointVersion = 2;
+inline constexpr std::uint32_t kCheckpointVersion = 3;
 
 // Everything a run needs to go on as if it had never stopped.
 struct RunState {

@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "core/splitmix.h"
 
@@ -117,6 +118,7 @@ BondSet build_bonds(const std::vector<Eigen::Vector3d>& centres, const std::vect
     bonds.b.push_back(j);
     bonds.tensile_strength.push_back(material.tensile_strength * factor);
     bonds.shear_strength.push_back(material.shear_strength * factor);
+    bonds.rest_overlap.push_back(std::max(0.0, radii[i] + radii[j] - (centres[i] - centres[j]).norm()));
   }
   bonds.material.assign(bonds.size(), 0);
   bonds.intact.assign(bonds.size(), 1);
@@ -133,7 +135,49 @@ void append_bonds(BondSet& bonds, const BondSet& more, std::uint32_t first_parti
     bonds.shear_strength.push_back(more.shear_strength[k]);
     bonds.intact.push_back(more.intact[k]);
     bonds.state.push_back(more.state[k]);
+    bonds.rest_overlap.push_back(more.rest_overlap[k]);
   }
+}
+
+double RestOverlaps::of(std::uint32_t i, std::uint32_t j) const {
+  if (offsets.empty()) return 0.0;
+  const auto first = partners.begin() + offsets[i], last = partners.begin() + offsets[i + 1];
+  const auto it = std::lower_bound(first, last, j);
+  return it != last && *it == j ? overlap[static_cast<std::size_t>(it - partners.begin())] : 0.0;
+}
+
+RestOverlaps rest_overlaps(const BondSet& bonds, std::size_t particles) {
+  RestOverlaps out;
+  if (std::none_of(bonds.rest_overlap.begin(), bonds.rest_overlap.end(), [](double o) { return o > 0.0; })) return out;
+  out.offsets.assign(particles + 1, 0u);
+  for (std::size_t k = 0; k < bonds.size(); ++k) {
+    if (bonds.rest_overlap[k] <= 0.0) continue;
+    ++out.offsets[bonds.a[k] + 1];
+    ++out.offsets[bonds.b[k] + 1];
+  }
+  for (std::size_t i = 0; i < particles; ++i) out.offsets[i + 1] += out.offsets[i];
+  out.partners.resize(out.offsets[particles]);
+  out.overlap.resize(out.offsets[particles]);
+  std::vector<std::uint32_t> next(out.offsets.begin(), out.offsets.end() - 1);
+  // Bonds ascend in (a, b) with a < b, so a particle's partners below it (as b) come in ascending a,
+  // and those above (as a) in ascending b, but the two runs interleave: sort each list after.
+  for (std::size_t k = 0; k < bonds.size(); ++k) {
+    if (bonds.rest_overlap[k] <= 0.0) continue;
+    for (const auto& [self, other] : {std::pair{bonds.a[k], bonds.b[k]}, std::pair{bonds.b[k], bonds.a[k]}}) {
+      out.partners[next[self]] = other;
+      out.overlap[next[self]++] = bonds.rest_overlap[k];
+    }
+  }
+  for (std::size_t i = 0; i < particles; ++i) {
+    std::vector<std::pair<std::uint32_t, double>> row;
+    for (std::uint32_t e = out.offsets[i]; e < out.offsets[i + 1]; ++e) row.emplace_back(out.partners[e], out.overlap[e]);
+    std::sort(row.begin(), row.end());
+    for (std::uint32_t e = out.offsets[i]; e < out.offsets[i + 1]; ++e) {
+      out.partners[e] = row[e - out.offsets[i]].first;
+      out.overlap[e] = row[e - out.offsets[i]].second;
+    }
+  }
+  return out;
 }
 
 bool BondedPartners::bonded(std::uint32_t i, std::uint32_t j) const {

@@ -20,6 +20,10 @@ struct BondSet {
   std::vector<double> tensile_strength;  // Pa, this bond's (BondMaterial::strength_spread)
   std::vector<double> shear_strength;    // Pa
   std::vector<std::uint8_t> intact;      // 1 until the bond breaks
+  // m, r_a + r_b - |x_a - x_b| when the bond was made, floored at 0: how far the pair overlapped at
+  // rest. Once the bond breaks the contact law takes only the overlap beyond it, so a pair bonded
+  // overlapping (a sampled surface shell's neighbours) is not pushed apart by its own rest pose.
+  std::vector<double> rest_overlap;
   std::vector<BondState<double>> state;
 
   std::size_t size() const { return a.size(); }
@@ -46,6 +50,19 @@ struct BondedPartners {
   bool bonded(std::uint32_t i, std::uint32_t j) const;
 };
 BondedPartners bonded_partners(const BondSet& bonds, std::size_t particles);
+
+// Each particle's bond partners whose spheres overlapped when bonded, with that rest overlap (CSR over
+// particle ids, partners ascending; intact or broken alike: the lists keep intact pairs from the
+// contact law anyway). Empty (no offsets) when no bond has a rest overlap.
+struct RestOverlaps {
+  std::vector<std::uint32_t> offsets, partners;
+  std::vector<double> overlap;  // m
+
+  bool empty() const { return offsets.empty(); }
+  // m: the rest overlap of the bond joining i and j, 0 when there is none.
+  double of(std::uint32_t i, std::uint32_t j) const;
+};
+RestOverlaps rest_overlaps(const BondSet& bonds, std::size_t particles);
 
 // The mass properties a body hands to its spheres.
 struct BodyMassShare {

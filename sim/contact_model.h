@@ -195,16 +195,18 @@ Real hertz_elastic_energy(Real delta, Real effective_radius, Real effective_modu
 // the bodies the spheres belong to, radii r (m), inverse masses of those bodies (1/kg, 0 for static
 // or kinematic: the damping uses the rigid bodies' masses, as LAMMPS does with fix rigid). The
 // overlap entering the force is clamped at max_overlap (m) to bound the force after a bad step.
+// rest_overlap (m): the pair's overlap when it was bonded, for a pair whose bond broke (BondSet): the
+// spheres touch only past it, and the force takes the overlap beyond it.
 template <typename Real>
 ContactForce<Real> sphere_sphere_contact(const Vec3<Real>& p1, const Vec3<Real>& v1, const Vec3<Real>& w1, Real r1,
                                          Real inverse_mass1, const Vec3<Real>& p2, const Vec3<Real>& v2,
                                          const Vec3<Real>& w2, Real r2, Real inverse_mass2, Real max_overlap,
                                          const ContactCoefficients<Real>& c, Real dt = Real(0),
-                                         Vec3<Real>* spring = nullptr) {
+                                         Vec3<Real>* spring = nullptr, Real rest_overlap = Real(0)) {
   ContactForce<Real> out;
   const Vec3<Real> d = p1 - p2;
   const Real distance = d.norm();
-  const Real raw_overlap = r1 + r2 - distance;
+  const Real raw_overlap = r1 + r2 - distance - rest_overlap;
   if (raw_overlap <= Real(0) || distance <= Real(0)) return out;
   const Vec3<Real> n = d / distance;
   out.touching = true;

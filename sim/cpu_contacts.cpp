@@ -89,6 +89,7 @@ template <typename Fn>
 void CpuContacts::visit_neighbours(std::uint32_t slot, Fn& fn, SpringLookup& lookup) const {
   const double cap = overlap_ratio_cap();
   const ParticleState& me = state_[slot];
+  const std::uint32_t me_id = lists_.order()[slot];
   for (const ListEntry& entry : lists_.candidates(slot)) {
     const ParticleState& other = state_[entry.slot];
     const double reach = me.radius + other.radius;  // m
@@ -99,7 +100,7 @@ void CpuContacts::visit_neighbours(std::uint32_t slot, Fn& fn, SpringLookup& loo
     const ContactForce<double> f = sphere_sphere_contact(
         me.position, me.velocity, me.angular_velocity, me.radius, me.inverse_mass, other.position, other.velocity,
         other.angular_velocity, other.radius, other.inverse_mass, cap * smaller, coefficients, settings_.dt,
-        lookup.find(partner));
+        lookup.find(partner), lists_.rest_overlap(me_id, entry.particle));
     if (!f.touching) continue;
     lookup.keep(partner);
     fn(f, partner, smaller);

@@ -88,6 +88,7 @@ void CpuContactLists::build(const World& world, const std::vector<Eigen::Vector3
   build_neighbour_grid(positions, cell > 0 ? cell : 1.0, grid_);
   fill_grid_entries(world, positions);
   bonded_ = bonded_partners(world.bonds, positions.size());
+  rest_ = rest_overlaps(world.bonds, positions.size());
   sort_by_cell();
   fill_lists();
   fill_pairs();

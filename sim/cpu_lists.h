@@ -81,6 +81,8 @@ class CpuContactLists {
   // The same candidates, each pair once; every list entry names its pair.
   const CandidatePairs& pairs() const { return pairs_; }
 
+  // m: the rest overlap of the bond that joined world particles i and j (RestOverlaps), 0 if none.
+  double rest_overlap(std::uint32_t i, std::uint32_t j) const { return rest_.of(i, j); }
   double skin() const { return skin_; }                          // m
   double largest_diameter() const { return largest_diameter_; }  // m, of the last build
   std::size_t builds() const { return builds_; }                 // since construction
@@ -120,6 +122,7 @@ class CpuContactLists {
   CandidatePairs pairs_;
   std::vector<Eigen::Vector3d> built_position_;  // m, world order, at the build
   BondedPartners bonded_;                        // of the build: pairs the contact law leaves to their bond
+  RestOverlaps rest_;                            // of the build: broken bonds' pairs meet past these
   double skin_ = 0, largest_diameter_ = 0;
   std::size_t builds_ = 0, listed_ = 0;
   bool built_ = false;

@@ -79,6 +79,8 @@ void GpuStepper::list_build_passes() {
   grid_.bind();
   list_.bind(TS_SIM_LIST);
   build_position_.bind(TS_SIM_BUILD_POSITION);
+  bond_pair_.bind(TS_SIM_BOND_PAIR);  // intact bonded pairs are no candidates
+  bond_csr_.bind(TS_SIM_BOND_CSR);
   list_params_.bind(TS_SIM_PARAMS);
   queue_.dispatch_items(list_build_, particle_count_);
 }

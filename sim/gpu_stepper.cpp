@@ -11,6 +11,7 @@
 #include "gpu/layouts.h"
 #include "shaders/common/bindings.h"
 #include "shaders/sim/bindings.h"
+#include "sim/cpu_bonds.h"
 #include "sim/cpu_contacts.h"
 #include "sim/state_bytes.h"
 
@@ -28,16 +29,24 @@ std::vector<std::string> precision_defines(Precision precision) {
   return precision != Precision::Float ? std::vector<std::string>{"TS_FP64 1"} : std::vector<std::string>{};
 }
 
+// The bond kernels' arithmetic follows the contact kernel's (sim/precision.glsl, creal).
+std::vector<std::string> bond_defines(Precision precision) {
+  std::vector<std::string> defines = precision_defines(precision);
+  if (precision == Precision::FullDouble) defines.emplace_back("TS_CONTACT_FP64 1");
+  return defines;
+}
+
 // The contact kernel's specialisation for these settings and a world with or without walls
 // (shaders/sim/contact_forces.comp, TS_CONTACT_*): switches the whole scene shares are compiled in, so
 // what is off (the spring history above all) costs the kernel no registers.
-std::vector<std::string> contact_defines(Precision precision, const StepSettings& s, bool walls) {
+std::vector<std::string> contact_defines(Precision precision, const StepSettings& s, bool walls, bool bonds) {
   std::vector<std::string> defines = precision_defines(precision);
   if (precision == Precision::FullDouble) defines.emplace_back("TS_CONTACT_FP64 1");
   defines.push_back(fmt::format("TS_CONTACT_SPRINGS {}", s.tangential == TangentialModel::Spring ? 1 : 0));
   defines.push_back(fmt::format("TS_CONTACT_DAMPING {}", s.normal_damping == NormalDamping::Tsuji ? 0 : 1));
   defines.push_back(fmt::format("TS_CONTACT_WALLS {}", walls ? 1 : 0));
   defines.push_back(fmt::format("TS_CONTACT_PENETRATION {}", s.check_penetration ? 1 : 0));
+  defines.push_back(fmt::format("TS_CONTACT_BONDS {}", bonds ? 1 : 0));
   return defines;
 }
 
@@ -66,8 +75,9 @@ EnergyCheck energy_check(const World& world, const StepSettings& settings) {
     if (world.bodies.motion[k] == MotionType::Dynamic) mass += 1.0 / world.bodies.inverse_mass[k];
   for (double r : world.particles.radius) diameter = std::max(diameter, 2 * r);
   const double springs = settings.check_energy ? spring_energy(world, settings) : 0.0;
-  return {e.total() + springs,
-          e.translational + e.rotational + springs + mass * (world.gravity.norm() * diameter + 1e-4)};
+  const double bonds = bond_energy(world);
+  return {e.total() + springs + bonds,
+          e.translational + e.rotational + springs + bonds + mass * (world.gravity.norm() * diameter + 1e-4)};
 }
 
 }  // namespace
@@ -97,6 +107,9 @@ GpuStepper::GpuStepper(gpu::Context& context, const StepSettings& settings, Prec
       resort_scan_(library_),
       list_decide_(gpu::Program::compute(library_, "sim/list_decide.comp")),
       list_build_(gpu::Program::compute(library_, "sim/list_build.comp", precision_defines(precision))),
+      bond_forces_(gpu::Program::compute(library_, "sim/bond_forces.comp", bond_defines(precision))),
+      bond_sums_(gpu::Program::compute(library_, "sim/bond_sums.comp", bond_defines(precision))),
+      resort_bonds_(gpu::Program::compute(library_, "sim/resort_bonds.comp")),
       syncs_at_start_(gpu::host_sync_counts()) {}
 
 template <typename T>
@@ -206,10 +219,6 @@ std::vector<SimCylinder> pack_cylinders(const std::vector<CylinderWall>& walls) 
 }  // namespace
 
 void GpuStepper::upload(const World& world) {
-  if (!world.bonds.a.empty()) {
-    // The bond law runs in the CPU reference only so far (issue 48); a GPU step would drop the bonds.
-    throw InputError("breakable props (bonded spheres) run on the CPU reference only for now: use --backend cpu");
-  }
   loaded_ = true;
   body_count_ = static_cast<std::uint32_t>(world.bodies.size());
   particle_count_ = static_cast<std::uint32_t>(world.particles.size());
@@ -223,11 +232,13 @@ void GpuStepper::upload(const World& world) {
   upload_bodies(world);
   upload_particles(world);
   upload_springs(world);
+  upload_bonds(world);  // before allocate_lists: the list build binds the bonds
   allocate_resort(body_count_, particle_count_);
   upload_materials_and_walls(world);
-  // Compiled for this world (walls or none); the context's program cache links each variant once.
+  // Compiled for this world (walls or none, bonds or none); the context's program cache links each variant once.
   contacts_ = gpu::Program::compute(library_, "sim/contact_forces.comp",
-                                    contact_defines(precision_, settings_, plane_count_ + cylinder_count_ > 0));
+                                    contact_defines(precision_, settings_, plane_count_ + cylinder_count_ > 0,
+                                                    bond_count_ > 0));
   allocate_statistics();
   allocate_lists(world);  // before set_params: the contact kernel's grid cell and capacity
   set_params();
@@ -417,8 +428,13 @@ void GpuStepper::step(int steps) {
     bind_state();
     grid_.bind();
     list_.bind(TS_SIM_LIST);
+    bond_csr_.bind(TS_SIM_BOND_CSR);  // read with TS_CONTACT_BONDS
     bind_contact_params(grid_.table_size());
     queue_.dispatch_items(contacts_, particle_count_);
+    if (bond_count_ > 0) {
+      bond_passes();
+      bind_state();  // the bond passes took slots of the state
+    }
     bind_integrate_params(time_ + settings_.dt);
     queue_.dispatch_items(integrate_, body_count_);
     time_ += settings_.dt;
@@ -453,6 +469,8 @@ StepStats GpuStepper::statistics() {
   stats.velocity_clamps = counters[0];
   stats.angular_velocity_clamps = counters[1];
   stats.spring_overflows = counters[2];
+  stats.bonds_broken = counters[TS_SIM_COUNTER_BONDS_BROKEN];
+  const std::uint32_t lost_exclusions = counters[TS_SIM_COUNTER_BOND_EXCLUSIONS_LOST];
   stats.penetration = penetration(counters);
   list_builds_ += counters[TS_SIM_COUNTER_LIST_BUILDS];
   list_overflows_ += counters[TS_SIM_COUNTER_LIST_OVERFLOWS];
@@ -462,8 +480,17 @@ StepStats GpuStepper::statistics() {
                                                 "state (reduce dt; see the time-step bound)",
                                                 time_, static_cast<std::size_t>(bad)));
   }
+  if (lost_exclusions > 0) {
+    throw Error(ExitCode::Unstable,
+                fmt::format("simulation stopped at t = {:.6g} s: {} bonded spheres had more contact candidates "
+                            "than the lists hold (K = {}) and too many bonded partners to list instead; their "
+                            "bonded pairs would have met as contacts too (use --backend cpu for this scene)",
+                            time_, lost_exclusions, list_capacity_));
+  }
   if (stats.penetration.count > 0) throw WallPenetration(time_, stats.penetration);
-  const double growth = stats.energy.total() - energy_reference_;
+  // The bonds' elastic energy after the step (the CPU reference reports it at the step's start).
+  stats.elastic_energy = bond_energy();
+  const double growth = stats.energy.total() + stats.elastic_energy - energy_reference_;
   if (settings_.check_energy && !any_kinematic_ && growth > settings_.energy_growth_tolerance * energy_scale_) {
     throw Error(ExitCode::Unstable,
                 fmt::format("simulation unstable at t = {:.6g} s: mechanical energy grew by {:.3g} J with no work "
@@ -490,6 +517,7 @@ void GpuStepper::download(World& world) const {
   }
   world.time = time_;
   download_springs(world);
+  download_bonds(world);
 }
 
 // The history slots in the GPU's layout: world.springs as far as it goes (grains appended since
@@ -663,6 +691,7 @@ void GpuStepper::resort() {
   resort_fixup_params_.values = {{particle_count_, 0u, 0u, 0u}, {springs ? 1 : 0, 0, 0, 0}};
   resort_fixup_params_.bind(TS_SIM_PARAMS);
   queue_.dispatch_items(resort_fixup_, particle_count_);
+  if (bond_count_ > 0) rename_bonded_spheres();
   force_list_rebuild();  // the lists name particles by their old index
 }
 
@@ -672,7 +701,8 @@ std::size_t GpuStepper::gpu_bytes() const {
                                &particle_local_, &body_position_, &body_orientation_, &body_velocity_, &body_omega_,
                                &body_inverse_inertia_, &body_range_, &body_momentum_, &particle_wrench_,
                                &springs_, &keyframes_, &pairs_, &planes_, &cylinders_, &particle_stats_buffer_,
-                               &list_, &build_position_})
+                               &list_, &build_position_, &bond_pair_, &bond_csr_, &bond_state_,
+                               &bond_constants_, &bond_load_})
     total += b->bytes();
   return total;
 }
@@ -704,9 +734,15 @@ std::string GpuStepper::save_state() const {
   w.put_string(context_.renderer());
   w.put(body_count_);
   w.put(particle_count_);
+  if (bond_count_ > 0) w.put(bond_count_);
   w.put(steps_since_resort_);
   for (double v : {time_, energy_reference_, energy_scale_}) w.put(v);
-  for (const gpu::Buffer* b : persistent_buffers(*this)) {
+  std::vector<const gpu::Buffer*> buffers;
+  for (const gpu::Buffer* b : persistent_buffers(*this)) buffers.push_back(b);
+  // The bonds (their spheres' GPU indices, intact flags and loads), only when there are any: the
+  // state of a world without bonds is as it was before bonds.
+  if (bond_count_ > 0) buffers.insert(buffers.end(), {&bond_pair_, &bond_state_});
+  for (const gpu::Buffer* b : buffers) {
     const auto bytes = b->read<char>(b->bytes());
     w.put_string(std::string_view(bytes.data(), bytes.size()));
   }
@@ -727,9 +763,13 @@ void GpuStepper::restore_state(const World& world, std::string_view state) {
   if (r.get<std::uint32_t>() != body_count_ || r.get<std::uint32_t>() != particle_count_) {
     r.fail("made for a world of another size");
   }
+  if (bond_count_ > 0 && r.get<std::uint32_t>() != bond_count_) r.fail("made for a world with other bonds");
   r.get(steps_since_resort_);
   for (double* v : {&time_, &energy_reference_, &energy_scale_}) r.get(*v);
-  for (gpu::Buffer* b : persistent_buffers(*this)) {
+  std::vector<gpu::Buffer*> buffers;
+  for (gpu::Buffer* b : persistent_buffers(*this)) buffers.push_back(b);
+  if (bond_count_ > 0) buffers.insert(buffers.end(), {&bond_pair_, &bond_state_});
+  for (gpu::Buffer* b : buffers) {
     const std::string bytes = r.get_string();
     if (bytes.size() != b->bytes()) r.fail("a buffer of another size");
     if (!bytes.empty()) b->upload(bytes.data(), bytes.size());

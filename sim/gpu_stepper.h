@@ -3,7 +3,8 @@
 // World: poses -> particle positions and velocities -> (when the contact candidate lists are stale,
 // decided on the GPU) hashed grid (counting sort) and lists -> contact forces gathered per particle
 // over its list (no float atomics) -> per-body sums and integration. Steps run with no CPU round
-// trip; statistics and state are read back only when asked. What only the CPU reference
+// trip; statistics and state are read back only when asked. Bonded spheres (breakable props) take
+// their bonds' loads after the contacts (sim/gpu_bonds.cpp). What only the CPU reference
 // computes (contact dumps, the spring energy of a loaded state) comes from sim/cpu_contacts.h.
 #include <array>
 #include <cstdint>
@@ -103,6 +104,15 @@ class GpuStepper : public Stepper {
   void bind_contact_params(std::uint32_t table_size);
   void bind_integrate_params(double time_after);
   void download_springs(World& world) const;
+  // Bonds of breakable props (sim/gpu_bonds.cpp): their buffers from `world` (placeholders without
+  // bonds, so list_build always has its bindings); each step's two passes (the loads and breaks, then
+  // the per-particle sums into the wrench); their spheres renamed after a re-sort; the energy they
+  // hold (J, read back); their state back into `world`.
+  void upload_bonds(const World& world);
+  void bond_passes();
+  void rename_bonded_spheres();
+  double bond_energy() const;
+  void download_bonds(World& world) const;
   std::size_t counter_count() const;  // uints of counters_
   Penetration penetration(const std::vector<std::uint32_t>& counters) const;
   void allocate_resort(std::uint32_t body_count, std::uint32_t particle_count);
@@ -169,6 +179,14 @@ class GpuStepper : public Stepper {
   double skin_ = 0.0, list_cell_ = 0.0;                       // m
   std::uint32_t list_capacity_ = 0;
   std::uint64_t list_builds_ = 0, list_overflows_ = 0;
+  // Bonds (TS_SIM_BOND_*), their kernels and parameters, and each bond's geometry for the energy.
+  gpu::Program bond_forces_, bond_sums_, resort_bonds_;
+  gpu::ParamBlock<gpu::params::SimBondParams> bond_params_;
+  gpu::ParamBlock<gpu::params::SimBondParams64> bond_params64_;
+  gpu::ParamBlock<gpu::params::ItemCount> resort_bonds_params_;
+  gpu::Buffer bond_pair_, bond_csr_, bond_state_, bond_constants_, bond_load_;
+  std::vector<BondGeometry<double>> bond_geometry_;
+  std::uint32_t bond_count_ = 0;
   std::int64_t steps_since_resort_ = 0;
   std::uint32_t particle_count_ = 0, body_count_ = 0, plane_count_ = 0, cylinder_count_ = 0, material_count_ = 0;
   double cell_size_ = 0.0;  // m: the largest particle diameter, as the CPU reference

@@ -126,6 +126,7 @@ void put_bonds(ByteWriter& w, const World& world) {
     w.put(s.twisting_moment);
     w.put(s.bending_moment);
   });
+  w.put_vector(b.rest_overlap);
 }
 
 void get_bonds(ByteReader& r, World& world) {
@@ -147,6 +148,7 @@ void get_bonds(ByteReader& r, World& world) {
     r.get(s.twisting_moment);
     r.get(s.bending_moment);
   });
+  b.rest_overlap = r.get_vector<double>();
 }
 
 // Bonds join two different particles of the world, name a bond material, and carry finite loads
@@ -155,7 +157,7 @@ void check_bonds(const World& w, ByteReader& r) {
   const BondSet& b = w.bonds;
   const std::size_t n = b.size();
   if (b.b.size() != n || b.material.size() != n || b.tensile_strength.size() != n || b.shear_strength.size() != n ||
-      b.intact.size() != n || b.state.size() != n)
+      b.intact.size() != n || b.state.size() != n || b.rest_overlap.size() != n)
     r.fail("the bonds' arrays differ in length");
   for (std::size_t k = 0; k < n; ++k) {
     if (b.a[k] >= w.particles.size() || b.b[k] >= w.particles.size() || b.a[k] == b.b[k] ||
@@ -166,6 +168,8 @@ void check_bonds(const World& w, ByteReader& r) {
           std::isfinite(b.shear_strength[k]) && std::isfinite(s.normal_force) && s.shear_force.allFinite() &&
           std::isfinite(s.twisting_moment) && s.bending_moment.allFinite()))
       r.fail(fmt::format("bond {} has a strength that is not finite and > 0, or a load that is not finite", k));
+    if (!(b.rest_overlap[k] >= 0 && b.rest_overlap[k] < w.particles.radius[b.a[k]] + w.particles.radius[b.b[k]]))
+      r.fail(fmt::format("bond {} has a rest overlap that is not in [0, r_a + r_b)", k));
   }
   for (std::size_t i = 0; i < w.bond_materials.size(); ++i) {
     if (const std::string problem = validate(w.bond_materials[i]); !problem.empty())

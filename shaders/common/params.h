@@ -141,6 +141,17 @@ TS_PARAMS(SimContactParams64) {
   dvec4 step;
 };
 
+// ---- sim/bond_forces.comp and sim/bond_sums.comp: the bonds of breakable props. SimBondParams64 is
+// the same for the double-precision pipelines (TS_FP64), whose step length is a double.
+TS_PARAMS(SimBondParams) {
+  uvec4 sizes;            // x: bonds, y: particles; zw unused
+  vec4 step;              // x: dt [s]; yzw unused
+};
+TS_PARAMS(SimBondParams64) {
+  uvec4 sizes;
+  dvec4 step;             // at 32 (std140 aligns a dvec4 to 32 bytes)
+};
+
 // ---- sim/list_decide.comp and sim/list_build.comp: the contact candidate lists (sim/contact_lists.h).
 TS_PARAMS(SimListParams) {
   uvec4 sizes;            // x: particles, y: hash table size, z: list capacity K per particle, w: rows of

@@ -27,6 +27,13 @@
 //                                 RESORT_SOURCE, RESORT_DESTINATION, RESORT_OWNER
 //   sim/gather_rows.comp          GATHER_SOURCE, GATHER_DESTINATION, GATHER_INDEX
 //   sim/resort_fixup.comp         PARTICLE_INFO, RESORT_DESTINATION, RESORT_OWNER, SPRINGS
+//   sim/resort_bonds.comp         BOND_PAIR, RESORT_DESTINATION
+//   sim/bond_forces.comp          PARTICLE_POSITION, _VELOCITY, _INFO, _POSITION_EXACT (fp64), BODY_OMEGA,
+//                                 BOND_PAIR, _STATE, _PARAMS, _LOAD, COUNTERS, LIST_STATE
+//   sim/bond_sums.comp            PARTICLE_POSITION, _INFO, _WRENCH, _POSITION_EXACT (fp64), BODY_POSITION,
+//                                 BOND_PAIR, _CSR, _LOAD
+// list_build.comp also binds BOND_PAIR and BOND_CSR (intact bonded pairs are no contact candidates),
+// contact_forces.comp (TS_CONTACT_BONDS) BOND_CSR (a broken bond's pair meets past its rest overlap).
 #ifndef TETRASAND_SIM_BINDINGS_H
 #define TETRASAND_SIM_BINDINGS_H
 
@@ -70,7 +77,11 @@
 #define TS_SIM_COUNTER_PENETRATIONS 3     // particle-steps of a dynamic particle wholly behind a smooth wall
 #define TS_SIM_COUNTER_LIST_BUILDS 4      // contact list builds (list_decide.comp)
 #define TS_SIM_COUNTER_LIST_OVERFLOWS 5   // particles found with more than K candidates, summed over builds
-#define TS_SIM_COUNTER_WALL_SLOTS 6       // the first per-wall slot
+#define TS_SIM_COUNTER_BONDS_BROKEN 6     // bonds broken (bond_forces.comp)
+// Particles whose candidates overflowed the list and whose intact bonded partners did not fit in the
+// list's rows either (list_build.comp): their contact walk would meet a bonded pair; a run stops.
+#define TS_SIM_COUNTER_BOND_EXCLUSIONS_LOST 7
+#define TS_SIM_COUNTER_WALL_SLOTS 8       // the first per-wall slot
 
 // ---- Contact candidate lists (sim/contact_lists.h; GpuStepper::rebuild_lists). LIST and
 // BUILD_POSITION share slots with the statistics' partials, which only their own passes bind; the
@@ -82,6 +93,28 @@
 #define TS_SIM_LIST_ARGS 3           // uvec4 per rebuild dispatch: the plan's row or zeros (read by glDispatchComputeIndirect)
 #define TS_SIM_LIST_MAX_DISPLACEMENT 0  // float bits: the largest distance a particle moved since the last build [m]
 #define TS_SIM_LIST_FORCED 1            // 1: rebuild at the next step whatever the displacement
+
+// ---- Bonds of breakable props (sim/bonds.h, sim/bond_model.h; GpuStepper's bond passes in
+// sim/gpu_bonds.cpp). GPU bond k is the world's bond k (BondSet order, ascending (a, b) world ids),
+// whatever the re-sort does to the particles. The bond passes (resort_bonds, bond_forces, bond_sums)
+// and list_build bind these on slots that no other buffer of those passes uses; every pass after them
+// rebinds the state (GpuStepper::bind_state).
+#define TS_SIM_BOND_PAIR 2    // uvec4 per bond: x GPU index of sphere a, y of sphere b (renamed at each re-sort), z 1 while intact, w unused
+// uint[]: [w], w <= N (world particles): where world particle w's entries start; entry e is 3 uints
+// from N + 1 + 3e: the bond's index, the partner's world particle id, and the bond's rest overlap
+// (float bits, m; sim::BondSet::rest_overlap). Each particle's bonds in ascending index (the sums'
+// fixed order). Static: a re-sort leaves it valid.
+#define TS_SIM_BOND_CSR 3
+#define TS_SIM_BOND_CSR_STRIDE 3
+// 2 real4 per bond (sim::BondState): [2k] xyz shear force [N], w normal force [N] (> 0 compression);
+// [2k + 1] xyz bending moment [N m], w twisting moment [N m]. Zero once broken.
+#define TS_SIM_BOND_STATE 4
+// 2 real4 per bond (sim::BondGeometry and the bond's strengths): [2k] area [m^2], bending inertia I
+// [m^4], polar inertia J [m^4], bond radius [m]; [2k + 1] k_n, k_s [Pa/m], tensile, shear strength [Pa].
+#define TS_SIM_BOND_PARAMS 5
+// 4 real4 per bond, this step's load (sim::BondLoad): [4k] force on a [N], [4k + 1] moment on a [N m],
+// [4k + 2] arm from a's centre to the bond's centre [m], [4k + 3] the same from b's. Zero when broken.
+#define TS_SIM_BOND_LOAD 8
 
 // ---- Re-sort by Morton key (GpuStepper::resort): the keys go through gpu::BucketSort (TS_SORT_*).
 #define TS_SIM_RESORT_ORDER TS_SORT_SORTED  // uint per new body: its old index (the sort's output)

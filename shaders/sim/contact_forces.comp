@@ -14,6 +14,7 @@
 //   TS_CONTACT_DAMPING      TS_DAMPING_TSUJI (0) or TS_DAMPING_THESIS (1)
 //   TS_CONTACT_WALLS        1: the world has smooth walls (planes or cylinders)
 //   TS_CONTACT_PENETRATION  1: count dynamic particles that passed through a wall
+//   TS_CONTACT_BONDS        1: the world has bonds; a broken bond's pair touches only past its rest overlap
 // Without them (glslangValidator, the Params test) every switch is on, Tsuji damping.
 #ifndef TS_CONTACT_SPRINGS
 #define TS_CONTACT_SPRINGS 1
@@ -27,6 +28,9 @@
 #ifndef TS_CONTACT_PENETRATION
 #define TS_CONTACT_PENETRATION 1
 #endif
+#ifndef TS_CONTACT_BONDS
+#define TS_CONTACT_BONDS 1
+#endif
 #include "common/dispatch.glsl"
 #include "common/bindings.h"
 #include "sim/bindings.h"
@@ -37,7 +41,6 @@
 // the dependent neighbour loads, small enough that a group's register file does not cap occupancy),
 // 256 for the tree reductions (reduce_*.comp), which halve the partial count per level.
 layout(local_size_x = 128) in;
-layout(std430, binding = TS_SIM_PARTICLE_POSITION) readonly buffer P { vec4 particle_position[]; };
 layout(std430, binding = TS_GRID_CELL_START) readonly buffer CellStart { uint cell_start[]; };
 layout(std430, binding = TS_GRID_SORTED) readonly buffer Sorted { uint sorted_ids[]; };
 layout(std430, binding = TS_SIM_PARTICLE_VELOCITY) readonly buffer V { real4 particle_velocity[]; };
@@ -51,11 +54,16 @@ layout(std430, binding = TS_SIM_CYLINDERS) readonly buffer Cylinders { SimCylind
 layout(std430, binding = TS_SIM_PARTICLE_STATS) writeonly buffer S { vec4 particle_stats[]; };
 layout(std430, binding = TS_SIM_COUNTERS) buffer C { uint counters[]; };
 layout(std430, binding = TS_SIM_LIST) readonly buffer L { uint list[]; };
+#if TS_CONTACT_BONDS
+layout(std430, binding = TS_SIM_BOND_CSR) readonly buffer Csr { uint bond_csr[]; };
+#endif
 #ifdef TS_FP64
 layout(std430, binding = TS_SIM_PARTICLE_POSITION_EXACT) readonly buffer PX { dvec4 particle_position_exact[]; };
 #define POSITION(k) particle_position_exact[k]
 layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots64 springs[]; };
 #else
+// The float positions only without TS_FP64: a declared block counts against the 16 even unused.
+layout(std430, binding = TS_SIM_PARTICLE_POSITION) readonly buffer P { vec4 particle_position[]; };
 #define POSITION(k) particle_position[k]
 layout(std430, binding = TS_SIM_SPRINGS) buffer Springs { SimSpringSlots springs[]; };
 #endif
@@ -106,6 +114,18 @@ creal3 contact_force(uint i, bool with_springs, int partner, creal3 n, creal del
 #endif
 }
 
+#if TS_CONTACT_BONDS
+// m: the rest overlap of the bond that joined world particles i (its CSR entries [first, last)) and
+// world_j, 0 when none (intact bonds never get here: the lists leave their pairs out).
+creal rest_overlap(uint first, uint last, uint world_j, uint particles) {
+  for (uint e = first; e < last; ++e) {
+    uint entry = particles + 1u + TS_SIM_BOND_CSR_STRIDE * e;
+    if (bond_csr[entry + 1u] == world_j) return creal(uintBitsToFloat(bond_csr[entry + 2u]));
+  }
+  return 0.0;
+}
+#endif
+
 // Particle i lies wholly behind the surface of smooth wall `slot` (planes, then cylinders): counted,
 // and the wall keeps the lowest world particle id found behind it (as ~id, so 0 means none).
 #if TS_CONTACT_WALLS && TS_CONTACT_PENETRATION
@@ -140,9 +160,14 @@ void main() {
   // build stored in rows 1-3: both in ascending index, one fixed order whenever the list was built.
   uint particles = params.sizes.x, listed = list[i];
   bool from_list = listed <= params.lists.x;
+  uint bonded_partners = 0u;  // the walk skips these (list_build.comp, rows 5 on): their bonds carry them
+#if TS_CONTACT_BONDS
+  uint bonds_first = bond_csr[particle_info[i].z], bonds_last = bond_csr[particle_info[i].z + 1u];
+#endif
   if (!from_list) {
     ivec3 cell = ivec3(int(list[particles + i]), int(list[2u * particles + i]), int(list[3u * particles + i]));
     begin_walk(cell, params.sizes.y, particles);
+    bonded_partners = min(list[4u * particles + i], params.lists.x - 4u);
   }
   for (uint k = 0u;; ++k) {
     uint j;
@@ -155,6 +180,9 @@ void main() {
     }
     uint body_j = particle_info[j].x;
     if (body_j == body_i) continue;  // the grid walk's own body (lists hold other bodies only)
+    bool bonded = false;
+    for (uint b = 0u; b < bonded_partners; ++b) bonded = bonded || list[(5u + b) * particles + i] == j;
+    if (bonded) continue;
     real inv_mass_j = body_position[body_j].w;
     if (inv_mass_i == 0.0 && inv_mass_j == 0.0) continue;  // neither body can move
     real4 xj4 = POSITION(j);
@@ -172,6 +200,12 @@ void main() {
     real gap2 = reach * reach - dot(dx, dx);
     if (gap2 <= 0.0) continue;
     creal raw = creal(gap2) / (creal(reach) + dist);
+#if TS_CONTACT_BONDS
+    if (bonds_first != bonds_last) {
+      raw -= rest_overlap(bonds_first, bonds_last, particle_info[j].z, particles);
+      if (raw <= 0.0) continue;
+    }
+#endif
     creal3 n = d / dist;
     creal smaller = min(ri, rj);
     creal delta = min(raw, overlap_cap * smaller);

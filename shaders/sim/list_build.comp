@@ -8,6 +8,10 @@
 // with more than K candidates stores K + 1 and, in rows 1-3, the grid cell it was found in: the
 // contact kernel walks the grid for it (still valid for it: the cell is largest diameter + skin).
 // The positions are kept as the build's (TS_SIM_BUILD_POSITION) for the displacement test.
+// Pairs joined by an intact bond are left to the bond (sim/bond_forces.comp), as the CPU lists do: no
+// candidates. An overflowing particle lists its intact bonded partners instead, in row 4 (how many)
+// and rows 5 on, for the contact kernel's grid walk to skip; when they do not fit either, it is
+// counted (TS_SIM_COUNTER_BOND_EXCLUSIONS_LOST) and the run stops at the next statistics.
 #include "common/dispatch.glsl"
 #include "common/bindings.h"
 #include "sim/bindings.h"
@@ -21,9 +25,20 @@ layout(std430, binding = TS_SIM_BODY_POSITION) readonly buffer BP { real4 body_p
 layout(std430, binding = TS_SIM_LIST) writeonly buffer L { uint list[]; };
 layout(std430, binding = TS_SIM_BUILD_POSITION) writeonly buffer B { vec4 build_position[]; };
 layout(std430, binding = TS_SIM_COUNTERS) buffer C { uint counters[]; };
+layout(std430, binding = TS_SIM_BOND_PAIR) readonly buffer Pairs { uvec4 bond_pair[]; };
+layout(std430, binding = TS_SIM_BOND_CSR) readonly buffer Csr { uint bond_csr[]; };
 #include "sim/candidates.glsl"
 #include "common/params.h"
 layout(std140, binding = TS_SIM_PARAMS) uniform ListBlock { SimListParams params; };
+
+// Particle i's intact bonds (its CSR entries [first, last)): whether one joins it to j.
+bool bonded(uint i, uint j, uint first, uint last, uint particles) {
+  for (uint e = first; e < last; ++e) {
+    uvec4 pair = bond_pair[bond_csr[particles + 1u + TS_SIM_BOND_CSR_STRIDE * e]];
+    if (pair.z != 0u && (pair.x == j || pair.y == j) && j != i) return true;
+  }
+  return false;
+}
 
 void main() {
   uint i = dispatch_item();
@@ -35,12 +50,15 @@ void main() {
   bool fixed_i = body_position[body_i].w == 0.0;
   ivec3 cell = cell_of_position(xi.xyz, params.lengths.x);
   begin_walk(cell, params.sizes.y, particles);
+  uint world_id = particle_info[i].z;
+  uint bonds_first = bond_csr[world_id], bonds_last = bond_csr[world_id + 1u];
   uint n = 0u;
   for (uint j = next_candidate(); j != TS_SIM_WALK_DONE; j = next_candidate()) {
     uint body_j = particle_info[j].x;
     if (body_j == body_i || (fixed_i && body_position[body_j].w == 0.0)) continue;
     vec4 xj = particle_position[j];
     if (distance(xi.xyz, xj.xyz) >= xi.w + xj.w + params.lengths.z) continue;
+    if (bonds_first != bonds_last && bonded(i, j, bonds_first, bonds_last, particles)) continue;
     if (n == capacity) {
       n = capacity + 1u;
       break;
@@ -54,5 +72,14 @@ void main() {
     list[2u * particles + i] = uint(cell.y);
     list[3u * particles + i] = uint(cell.z);
     atomicAdd(counters[TS_SIM_COUNTER_LIST_OVERFLOWS], 1u);  // integer counts: order-free
+    uint m = 0u;
+    for (uint e = bonds_first; e < bonds_last; ++e) {
+      uvec4 pair = bond_pair[bond_csr[particles + 1u + TS_SIM_BOND_CSR_STRIDE * e]];
+      if (pair.z == 0u) continue;
+      if (4u + m < capacity) list[(5u + m) * particles + i] = pair.x == i ? pair.y : pair.x;
+      ++m;
+    }
+    list[4u * particles + i] = m;
+    if (4u + m > capacity) atomicAdd(counters[TS_SIM_COUNTER_BOND_EXCLUSIONS_LOST], 1u);
   }
 }

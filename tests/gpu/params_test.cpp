@@ -210,7 +210,7 @@ TEST_F(GpuParams, SimKernelsMatchCppInBothPrecisions) {
   check(compute("sim/contact_forces.comp", {"TS_FP64 1", "TS_CONTACT_FP64 1"}), {contact<SimContactParams64>()});
   // The leanest specialisation still reads the whole block (std140 keeps every member).
   const std::vector<std::string> lean{"TS_CONTACT_SPRINGS 0", "TS_CONTACT_DAMPING 1", "TS_CONTACT_WALLS 0",
-                                      "TS_CONTACT_PENETRATION 0"};
+                                      "TS_CONTACT_PENETRATION 0", "TS_CONTACT_BONDS 0"};
   check(compute("sim/contact_forces.comp", lean), {contact<SimContactParams>()});
   check(compute("sim/integrate_bodies.comp"), {integrate<SimIntegrateParams>()});
   check(compute("sim/integrate_bodies.comp", {"TS_FP64 1"}), {integrate<SimIntegrateParams64>()});
@@ -233,6 +233,18 @@ TEST_F(GpuParams, SimKernelsMatchCppInBothPrecisions) {
         {{"FixupBlock",
           sizeof(SimFixupParams),
           {TS_MEMBER(params, SimFixupParams, sizes), TS_MEMBER(params, SimFixupParams, models)}}});
+  const BlockSpec bonds{"BondBlock",
+                        sizeof(SimBondParams),
+                        {TS_MEMBER(params, SimBondParams, sizes), TS_MEMBER(params, SimBondParams, step)}};
+  const BlockSpec bonds64{"BondBlock",
+                          sizeof(SimBondParams64),
+                          {TS_MEMBER(params, SimBondParams64, sizes), TS_MEMBER(params, SimBondParams64, step)}};
+  for (const char* kernel : {"sim/bond_forces.comp", "sim/bond_sums.comp"}) {
+    check(compute(kernel), {bonds});
+    check(compute(kernel, {"TS_FP64 1"}), {bonds64});
+    check(compute(kernel, {"TS_FP64 1", "TS_CONTACT_FP64 1"}), {bonds64});
+  }
+  check(compute("sim/resort_bonds.comp"), {item_count("BondsBlock")});
   check(compute("sim/gather_rows.comp"),
         {{"GatherBlock", sizeof(SimGatherParams), {TS_MEMBER(params, SimGatherParams, shape)}}});
 }
