@@ -115,18 +115,20 @@ bool CpuContacts::spheres_touch(std::uint32_t first_slot, std::uint32_t second_s
   return !((a.centre - b.centre).squaredNorm() >= reach * reach);
 }
 
-bool CpuContacts::pair_contact(const ParticleState& a, const ParticleState& b, double cap, PairContact& out) const {
+bool CpuContacts::pair_contact(const ParticleState& a, const ParticleState& b, double cap, double rest_overlap,
+                               PairContact& out) const {
   const auto& coefficients = pairs_[a.material * material_count_ + b.material];
   const ContactForce<double> f =
       sphere_sphere_contact(a.position, a.velocity, a.angular_velocity, a.radius, a.inverse_mass, b.position,
                             b.velocity, b.angular_velocity, b.radius, b.inverse_mass,
-                            cap * std::min(a.radius, b.radius), coefficients, settings_.dt);
+                            cap * std::min(a.radius, b.radius), coefficients, settings_.dt, nullptr, rest_overlap);
   if (!f.touching) return false;
   const double smaller = std::min(a.radius, b.radius);  // m
   // The second particle's arm as sphere_sphere_contact forms it (the same operations, so the same bits).
   const Eigen::Vector3d d = a.position - b.position;
   const double distance = d.norm();
-  const Eigen::Vector3d arm_second = (b.radius - 0.5 * (a.radius + b.radius - distance)) * (d / distance);
+  const Eigen::Vector3d arm_second =
+      (b.radius - 0.5 * (a.radius + b.radius - distance - rest_overlap)) * (d / distance);
   out = {f.force, f.arm, arm_second, f.overlap / smaller, f.elastic_energy, f.overlap_clamped};
   return true;
 }
@@ -150,7 +152,10 @@ void CpuContacts::compute_pair_contacts() {
   pair_contacts_.resize(touching_pairs_.size());
   for_each_index(static_cast<std::uint32_t>(touching_pairs_.size()), [&](std::uint32_t k) {
     const std::uint32_t p = touching_pairs_[k];
-    if (!pair_contact(state_[pairs.first[p]], state_[pairs.second[p]], cap, pair_contacts_[k])) {
+    // A pair whose bond broke touches only past its rest overlap (BondSet::rest_overlap), as on the
+    // spring path; 0 for every other pair.
+    const double rest = lists_.rest_overlap(lists_.order()[pairs.first[p]], lists_.order()[pairs.second[p]]);
+    if (!pair_contact(state_[pairs.first[p]], state_[pairs.second[p]], cap, rest, pair_contacts_[k])) {
       contact_of_pair_[p] = kNotTouching;
     }
   });

@@ -109,7 +109,8 @@ class CpuContacts {
   // Every touching candidate pair's contact into pair_contacts_ (no springs).
   void compute_pair_contacts();
   // Whether the two touch; if so, their contact into `out`.
-  bool pair_contact(const ParticleState& first, const ParticleState& second, double cap, PairContact& out) const;
+  bool pair_contact(const ParticleState& first, const ParticleState& second, double cap, double rest_overlap,
+                    PairContact& out) const;
   bool spheres_touch(std::uint32_t first_slot, std::uint32_t second_slot) const;
   // As ParticleContacts::add for each touching partner of the particle at `slot`, by increasing
   // partner id, the contacts read from pair_contacts_.
