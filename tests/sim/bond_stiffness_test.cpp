@@ -18,6 +18,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 
 #include "sim/cpu_bonds.h"
@@ -29,8 +30,6 @@ namespace {
 using V = Eigen::Vector3d;
 constexpr double kRadius = 1e-3;          // m
 constexpr double kBondModulus = 1e8;      // Pa, E of the bond cement
-constexpr double kStepFactor = 5.0;       // dt over the bonds' accuracy bound (omega dt = 0.79 < 2)
-constexpr double kSettled = 1e-5;         // relative change of the read displacement over 1 / c
 const double kCell = 4.0 * std::sqrt(2.0) * std::pow(kRadius, 3);  // m^3, FCC volume per sphere
 const double kPlaneSpacing = std::sqrt(2.0) * kRadius;           // m, between FCC planes normal to x
 
@@ -47,15 +46,20 @@ struct Specimen {
   double dt = 0;           // s
 };
 
-Specimen bonded_cylinder(int across, int planes) {
-  Specimen s;
-  World& w = s.world;
-  w.materials.push_back(Material{});
-  w.gravity = V::Zero();
+BondMaterial unbreakable() {
   BondMaterial bond;
   bond.youngs_modulus = kBondModulus;
   bond.tensile_strength = 1e12;  // nothing breaks: only the elastic response is measured
   bond.shear_strength = 1e12;
+  return bond;
+}
+
+Specimen bonded_cylinder(int across, int planes, double step_factor, const BondMaterial& bond = unbreakable(),
+                         std::uint64_t seed = 7) {
+  Specimen s;
+  World& w = s.world;
+  w.materials.push_back(Material{});
+  w.gravity = V::Zero();
   const double half = kPlaneSpacing;  // half the cube edge 2 sqrt(2) r
   const double reach = (across - 1) * kRadius;  // largest centre distance from the axis (D/2 - r)
   const int lateral = across + 2;
@@ -97,10 +101,10 @@ Specimen bonded_cylinder(int across, int planes) {
   s.area = static_cast<double>(centres.size()) * kCell / specimen_length;
   s.second_moment = moment / specimen_length;
   s.length = (planes - 2) * kPlaneSpacing;
-  w.bonds = build_bonds(centres, std::vector<double>(centres.size(), kRadius), bond, 7);
+  w.bonds = build_bonds(centres, std::vector<double>(centres.size(), kRadius), bond, seed);
   w.bond_materials = {bond};
   const std::vector<double> masses(centres.size(), mass);
-  s.dt = kStepFactor * bond_time_step(w.bonds, masses, w.particles.radius, bond);
+  s.dt = step_factor * bond_time_step(w.bonds, masses, w.particles.radius, bond);
   return s;
 }
 
@@ -111,10 +115,21 @@ double mean_displacement(const World& w, const std::vector<std::uint32_t>& bodie
   return sum / static_cast<double>(bodies.size());
 }
 
-// Applies `force` (N, shared evenly by the loaded spheres) and the driver's damping until `read` (a
-// displacement, m) settles; returns its settled value.
+// What a static load gives: the read displacement (m) with the start transient decayed, and the slow
+// creep seen under a steady load (m/s; docs/validation.md criterion 3 finding: it shrinks with dt).
+struct Settled {
+  double displacement = 0;  // the late straight line's value at the load's start
+  double creep = 0;         // its slope
+};
+
+// Applies `force` (N, shared evenly by the loaded spheres) with the driver's damping for 2 kWindows
+// windows of 1 / c: the transient decays by exp(-kWindows / 2) over the first kWindows, and the second
+// kWindows are fitted with a straight line in time (least squares) whose value at the load's start is
+// the static displacement without the creep.
+constexpr int kWindows = 30;
+
 template <typename Read>
-double settle(Specimen& s, const V& force, double omega, const Read& read) {
+Settled settle(Specimen& s, const V& force, double omega, const Read& read) {
   World& w = s.world;
   StepSettings settings;
   settings.dt = s.dt;
@@ -126,8 +141,9 @@ double settle(Specimen& s, const V& force, double omega, const Read& read) {
   const double keep = 1.0 - damping * s.dt;
   const V kick = force / static_cast<double>(s.loaded.size()) * s.dt * w.bodies.inverse_mass[s.loaded[0]];
   const auto window = std::max<std::int64_t>(1, static_cast<std::int64_t>(1.0 / (damping * s.dt)));
-  double last = 0;
-  for (int rounds = 0; rounds < 400; ++rounds) {
+  double st = 0, sx = 0, stt = 0, stx = 0;
+  int fitted = 0;
+  for (int round = 1; round <= 2 * kWindows; ++round) {
     for (std::int64_t step = 0; step < window; ++step) {
       stepper.step(w);
       for (std::size_t k = 0; k < w.bodies.size(); ++k) {
@@ -137,23 +153,29 @@ double settle(Specimen& s, const V& force, double omega, const Read& read) {
       for (std::uint32_t k : s.loaded) w.bodies.linear_velocity[k] += kick;
     }
     const double now = read(w);
-    if (rounds > 4 && std::abs(now - last) < kSettled * std::abs(now)) return now;
-    last = now;
+    if (std::getenv("BOND_DEBUG")) std::printf("round %d read %.6e\n", round, now);
+    if (round <= kWindows) continue;
+    const double t = static_cast<double>(round * window) * s.dt;
+    st += t, sx += now, stt += t * t, stx += t * now;
+    ++fitted;
   }
-  ADD_FAILURE() << "the specimen did not settle within 400 windows of 1 / c";
-  return last;
+  Settled out;
+  out.creep = (fitted * stx - st * sx) / (fitted * stt - st * st);
+  out.displacement = (sx - out.creep * st) / fitted;
+  return out;
 }
 
 struct Stiffness {
   double apparent_modulus = 0;  // E_app, Pa
   double measured_tip = 0;      // m
   double predicted_tip = 0;     // m, P L^3 / (3 E_app I)
+  double axial_creep = 0, tip_creep = 0;  // relative to the settled value, per second
   std::size_t spheres = 0, bonds = 0;
 };
 
-Stiffness measure(int across, int planes) {
+Stiffness measure(int across, int planes, double step_factor) {
   Stiffness out;
-  const Specimen fresh = bonded_cylinder(across, planes);
+  const Specimen fresh = bonded_cylinder(across, planes, step_factor);
   out.spheres = fresh.world.bodies.size();
   out.bonds = fresh.world.bonds.size();
   const std::vector<V> start = fresh.world.bodies.position;
@@ -171,8 +193,9 @@ Stiffness measure(int across, int planes) {
     return mean_displacement(w, axial.plane[quarter], start, V::UnitX()) -
            mean_displacement(w, axial.plane[three_quarters], start, V::UnitX());
   };
-  const double squeezed = settle(axial, V(-push, 0, 0), 0.5 * std::numbers::pi * wave / axial.length, shortening);
-  out.apparent_modulus = (push / axial.area) / (squeezed / gauge);
+  const Settled squeezed = settle(axial, V(-push, 0, 0), 0.5 * std::numbers::pi * wave / axial.length, shortening);
+  out.apparent_modulus = (push / axial.area) / (squeezed.displacement / gauge);
+  out.axial_creep = squeezed.creep / squeezed.displacement;
 
   // Cantilever: an end load in y, sized for a tip deflection of about 1e-4 of the length.
   Specimen beam = fresh;
@@ -181,33 +204,145 @@ Stiffness measure(int across, int planes) {
   const double omega = 3.516 * std::sqrt(out.apparent_modulus * beam.second_moment /
                                          (beam.density * beam.area * std::pow(beam.length, 4)));
   const auto tip = [&](const World& w) { return mean_displacement(w, beam.loaded, start, V::UnitY()); };
-  out.measured_tip = settle(beam, V(0, load, 0), omega, tip);
+  const Settled bent = settle(beam, V(0, load, 0), omega, tip);
+  out.measured_tip = bent.displacement;
+  out.tip_creep = bent.creep / bent.displacement;
   out.predicted_tip = load * std::pow(beam.length, 3) / (3.0 * out.apparent_modulus * beam.second_moment);
   return out;
 }
 
-void report(const char* name, int across, int planes, const Stiffness& s) {
-  std::printf("%s: %d spheres across, %d planes (L/D %.2f), %zu spheres, %zu bonds: E_app/E = %.4f; "
-              "tip %.4e m measured, %.4e m Euler-Bernoulli, ratio %.4f\n",
+void report(const char* name, int across, int planes, double step_factor, const Stiffness& s) {
+  std::printf("%s: %d spheres across, %d planes (L/D %.2f), %zu spheres, %zu bonds, dt %.2f x the bonds' bound: "
+              "E_app/E = %.4f; tip %.4e m measured, %.4e m Euler-Bernoulli, ratio %.4f; creep under the load "
+              "%.3g/s axial, %.3g/s tip (relative)\n",
               name, across, planes, (planes - 2) * kPlaneSpacing / (2.0 * across * kRadius), s.spheres, s.bonds,
-              s.apparent_modulus / kBondModulus, s.measured_tip, s.predicted_tip, s.measured_tip / s.predicted_tip);
+              step_factor, s.apparent_modulus / kBondModulus, s.measured_tip, s.predicted_tip,
+              s.measured_tip / s.predicted_tip, s.axial_creep, s.tip_creep);
 }
 
+// In CI: 5 spheres across, L/D about 4, dt 5x the bonds' bound (a few seconds).
 TEST(BondStiffness, SmallCantileverBendsAsEulerBernoulliWithTheModulusFromCompression) {
-  const int across = 5, planes = 30;  // L/D about 4
-  const Stiffness s = measure(across, planes);
-  report("small bonded cylinder", across, planes, s);
+  const int across = 5, planes = 30;
+  const Stiffness s = measure(across, planes, 5.0);
+  report("small bonded cylinder", across, planes, 5.0, s);
   EXPECT_GT(s.apparent_modulus, 0.0);
   EXPECT_NEAR(s.measured_tip / s.predicted_tip, 1.0, 0.15) << "criterion 3: within 15 % of Euler-Bernoulli";
 }
 
-// The criterion's specimen: about 10 spheres across a section.
-TEST(BondStiffness, DISABLED_TenAcrossCantileverBendsAsEulerBernoulliWithTheModulusFromCompression) {
-  const int across = 10, planes = 58;  // L/D about 4
-  const Stiffness s = measure(across, planes);
-  report("bonded cylinder", across, planes, s);
-  EXPECT_NEAR(s.measured_tip / s.predicted_tip, 1.0, 0.15) << "criterion 3: within 15 % of Euler-Bernoulli";
+// The small cylinder at smaller steps: how the static answers move with dt (about a minute).
+TEST(BondStiffness, DISABLED_SmallCylinderAtSmallerSteps) {
+  for (double factor : {2.5, 1.0}) report("small bonded cylinder", 5, 30, factor, measure(5, 30, factor));
 }
+
+// The criterion's specimen: about 10 spheres across a section, L/D about 4, at two steps (minutes).
+TEST(BondStiffness, DISABLED_TenAcrossCantileverBendsAsEulerBernoulliWithTheModulusFromCompression) {
+  const int across = 10, planes = 58;
+  for (double factor : {5.0, 2.5}) {
+    const Stiffness s = measure(across, planes, factor);
+    report("bonded cylinder", across, planes, factor, s);
+    EXPECT_NEAR(s.measured_tip / s.predicted_tip, 1.0, 0.15) << "criterion 3: within 15 % of Euler-Bernoulli";
+  }
+}
+
+// Criterion 4 (strength): uniaxial tension of the same cylinder between two grips, the first and the
+// last two planes moved apart as kinematic bodies. Loaded slowly: the whole specimen starts with the
+// grips' straight velocity profile (no wave from a sudden start), and the stress would reach the
+// bonds' tensile strength (at E_app ~ E) in kLoadingTransits times the time a wave takes along it.
+// Peak stress: the largest pull the bonds across the far grip carry, over the section's area.
+constexpr double kLoadingTransits = 20.0;
+
+struct Pull {
+  double peak_stress = 0;  // Pa
+  std::size_t broken = 0, bonds = 0;
+};
+
+Pull pull_apart(int across, int planes, double spread, std::uint64_t seed) {
+  BondMaterial bond = unbreakable();
+  bond.tensile_strength = 1e5;  // Pa: failure near a strain of 1e-3, small rotations
+  bond.shear_strength = 1e5;
+  bond.strength_spread = spread;
+  Specimen s = bonded_cylinder(across, planes, 1.0, bond, seed);
+  World& w = s.world;
+  const double length = (planes - 1) * kPlaneSpacing;
+  const double wave = std::sqrt(kBondModulus / s.density);
+  const double strain_rate = (bond.tensile_strength / kBondModulus) / (kLoadingTransits * length / wave);
+  const double grip_speed = 0.5 * strain_rate * length;  // m/s, each grip
+  std::vector<std::uint8_t> far_grip(w.bodies.size(), 0);
+  for (std::size_t k = 0; k < w.bodies.size(); ++k) {
+    const double x = w.bodies.position[k].x();
+    w.bodies.linear_velocity[k] = V(strain_rate * (x - 0.5 * length), 0, 0);
+    const bool near = x < 1.5 * kPlaneSpacing, far = x > length - 1.5 * kPlaneSpacing;
+    if (!near && !far) continue;
+    far_grip[k] = far ? 1 : 0;
+    w.bodies.motion[k] = MotionType::Kinematic;
+    w.bodies.inverse_mass[k] = 0;
+    w.bodies.inverse_inertia[k].setZero();
+    w.bodies.linear_velocity[k] = V(far ? grip_speed : -grip_speed, 0, 0);
+  }
+  StepSettings settings;
+  settings.dt = s.dt;
+  settings.integrator = Integrator::SemiImplicitEuler;
+  settings.design_speed = 10 * grip_speed;
+  CpuStepper stepper(w, settings);
+  Pull out;
+  out.bonds = w.bonds.size();
+  const auto steps = static_cast<std::int64_t>(3.0 * kLoadingTransits * length / wave / s.dt);
+  for (std::int64_t step = 0; step < steps; ++step) {
+    out.broken += stepper.step(w).bonds_broken;
+    double pull = 0;  // N, what the bonds hold the far grip back with
+    for (std::size_t n = 0; n < w.bonds.size(); ++n) {
+      const std::uint32_t a = w.bonds.a[n], b = w.bonds.b[n];
+      if (!w.bonds.intact[n] || far_grip[a] == far_grip[b]) continue;
+      const V along = (w.bodies.position[a] - w.bodies.position[b]).normalized();
+      const V on_a = w.bonds.state[n].normal_force * along + w.bonds.state[n].shear_force;
+      pull -= far_grip[a] ? on_a.x() : -on_a.x();
+    }
+    out.peak_stress = std::max(out.peak_stress, pull / s.area);
+    if (pull < 0.5 * out.peak_stress * s.area && out.broken > 0) break;  // pulled through
+  }
+  out.peak_stress /= bond.tensile_strength;  // reported over the strength
+  return out;
+}
+
+struct Spread {
+  double mean = 0, deviation = 0;  // of peak stress / tensile strength over the seeds
+};
+
+Spread over_seeds(int across, int planes, double spread, int seeds) {
+  std::vector<double> peaks;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    const Pull p = pull_apart(across, planes, spread, static_cast<std::uint64_t>(seed));
+    std::printf("tension, %d across, %d planes, spread %.1f, seed %d: peak stress / tensile strength %.4f, "
+                "%zu of %zu bonds broken\n",
+                across, planes, spread, seed, p.peak_stress, p.broken, p.bonds);
+    peaks.push_back(p.peak_stress);
+  }
+  Spread out;
+  for (double x : peaks) out.mean += x / static_cast<double>(peaks.size());
+  for (double x : peaks) out.deviation += (x - out.mean) * (x - out.mean) / static_cast<double>(peaks.size() - 1);
+  out.deviation = std::sqrt(out.deviation);
+  std::printf("tension, %d across, spread %.1f: peak stress / tensile strength mean %.4f, standard deviation %.4f, "
+              "coefficient of variation %.4f over %d seeds\n",
+              across, spread, out.mean, out.deviation, out.deviation / out.mean, seeds);
+  return out;
+}
+
+void check_strength_criterion(int across, int planes, int seeds) {
+  const Spread even = over_seeds(across, planes, 0.0, seeds);
+  const Spread spread = over_seeds(across, planes, 0.3, seeds);
+  EXPECT_GT(even.mean, 0.0);
+  EXPECT_LT(even.deviation / even.mean, 0.25) << "criterion 4: coefficient of variation below 25 %";
+  EXPECT_LT(spread.deviation / spread.mean, 0.25) << "criterion 4: coefficient of variation below 25 %";
+  EXPECT_GT(spread.deviation / spread.mean, even.deviation / even.mean) << "criterion 4: grows with strength_spread";
+}
+
+// In CI: a short 5-across cylinder, 3 seeds per spread.
+TEST(BondStrength, TensionPeakVariesLittleOverSeedsAndMoreWithStrengthSpread) {
+  check_strength_criterion(5, 16, 3);
+}
+
+// The criterion as written: 5 seeds per spread on the 5-across, L/D 4 cylinder (minutes).
+TEST(BondStrength, DISABLED_TensionPeakOverFiveSeeds) { check_strength_criterion(5, 30, 5); }
 
 }  // namespace
 }  // namespace ts::sim
