@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "core/error.h"
 #include "gpu/gl.h"
@@ -14,7 +15,6 @@
 #include "gpu/params.h"
 #include "preview/colors.h"
 #include "preview/frame.h"
-#include "preview/path_calibration.h"
 #include "shaders/preview/bindings.h"
 
 namespace ts::preview {
@@ -485,7 +485,10 @@ RenderResult Renderer::render(const RenderSettings& s) {
 }
 
 void Renderer::set_gpu_path(GpuPath path) {
-  impl_->path = path == GpuPath::Auto ? choose_gpu_path(impl_->context, path).path : path;
+  if (path == GpuPath::Auto) {
+    throw std::invalid_argument("Renderer::set_gpu_path: resolve auto first (preview::choose_gpu_path)");
+  }
+  impl_->path = path;
 }
 
 GpuPath Renderer::gpu_path() const { return impl_->path; }

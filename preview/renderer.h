@@ -56,8 +56,9 @@ class Renderer final : public ImageRenderer {
   RenderResult render(const RenderSettings& settings) override;
 
   // How the shadow map and G-buffer are made: draws or compute kernels (preview/compute_passes.h);
-  // Auto resolves by choose_gpu_path (preview/path_calibration.h: calibrated per device, cached). The
-  // raster path until set.
+  // Raster or Compute (std::invalid_argument for Auto, which the caller resolves by
+  // preview::choose_gpu_path, preview/path_calibration.h: calibrated per device, cached). The raster
+  // path until set.
   void set_gpu_path(GpuPath path);
   GpuPath gpu_path() const;  // Raster or Compute
 
