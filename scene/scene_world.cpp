@@ -238,6 +238,7 @@ void bind_props(World& world, const BondMaterialSpec& spec, std::uint16_t materi
     bonds.shear_strength.push_back(all.shear_strength[k]);
     bonds.intact.push_back(1);
     bonds.state.push_back(all.state[k]);
+    bonds.rest_overlap.push_back(all.rest_overlap[k]);
   }
 }
 
