@@ -124,27 +124,18 @@ std::string requested_backend(const Options& o) {
 // (sim/cpu_stepper.h), by the rule of gpu/backend.h, named in its one line. A device that cannot
 // make a context at all stays an error (exit 3) under auto, as under --backend gpu: a broken driver on
 // a GPU machine should say so, not turn into a much slower run.
-// A scene with bonds (breakable props) runs on the CPU reference under auto until the GPU pipeline
-// steps bonds; --backend gpu keeps the pipeline's own refusal.
 gpu::Backend choose_backend(const Options& o, const GlobalOptions& global, const scene::Scene& scene,
                             std::unique_ptr<gpu::Context>& context) {
   const bool frames = scene.output.frames;
   const gpu::Backend requested = gpu::parse_backend(requested_backend(o)).value();  // IsMember checked it
-  const bool bonds_on_cpu = requested == gpu::Backend::Auto && scene.has_bonds();
-  if ((requested != gpu::Backend::Cpu && !bonds_on_cpu) || frames)
-    context = std::make_unique<gpu::Context>(context_options(global));
-  const gpu::Backend chosen = bonds_on_cpu ? gpu::Backend::Cpu : gpu::resolve_backend(requested, context.get());
+  if (requested != gpu::Backend::Cpu || frames) context = std::make_unique<gpu::Context>(context_options(global));
+  const gpu::Backend chosen = gpu::resolve_backend(requested, context.get());
   const bool cpu = chosen == gpu::Backend::Cpu;
   const bool precision_ignored = cpu && !o.precision.empty();  // auto only: --cpu with it is refused
   const std::string precision_note =
       precision_ignored ? "--precision applies to the GPU pipeline only, the CPU reference computes in double" : "";
-  const std::string line =
-      bonds_on_cpu
-          ? fmt::format("backend: cpu, the CPU reference (auto: the scene has a breakable prop, whose bonds only "
-                        "the CPU reference steps for now{}{})",
-                        precision_note.empty() ? "" : "; ", precision_note)
-          : gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
-                              cpu ? "the CPU reference" : "the GPU pipeline", precision_note);
+  const std::string line = gpu::backend_line(requested, chosen, gpu::describe(context.get()), true,
+                                             cpu ? "the CPU reference" : "the GPU pipeline", precision_note);
   if (o.json) {
     log::info("{}", line);  // standard output stays the JSON
   } else {
