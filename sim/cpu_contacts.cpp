@@ -121,7 +121,8 @@ bool CpuContacts::pair_contact(const ParticleState& a, const ParticleState& b, d
   const ContactForce<double> f =
       sphere_sphere_contact(a.position, a.velocity, a.angular_velocity, a.radius, a.inverse_mass, b.position,
                             b.velocity, b.angular_velocity, b.radius, b.inverse_mass,
-                            cap * std::min(a.radius, b.radius), coefficients, settings_.dt, nullptr, rest_overlap);
+                            cap * std::min(a.radius, b.radius), coefficients, settings_.dt,
+                            static_cast<Eigen::Vector3d*>(nullptr), rest_overlap);
   if (!f.touching) return false;
   const double smaller = std::min(a.radius, b.radius);  // m
   // The second particle's arm as sphere_sphere_contact forms it (the same operations, so the same bits).

@@ -64,6 +64,27 @@ inline StepSettings symplectic(double dt) {
   return s;
 }
 
+// Two touching spheres of `mass` (kg) each, pressed together and sliding past each other, bonded with a
+// shear strength of 1 kPa: the bond breaks in shear within a few hundred steps of 1e-8 s.
+inline World sliding_pair_bonded_weakly_in_shear(double mass) {
+  World two;
+  two.materials = {Material{}};
+  two.gravity = V::Zero();
+  for (double x : {-kRadius, kRadius}) {
+    BodyDesc d;
+    d.position = V(x, 0, 0);
+    d.linear_velocity = V(x > 0 ? -0.01 : 0.01, x > 0 ? 0.05 : -0.05, 0);
+    d.inverse_mass = 1.0 / mass;
+    d.inverse_inertia = Eigen::Matrix3d::Identity() / (0.4 * mass * kRadius * kRadius);
+    add_body(two, d, {V::Zero()}, {kRadius}, 0);
+  }
+  BondMaterial weak_shear = cement();
+  weak_shear.shear_strength = 1e3;
+  two.bonds = build_bonds({two.bodies.position[0], two.bodies.position[1]}, {kRadius, kRadius}, weak_shear, 1);
+  two.bond_materials = {weak_shear};
+  return two;
+}
+
 // Two spheres bonded while they overlap by a tenth of a radius (their rest overlap), moving apart at
 // `speed` each (m/s), with a tensile strength low enough that the bond breaks on the way.
 inline World overlapping_pair(double speed) {

@@ -137,22 +137,7 @@ TEST(CpuBonds, BondedSpheresTakeNoContactForceUntilTheirBondBreaks) {
 
   // Two touching spheres bonded weakly in shear, pressed together and slid past each other: once the
   // bond breaks in a step, the same stepper's next lists hold the pair as a contact.
-  World two;
-  two.materials = {Material{}};
-  two.gravity = V::Zero();
-  const double mass = 1.0 / w.bodies.inverse_mass[0];
-  for (double x : {-kRadius, kRadius}) {
-    BodyDesc d;
-    d.position = V(x, 0, 0);
-    d.linear_velocity = V(x > 0 ? -0.01 : 0.01, x > 0 ? 0.05 : -0.05, 0);
-    d.inverse_mass = 1.0 / mass;
-    d.inverse_inertia = Eigen::Matrix3d::Identity() / (0.4 * mass * kRadius * kRadius);
-    add_body(two, d, {V::Zero()}, {kRadius}, 0);
-  }
-  BondMaterial weak_shear = cement();
-  weak_shear.shear_strength = 1e3;
-  two.bonds = build_bonds({two.bodies.position[0], two.bodies.position[1]}, {kRadius, kRadius}, weak_shear, 1);
-  two.bond_materials = {weak_shear};
+  World two = sliding_pair_bonded_weakly_in_shear(1.0 / w.bodies.inverse_mass[0]);
   ASSERT_EQ(two.bonds.size(), 1u);
   CpuStepper slide(two, symplectic(1e-8));
   std::size_t broke = 0;
