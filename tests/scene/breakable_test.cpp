@@ -70,9 +70,9 @@ int line_of(const std::string& text, const std::string& needle) {
 
 TEST(BreakableProps, BadBondMaterialValuesNameFileLineAndKey) {
   const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
-      {"tensile_strength = 2.0e4", "tensile_strength = 0.0", "bond_material.tensile_strength: must be > 0 Pa"},
-      {"shear_strength = 2.0e4", "shear_strength = -1.0", "bond_material.shear_strength: must be > 0 Pa"},
-      {"tensile_strength = 2.0e4", "tensile_strength = inf", "bond_material.tensile_strength: must be finite"},
+      {"tensile_strength = 1.0e4", "tensile_strength = 0.0", "bond_material.tensile_strength: must be > 0 Pa"},
+      {"shear_strength = 1.0e4", "shear_strength = -1.0", "bond_material.shear_strength: must be > 0 Pa"},
+      {"tensile_strength = 1.0e4", "tensile_strength = inf", "bond_material.tensile_strength: must be finite"},
       {"strength_spread = 0.3", "strength_spread = -0.1", "bond_material.strength_spread: must be in [0, 1]"},
       {"E = 1.0e6               #", "E = nan #", "bond_material.E: must be finite"},
       {"E = 1.0e6               #", "E = -1.0 #", "bond_material.E: must be > 0 Pa"},
