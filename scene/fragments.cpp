@@ -1,5 +1,7 @@
 #include "scene/fragments.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <numeric>
 
@@ -46,7 +48,20 @@ Fragments find_fragments(const World& world, const std::vector<BodyRange>& range
     mass[root] += 1.0 / world.bodies.inverse_mass[world.particles.body[i]];
   }
   f.largest_mass = n == 0 ? 0.0 : *std::max_element(mass.begin(), mass.end());
+  std::vector<std::uint32_t> spheres(n, 0);
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (f.label[i] != Fragments::kNone) ++spheres[f.label[i]];
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (f.label[i] == i) f.pieces.push_back({i, spheres[i], mass[i]});
+  std::stable_sort(f.pieces.begin(), f.pieces.end(),
+                   [](const Fragments::Piece& a, const Fragments::Piece& b) { return a.mass > b.mass; });
   return f;
+}
+
+std::string fragments_csv(const Fragments& fragments) {
+  std::string csv = "label,spheres,mass_kg\n";
+  for (const Fragments::Piece& p : fragments.pieces) csv += fmt::format("{},{},{:.9g}\n", p.label, p.spheres, p.mass);
+  return csv;
 }
 
 }  // namespace ts::scene

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "scene/scene_world.h"
@@ -19,7 +20,17 @@ struct Fragments {
   std::vector<std::uint32_t> label;
   std::size_t count = 0;       // fragments over all breakable props
   double largest_mass = 0;     // kg, of the heaviest fragment
+  // Every fragment, heaviest first (equal masses by label): the fragment mass distribution.
+  struct Piece {
+    std::uint32_t label = 0;    // its lowest particle index
+    std::uint32_t spheres = 0;
+    double mass = 0;            // kg
+  };
+  std::vector<Piece> pieces;
 };
+
+// fragments.csv: one row per fragment (label, spheres, mass_kg), heaviest first.
+std::string fragments_csv(const Fragments& fragments);
 
 // `ranges`: each prop's bodies (prop_body_ranges); only the breakable ones' spheres are counted.
 Fragments find_fragments(const World& world, const std::vector<BodyRange>& ranges);

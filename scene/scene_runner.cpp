@@ -553,6 +553,12 @@ RunResult SceneRun::run() {
   result_.grains = result_.bodies.grains;
   result_.outputs = output_->count();
   result_.files = output_->files();
+  if (scene_.has_bonds()) {
+    // The fragment mass distribution at the end of the run (docs/validation.md, criterion 5).
+    const Fragments f = find_fragments(world_, prop_body_ranges(scene_, world_));
+    write_file_atomically(dir_ / "fragments.csv", fragments_csv(f));
+    result_.files.push_back({"fragments.csv", static_cast<std::int64_t>(f.pieces.size()), "rows"});
+  }
   if (!servos_->empty() && output_->count() > 0)
     result_.files.push_back({"servo.csv", servos_->rows(), "rows"});
   if (hooks_.on_finish) hooks_.on_finish(*stepper_);

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -277,6 +278,22 @@ void expect_bonds_break(const std::string& name, double duration, std::size_t fr
   EXPECT_EQ(row.at("fragments"), static_cast<double>(result.bonds.fragments)) << name;
   EXPECT_NEAR(row.at("largest_fragment_kg"), result.bonds.largest_fragment_mass,
               1e-8 * result.bonds.largest_fragment_mass) << name;
+  // fragments.csv: every fragment at the end, heaviest first, the first the largest.
+  std::istringstream pieces(read_text(out / "fragments.csv"));
+  std::string line;
+  std::getline(pieces, line);
+  EXPECT_EQ(line, "label,spheres,mass_kg") << name;
+  std::vector<double> masses;
+  std::size_t spheres = 0;
+  while (std::getline(pieces, line)) {
+    const std::size_t first = line.find(','), second = line.find(',', first + 1);
+    spheres += std::stoul(line.substr(first + 1, second - first - 1));
+    masses.push_back(std::stod(line.substr(second + 1)));
+  }
+  ASSERT_EQ(masses.size(), result.bonds.fragments) << name;
+  EXPECT_NEAR(masses.front(), result.bonds.largest_fragment_mass, 1e-8 * masses.front()) << name;
+  EXPECT_TRUE(std::is_sorted(masses.rbegin(), masses.rend())) << name;
+  EXPECT_GE(spheres, masses.size()) << name;
 }
 
 TEST(BreakableProps, CrumbleSceneBreaksTheBallIntoFragmentsOnLanding) {
