@@ -315,6 +315,23 @@ TEST(CliPreview, AMeshPreviewsWithEitherSignAndAnInsideOutFieldIsReportedNotDraw
   EXPECT_NE(out.find("--sign needs a MESH input"), std::string::npos) << out;
 }
 
+// sample --backend gpu --preview draws on the GL device by the path the calibration chose for it
+// (preview/path_calibration.h) and names that choice in its preview line.
+TEST(CliPreview, SampleOnTheGpuDrawsByTheCalibratedGpuPathAndSaysSo) {
+  const auto dir = test::temp_dir();
+  std::string out;
+  ASSERT_EQ(test::run_tetrasand("sample " + q(test::asset("sphere.obj")) + " -o " + q(dir) +
+                                    " --count 150 --probes 5000 --backend gpu --preview",
+                                &out),
+            0)
+      << out;
+  ASSERT_TRUE(std::filesystem::exists(dir / "sphere.preview.png")) << out;
+  const bool compute = out.find("s on the GPU, compute (calibrated ") != std::string::npos;
+  const bool raster = out.find("s on the GPU, raster (calibrated ") != std::string::npos;
+  EXPECT_TRUE(compute || raster) << out;
+  EXPECT_GT(particle_pixel_share(preview::read_png(dir / "sphere.preview.png")), 0.01) << out;
+}
+
 // sample --backend cpu --preview draws on the CPU and needs no GL context: a device that does not exist
 // does not stop it.
 TEST(CliPreview, SampleUnderBackendCpuDrawsItsPreviewWithoutAGlContext) {
