@@ -64,6 +64,16 @@ inline StepSettings symplectic(double dt) {
   return s;
 }
 
+// A static floor of 13 x 13 touching spheres of kRadius centred on the origin at z = 0, one body.
+inline void add_sphere_floor(World& w) {
+  std::vector<V> floor;
+  for (int i = -6; i <= 6; ++i)
+    for (int j = -6; j <= 6; ++j) floor.emplace_back(2 * kRadius * i, 2 * kRadius * j, 0.0);
+  BodyDesc ground;
+  ground.motion = MotionType::Static;
+  add_body(w, ground, floor, std::vector<double>(floor.size(), kRadius), 0);
+}
+
 // Two touching spheres of `mass` (kg) each, pressed together and sliding past each other, bonded with a
 // shear strength of 1 kPa: the bond breaks in shear within a few hundred steps of 1e-8 s.
 inline World sliding_pair_bonded_weakly_in_shear(double mass) {

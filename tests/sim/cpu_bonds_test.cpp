@@ -93,12 +93,7 @@ struct Throw {
 Throw throw_at_floor(double strength, double speed) {
   World w = bonded_block(2, cement(strength), V(0, 0, 0.01));
   w.gravity = V(0, 0, -9.81);
-  std::vector<V> floor;
-  for (int i = -6; i <= 6; ++i)
-    for (int j = -6; j <= 6; ++j) floor.emplace_back(2 * kRadius * i, 2 * kRadius * j, 0.0);
-  BodyDesc ground;
-  ground.motion = MotionType::Static;
-  add_body(w, ground, floor, std::vector<double>(floor.size(), kRadius), 0);
+  add_sphere_floor(w);
   for (std::size_t k = 0; k + 1 < w.bodies.size(); ++k) w.bodies.linear_velocity[k] = V(0, 0, -speed);
   StepSettings s = symplectic(std::min(bond_step(w), 2e-7));
   s.design_speed = speed;

@@ -22,12 +22,7 @@ World thrown_block(double strength, double speed) {
   const double touch = 2.0 * kRadius + 1.5 * std::sqrt(2.0) * kRadius;  // centre height at first touch
   World w = bonded_block(2, cement(strength), V(0.1 * kRadius, -0.2 * kRadius, touch + 0.05 * kRadius));
   w.gravity = V(0, 0, -9.81);
-  std::vector<V> floor;
-  for (int i = -6; i <= 6; ++i)
-    for (int j = -6; j <= 6; ++j) floor.emplace_back(2 * kRadius * i, 2 * kRadius * j, 0.0);
-  BodyDesc ground;
-  ground.motion = MotionType::Static;
-  add_body(w, ground, floor, std::vector<double>(floor.size(), kRadius), 0);
+  add_sphere_floor(w);
   for (std::size_t k = 0; k + 1 < w.bodies.size(); ++k) w.bodies.linear_velocity[k] = V(0.3 * speed, 0, -speed);
   return w;
 }
