@@ -549,13 +549,14 @@ RunResult SceneRun::run() {
   result_.steps = step_;
   result_.last = stats_;
   result_.bodies = count_bodies(scene_, world_);
-  result_.bonds = count_bonds(scene_, world_);
   result_.grains = result_.bodies.grains;
   result_.outputs = output_->count();
   result_.files = output_->files();
   if (scene_.has_bonds()) {
-    // The fragment mass distribution at the end of the run (docs/validation.md, criterion 5).
+    // The counts and the fragment mass distribution at the end (docs/validation.md, criterion 5), from
+    // one search for the fragments.
     const Fragments f = find_fragments(world_, prop_body_ranges(scene_, world_));
+    result_.bonds = count_bonds(world_, f);
     write_file_atomically(dir_ / "fragments.csv", fragments_csv(f));
     result_.files.push_back({"fragments.csv", static_cast<std::int64_t>(f.pieces.size()), "rows"});
   }
@@ -567,15 +568,18 @@ RunResult SceneRun::run() {
 
 }  // namespace
 
-BondCounts count_bonds(const Scene& scene, const World& world) {
+BondCounts count_bonds(const World& world, const Fragments& fragments) {
   BondCounts c;
-  if (!scene.has_bonds()) return c;
   c.intact = world.bonds.intact_count();
   c.broken = world.bonds.size() - c.intact;
-  const Fragments f = find_fragments(world, prop_body_ranges(scene, world));
-  c.fragments = f.count;
-  c.largest_fragment_mass = f.largest_mass;
+  c.fragments = fragments.count;
+  c.largest_fragment_mass = fragments.largest_mass;
   return c;
+}
+
+BondCounts count_bonds(const Scene& scene, const World& world) {
+  if (!scene.has_bonds()) return {};
+  return count_bonds(world, find_fragments(world, prop_body_ranges(scene, world)));
 }
 
 BodyCounts count_bodies(const Scene& scene, const World& world) {

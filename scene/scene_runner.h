@@ -69,6 +69,9 @@ struct BondCounts {
   double largest_fragment_mass = 0;    // kg
 };
 BondCounts count_bonds(const Scene& scene, const World& world);
+// The same from fragments already found (scene/fragments.h) for this world.
+struct Fragments;
+BondCounts count_bonds(const World& world, const Fragments& fragments);
 
 // One kind of file a run wrote into its output folder: `pattern` as a user would list it
 // ("particles_NNNNNN.ply"), `count` files (or rows, for metrics.csv).
