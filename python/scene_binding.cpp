@@ -13,9 +13,9 @@
 #include "python/bindings.h"
 #include "scene/scene.h"
 #include "scene/scene_checks.h"
+#include "scene/scene_drivers.h"
 #include "scene/scene_runner.h"
 #include "scene/scene_world.h"
-#include "scene/servo.h"
 #include "sim/cpu_stepper.h"
 #include "sim/gpu_stepper.h"
 
@@ -65,7 +65,8 @@ class SteppedScene {
     settings.dt = dt_;
     settings.design_speed = scene::scene_design_speed(scene_, world_).speed;
     stepper_ = make_stepper(context_.get(), chosen, settings, bits);
-    start_emitters_and_servos();
+    drivers_.emplace(scene_, sources_, dt_);
+    drivers_->emit(world_);
     stepper_->load(world_);
   }
 
@@ -90,38 +91,14 @@ class SteppedScene {
   const std::string& time_step_warning() const { return warning_; }
 
  private:
-  void start_emitters_and_servos() {
-    emit_every_ = scene_.output.every;
-    for (const scene::Emitter& e : scene_.emitters) {
-      if (e.type != scene::EmitterType::Pour) continue;
-      pours_.emplace_back(scene_, e);
-      emit_every_ = std::min(emit_every_, std::max<std::int64_t>(1, std::llround(0.5 / (e.rate * dt_))));
-    }
-    for (scene::PourEmitter& p : pours_) p.emit(world_);
-    std::vector<scene::Servo> servos;
-    std::vector<std::uint32_t> bodies;
-    for (std::size_t k = 0; k < scene_.props.size(); ++k) {
-      if (!scene_.props[k].servo) continue;
-      servos.push_back(*scene_.props[k].servo);
-      bodies.push_back(sources_.prop_bodies[k]);
-    }
-    servos_.emplace(std::move(servos), std::move(bodies));
-  }
-
-  bool pouring() const {
-    return std::any_of(pours_.begin(), pours_.end(), [](const scene::PourEmitter& p) { return !p.finished(); });
-  }
-
-  // One stretch of at most `left` steps, ending where emitters or servos act next; returns its steps.
+  // At most `left` steps, up to where the runner's stretch ends (emitters and servos act at stretch
+  // ends, whatever chunks Python asks for); returns the steps taken.
   std::int64_t stretch(std::int64_t left) {
-    bool changed = false;
-    if (step_ > 0 && pouring()) {
-      for (scene::PourEmitter& p : pours_) changed = p.emit(world_) > 0 || changed;
+    if (step_ == stretch_end_) {
+      if (drivers_->act(world_, *stepper_, step_)) stepper_->load(world_);
+      stretch_end_ = drivers_->stretch_end(step_);
     }
-    if (servos_->update(world_, *stepper_, step_)) changed = true;
-    if (changed) stepper_->load(world_);
-    std::int64_t chunk = pouring() ? std::min(left, emit_every_) : left;
-    if (!servos_->empty()) chunk = std::min(chunk, servos_->steps_to_next(step_));
+    const std::int64_t chunk = std::min(left, stretch_end_ - step_);
     stats_ = stepper_->advance(world_, chunk);
     step_ += chunk;
     return chunk;
@@ -132,9 +109,8 @@ class SteppedScene {
   sim::World world_;
   scene::WorldSources sources_;
   std::unique_ptr<sim::Stepper> stepper_;
-  std::vector<scene::PourEmitter> pours_;
-  std::optional<scene::ServoControl> servos_;
-  std::int64_t emit_every_ = 1, step_ = 0;
+  std::optional<scene::SceneDrivers> drivers_;  // the pour emitters and the props' servos
+  std::int64_t step_ = 0, stretch_end_ = 0;
   double dt_ = 0;
   std::string warning_;
   sim::StepStats stats_;

@@ -20,6 +20,7 @@
 #include "core/text_tokens.h"
 #include "scene/checkpoint.h"
 #include "scene/fragments.h"
+#include "scene/scene_drivers.h"
 #include "scene/scene_checks.h"
 #include "scene/scene_world.h"
 #include "scene/vtk_files.h"
@@ -262,8 +263,6 @@ class SceneRun {
   void start_fresh();
   void resume();
   void restore(const RunState& state, const std::filesystem::path& file);
-  std::size_t emit();
-  bool pouring() const;
   void begin_stretch();
   std::int64_t stop_at() const;
   void advance_to(std::int64_t until);
@@ -280,9 +279,7 @@ class SceneRun {
   WorldSources sources_;
   RunResult result_;
   std::unique_ptr<Stepper> stepper_;
-  std::vector<PourEmitter> pours_;
-  std::int64_t emit_every_ = 0;  // steps between pour checks: about twice per release
-  std::optional<ServoControl> servos_;  // of the props with [prop.servo]; none: empty
+  std::optional<SceneDrivers> drivers_;  // the pour emitters and the props' servos
   std::optional<OutputWriter> output_;
   std::string hash_;     // of the scene, for checkpoints
   double duration_ = 0;  // s
@@ -306,31 +303,8 @@ void SceneRun::prepare(const World& initial) {
   settings.dt = result_.dt;
   settings.design_speed = scene_design_speed(scene_, initial).speed;  // picks the contact lists' skin
   stepper_ = make_stepper_ ? make_stepper_(settings) : std::make_unique<CpuStepper>(settings);
-  emit_every_ = scene_.output.every;
-  for (const Emitter& e : scene_.emitters) {
-    if (e.type != EmitterType::Pour) continue;
-    pours_.emplace_back(scene_, e);
-    emit_every_ = std::min(emit_every_, std::max<std::int64_t>(1, std::llround(0.5 / (e.rate * result_.dt))));
-  }
+  drivers_.emplace(scene_, sources_, result_.dt);
   if (checkpointing()) hash_ = scene_hash(scene_, initial);
-  std::vector<Servo> servos;
-  std::vector<std::uint32_t> bodies;
-  for (std::size_t k = 0; k < scene_.props.size(); ++k) {
-    if (!scene_.props[k].servo) continue;
-    servos.push_back(*scene_.props[k].servo);
-    bodies.push_back(sources_.prop_bodies[k]);
-  }
-  servos_.emplace(std::move(servos), std::move(bodies));
-}
-
-std::size_t SceneRun::emit() {
-  std::size_t added = 0;
-  for (PourEmitter& p : pours_) added += p.emit(world_);
-  return added;
-}
-
-bool SceneRun::pouring() const {
-  return std::any_of(pours_.begin(), pours_.end(), [](const PourEmitter& p) { return !p.finished(); });
 }
 
 void SceneRun::start_fresh() {
@@ -338,7 +312,7 @@ void SceneRun::start_fresh() {
   if (hooks_.edit_initial_world) hooks_.edit_initial_world(world_);
   prepare(world_);
   duration_ = control_.duration > 0 ? control_.duration : scene_.simulation.duration;
-  emit();
+  drivers_->emit(world_);
   stepper_->load(world_);
   output_.emplace(scene_, dir_, hooks_);
   remove_checkpoints(dir_);
@@ -392,8 +366,9 @@ void SceneRun::restore(const RunState& s, const std::filesystem::path& file) {
   world_ = s.world;
   stepper_->load(world_);
   try {
-    if (s.pours.size() != pours_.size()) throw InputError("its pour emitters are not the scene's");
-    for (std::size_t i = 0; i < pours_.size(); ++i) pours_[i].restore(s.pours[i]);
+    std::vector<PourEmitter>& pours = drivers_->pours();
+    if (s.pours.size() != pours.size()) throw InputError("its pour emitters are not the scene's");
+    for (std::size_t i = 0; i < pours.size(); ++i) pours[i].restore(s.pours[i]);
     stepper_->restore_state(world_, s.engine_state);
   } catch (const InputError& e) {
     throw InputError(file, e.what());
@@ -422,16 +397,10 @@ void SceneRun::restore(const RunState& s, const std::filesystem::path& file) {
 // Releases due grains (after the first step) and updates the servos due, then sets where the stretch
 // ends: at the next output, or sooner while pouring or at the next servo update.
 void SceneRun::begin_stretch() {
-  bool changed = step_ > 0 && pouring() && emit() > 0;
-  // The contacts are the CPU reference's on the state the last stretch brought back; on the GPU the
-  // servo's new velocity goes up with the whole state again (load), at servo steps only.
-  if (servos_->update(world_, *stepper_, step_)) changed = true;
-  if (changed) stepper_->load(world_);
+  if (drivers_->act(world_, *stepper_, step_)) stepper_->load(world_);
   const std::int64_t every = scene_.output.every;
   stretch_output_ = std::min(total_, (step_ / every + 1) * every);
-  std::int64_t chunk = std::min(stretch_output_ - step_, pouring() ? emit_every_ : stretch_output_ - step_);
-  if (!servos_->empty()) chunk = std::min(chunk, servos_->steps_to_next(step_));
-  stretch_end_ = step_ + chunk;
+  stretch_end_ = std::min(stretch_output_, drivers_->stretch_end(step_));
 }
 
 // Where the next advance stops: the stretch's end, or sooner for a checkpoint or a look at the clock.
@@ -482,7 +451,7 @@ void SceneRun::end_stretch() {
   stats_.angular_velocity_clamps = std::exchange(angular_clamps_, 0);
   stats_.overlap_clamps = std::exchange(overlap_clamps_, 0);
   output_->write(world_, stats_, step_, *stepper_);
-  if (!servos_->empty()) write_file_atomically(dir_ / "servo.csv", servos_->csv());  // whole, as metrics.csv
+  if (!drivers_->servos().empty()) write_file_atomically(dir_ / "servo.csv", drivers_->servos().csv());  // whole, as metrics.csv
   try {
     watch_.interval(stats_.velocity_clamps + stats_.angular_velocity_clamps, step_ - last_output_step_,
                     world_.time);
@@ -526,7 +495,7 @@ RunState SceneRun::state() const {
   s.run_spring_overflows = result_.spring_overflows;
   s.clamp_watch = watch_.state();
   s.last = stats_;
-  for (const PourEmitter& p : pours_) s.pours.push_back(p.progress());
+  for (const PourEmitter& p : drivers_->pours()) s.pours.push_back(p.progress());
   s.metrics_csv = output_->csv();
   s.world = world_;
   s.engine_state = stepper_->save_state();
@@ -560,8 +529,8 @@ RunResult SceneRun::run() {
     write_file_atomically(dir_ / "fragments.csv", fragments_csv(f));
     result_.files.push_back({"fragments.csv", static_cast<std::int64_t>(f.pieces.size()), "rows"});
   }
-  if (!servos_->empty() && output_->count() > 0)
-    result_.files.push_back({"servo.csv", servos_->rows(), "rows"});
+  if (!drivers_->servos().empty() && output_->count() > 0)
+    result_.files.push_back({"servo.csv", drivers_->servos().rows(), "rows"});
   if (hooks_.on_finish) hooks_.on_finish(*stepper_);
   return result_;
 }
