@@ -302,6 +302,19 @@ TEST(BondStiffness, LoadedCantileverComesToRestAtADeflectionIndependentOfTheTime
   EXPECT_NEAR(fine.apparent_modulus / coarse.apparent_modulus, 1.0, 1e-3) << "the static shortening depends on dt";
 }
 
+// In CI, a regression guard, not criterion 3: the 5-across cylinder (L/D about 4) at 5 times the bound
+// keeps the static answers recorded for it after the driver's fix (docs/validation.md criterion 3,
+// 2026-12-08: E_app / E 1.1361, tip 1.1967 times Euler-Bernoulli's; the criterion wants 1.15 at most
+// and is met only at 10 across). 1 % either way: the rest state itself repeats to 1e-6, so only a change
+// in the law, the lattice or the measure moves them that far. 20 windows instead of 30: the recorded
+// history has the tip within 3e-5 of its final value after 40 windows. About 10 s.
+TEST(BondStiffness, SmallCylinderKeepsItsRecordedModulusAndCantileverDeflection) {
+  const Stiffness s = measure(5, 30, 5.0, 20);
+  report("small bonded cylinder", 5, 30, 5.0, s);
+  EXPECT_NEAR(s.apparent_modulus / kBondModulus, 1.1361, 0.01 * 1.1361);
+  EXPECT_NEAR(s.measured_tip / s.predicted_tip, 1.1967, 0.01 * 1.1967);
+}
+
 // The small cylinder (5 spheres across, L/D about 4) at three steps, checked against the criterion at
 // each (about two minutes). DISABLED_: criterion 3 is not met on a section this coarse
 // (docs/validation.md: tip about 1.19 times Euler-Bernoulli's), so it cannot stand as a CI test; run it
@@ -339,7 +352,7 @@ TEST(BondStiffness, DISABLED_TenAcrossCantileverBendsAsEulerBernoulliWithTheModu
 // bonds' tensile strength (at E_app ~ E) in kLoadingTransits times the time a wave takes along it.
 // Peak stress: the largest pull the bonds across the far grip carry, over the section's area.
 constexpr double kLoadingTransits = 20.0;
-constexpr std::int64_t kCurveEvery = 50;  // steps between the stress-strain curve's points
+constexpr std::int64_t kCurveEvery = 100;  // steps between the stress-strain curve's points
 
 struct Pull {
   double peak_stress = 0;  // Pa
