@@ -3,7 +3,7 @@
 //   tetrasand_bench_sim [--grains 1000,8000,64000,512000,1000000] [--seconds 2] [--min-steps 2]
 //                       [--cpu-min-steps N] [--precision float|double|full-double (a list)] [--csv FILE]
 //                       [--timings] [--bonded 256,2048] [--bonded-csv FILE] [--scene bed|plough]
-//                       [--plough-speed 0.5]
+//                       [--plough-speed 0.5] [--skip-cpu]
 // --cpu-min-steps: the CPU reference's own minimum (default --min-steps), so a device run can time 10 GPU
 // steps a size without spending its time cap on 10 CPU steps of 4M grains. --timings prints each engine's
 // timing_report() (per-kernel GPU times, the contact lists' skin, builds and candidates) on stderr.
@@ -17,6 +17,8 @@
 // kinematic blade driven through it at --plough-speed m/s), where the contact lists are rebuilt every
 // few tens of steps, so its rate includes their builds (--timings says how many, and what they cost).
 // Its grain count is the bed's grains left after the blade's slot; the blade's spheres are not counted.
+// --skip-cpu leaves the CPU reference out (its columns and the contacts per grain 0, the ratio nan): at 4M grains its world copy and
+// stepper would double the memory the GPU measurement needs, and take its time.
 // --bonded 256,2048 (sphere counts, default none) adds, after the grain rows, a row per size of
 // bonded spheres (bench_scenes.h bonded_block: breakable-prop spheres resting on a floor, the bond law
 // in both steppers, issue 48): sphere-steps per second of both, and the memory per bond of both (GPU:
@@ -27,6 +29,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -55,6 +58,7 @@ struct Options {
   std::string bonded_csv;
   std::string scene = "bed";  // bed (settled) or plough (moving)
   double plough_speed = 0.5;  // m/s
+  bool skip_cpu = false;      // GPU rows only
 };
 
 std::vector<std::uint32_t> parse_counts(const std::string& text) {
@@ -104,6 +108,8 @@ Options parse(int argc, char** argv) {
       o.plough_speed = std::stod(next());
       if (!(o.plough_speed > 0 && o.plough_speed <= 10))
         throw std::runtime_error("--plough-speed: expected a speed in m/s within (0, 10], got " + std::string(argv[i]));
+    } else if (arg == "--skip-cpu") {
+      o.skip_cpu = true;
     } else if (arg == "--timings") {
       o.timings = true;
     } else {
@@ -166,7 +172,7 @@ Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Optio
   row.particles = bed.world.particles.size();
   row.dt = bed.settings.dt;
   const int batch = std::clamp(static_cast<int>(200000 / row.grains), 1, 100);
-  {
+  if (!options.skip_cpu) {
     // CPU first, so the resident-memory growth it causes is not memory the GPU stepper freed.
     const double before = resident_bytes();
     ts::sim::World world = bed.world;
@@ -253,14 +259,15 @@ std::string report_row(const Row& r, std::size_t k, ts::sim::Precision precision
                        const std::string& scene) {
   const double g = r.gpu[k].steps_per_second * static_cast<double>(r.grains);
   const double c = r.cpu.steps_per_second * static_cast<double>(r.grains);
+  const double ratio = c > 0 ? g / c : std::nan("");  // --skip-cpu: no CPU rate
   fmt::print(
       "{} grains {:>8}: {:.1f} contacts/grain; GPU {} {:.3g} grain-steps/s ({} steps), CPU reference {:.3g} "
       "grain-steps/s ({} steps), ratio {:.2f}; memory per grain GPU {:.0f} B, CPU {:.0f} B\n",
-      scene, r.grains, r.contacts_per_grain, precision_name(precision), g, r.gpu[k].steps, c, r.cpu.steps, g / c,
+      scene, r.grains, r.contacts_per_grain, precision_name(precision), g, r.gpu[k].steps, c, r.cpu.steps, ratio,
       r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain);
   std::fflush(stdout);
   return fmt::format("{},{},{:.3f},{:.4g},{},{:.5g},{},{:.5g},{:.4f},{:.1f},{:.1f},{},\"{}\",{}\n", r.grains,
-                     r.particles, r.contacts_per_grain, r.dt, r.gpu[k].steps, g, r.cpu.steps, c, g / c,
+                     r.particles, r.contacts_per_grain, r.dt, r.gpu[k].steps, g, r.cpu.steps, c, ratio,
                      r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain, precision_name(precision), renderer, scene);
 }
 

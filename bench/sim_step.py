@@ -126,7 +126,7 @@ def kernel_rows(label, tables):
 def section(results, args, renderer):
     title = "The simulation step before and after the contact lists"
     if any(r["scene"] != "bed" for r in results):
-        title += f": a scene that moves ({args.section})"
+        title += ": a scene that moves"
     lines = [f"## {title}", "",
              f"Measured by `bench/sim_step.py` on {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}; GL renderer: "
              f"{renderer}. No NVIDIA GPU was used: every GPU figure here is llvmpipe (software). Before: "
