@@ -4,11 +4,11 @@ bench/sim_step_criteria.md, written before the first run):
 
   bench/sim_step.py --before DIR --after DIR [--grains 64000,1000000] [--precision float] [--min-steps 3]
                     [--before-min-steps N] [--seconds 0] [--scenes bed,plough] [--plough-speed 0.5]
-                    [--out DIR] [--markdown docs/benchmarks/sim.md] [--section sim-step]
+                    [--after-first] [--out DIR] [--markdown docs/benchmarks/sim.md] [--section sim-step]
 
 DIR holds a build's tetrasand_bench_sim (the after one is BUILD/bin); a DIR with a shaders/ folder runs with
 TETRASAND_SHADER_DIR set to it, so a kept copy of an older build reads its own shaders. Each size runs before,
-then after, so load from other jobs falls on both. Writes OUT/sim-step.json, the raw CSVs and --timings
+then after (--after-first: after, then before, for a second round), so load from other jobs falls on both. Writes OUT/sim-step.json, the raw CSVs and --timings
 reports, and with --markdown the section --section of that file: grain-steps/s of both builds and their
 ratio for the GPU pipeline and the CPU reference, and the after build's per-kernel tables.
 
@@ -133,7 +133,7 @@ def section(results, args, renderer):
              f"`{args.before}`; after: `{args.after}`. Reading rules written before the run: "
              "[bench/sim_step_criteria.md](../../bench/sim_step_criteria.md). Grain-steps/s on the settled bed "
              f"(bed) and the bed with a blade driven through it at {args.plough_speed} m/s (plough); each size and "
-             "scene ran before, then after.", ""]
+             f"scene ran {'after, then before' if args.after_first else 'before, then after'}.", ""]
     lines += ratio_rows(results)
     if any(r["scene"] != "bed" for r in results):
         lines += ["", "The list builds' share of the after build's step (`--timings`; GPU: kernel time, the passes "
@@ -159,6 +159,7 @@ def main():
     ap.add_argument("--scenes", default="bed")
     ap.add_argument("--plough-speed", type=float, default=0.5)
     ap.add_argument("--section", default="sim-step")
+    ap.add_argument("--after-first", action="store_true")
     ap.add_argument("--seconds", type=float, default=0)
     ap.add_argument("--out", default="sim-step-out")
     ap.add_argument("--markdown")
@@ -171,8 +172,12 @@ def main():
             raise SystemExit(f"sim_step: --scenes: '{scene}' is neither bed nor plough")
     for grains in map(int, args.grains.split(",")):
         for scene in scenes:
-            before = run_bench(args.before, grains, args, args.out, "before", scene)
-            after = run_bench(args.after, grains, args, args.out, "after", scene)
+            if args.after_first:  # a second round in the other order puts a load trend on the other side
+                after = run_bench(args.after, grains, args, args.out, "after", scene)
+                before = run_bench(args.before, grains, args, args.out, "before", scene)
+            else:
+                before = run_bench(args.before, grains, args, args.out, "before", scene)
+                after = run_bench(args.after, grains, args, args.out, "after", scene)
             results.append({"grains": grains, "scene": scene, "before": before, "after": after})
             print(f"{grains} grains, {scene}: before {before['wall_s']:.0f} s, after {after['wall_s']:.0f} s "
                   f"(load {before['load'][0]:.1f} / {after['load'][0]:.1f})", flush=True)
