@@ -172,8 +172,9 @@ BenchWorld ploughed_bed(std::uint32_t grains, double speed) {
   const sim::Bodies& b = source.bodies;
   const Eigen::Vector3d lo = source.walls.planes.at(0).point;  // the box's low corner (settled_bed's walls)
   const Eigen::Vector3d hi = source.walls.planes.at(3).point;  // its high corner in x and y
-  double radius = 0, top = lo.z();                              // m: largest particle radius, the bed's top
-  for (std::size_t p = 0; p < source.particles.size(); ++p) radius = std::max(radius, source.particles.radius[p]);
+  double radius = 0, top = lo.z();                             // m: largest particle radius, the bed's top
+  for (std::size_t p = 0; p < source.particles.size(); ++p)
+    radius = std::max(radius, source.particles.radius[p]);
   for (std::size_t k = 0; k < b.size(); ++k) top = std::max(top, b.position[k].z() + b.bounding_radius[k]);
   const double blade_x = lo.x() + 0.25 * (hi.x() - lo.x());
   const double spacing = 1.5 * radius;  // m: gaps of half a radius, far narrower than a grain

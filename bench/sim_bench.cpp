@@ -17,8 +17,8 @@
 // kinematic blade driven through it at --plough-speed m/s), where the contact lists are rebuilt every
 // few tens of steps, so its rate includes their builds (--timings says how many, and what they cost).
 // Its grain count is the bed's grains left after the blade's slot; the blade's spheres are not counted.
-// --skip-cpu leaves the CPU reference out (its columns and the contacts per grain 0, the ratio nan): at 4M grains its world copy and
-// stepper would double the memory the GPU measurement needs, and take its time.
+// --skip-cpu leaves the CPU reference out (its columns and the contacts per grain 0, the ratio nan): at 4M
+// grains its world copy and stepper would double the memory the GPU measurement needs, and take its time.
 // --bonded 256,2048 (sphere counts, default none) adds, after the grain rows, a row per size of
 // bonded spheres (bench_scenes.h bonded_block: breakable-prop spheres resting on a floor, the bond law
 // in both steppers, issue 48): sphere-steps per second of both, and the memory per bond of both (GPU:
@@ -107,7 +107,8 @@ Options parse(int argc, char** argv) {
     } else if (arg == "--plough-speed") {
       o.plough_speed = std::stod(next());
       if (!(o.plough_speed > 0 && o.plough_speed <= 10))
-        throw std::runtime_error("--plough-speed: expected a speed in m/s within (0, 10], got " + std::string(argv[i]));
+        throw std::runtime_error("--plough-speed: expected a speed in m/s within (0, 10], got " +
+                                 std::string(argv[i]));
     } else if (arg == "--skip-cpu") {
       o.skip_cpu = true;
     } else if (arg == "--timings") {
@@ -167,8 +168,8 @@ Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Optio
                                         ? ts::bench::ploughed_bed(requested, options.plough_speed)
                                         : ts::bench::settled_bed(requested);
   Row row;
-  row.grains = static_cast<std::size_t>(std::count(bed.world.bodies.motion.begin(), bed.world.bodies.motion.end(),
-                                                   ts::sim::MotionType::Dynamic));
+  row.grains = static_cast<std::size_t>(std::count(
+      bed.world.bodies.motion.begin(), bed.world.bodies.motion.end(), ts::sim::MotionType::Dynamic));
   row.particles = bed.world.particles.size();
   row.dt = bed.settings.dt;
   const int batch = std::clamp(static_cast<int>(200000 / row.grains), 1, 100);
@@ -263,12 +264,13 @@ std::string report_row(const Row& r, std::size_t k, ts::sim::Precision precision
   fmt::print(
       "{} grains {:>8}: {:.1f} contacts/grain; GPU {} {:.3g} grain-steps/s ({} steps), CPU reference {:.3g} "
       "grain-steps/s ({} steps), ratio {:.2f}; memory per grain GPU {:.0f} B, CPU {:.0f} B\n",
-      scene, r.grains, r.contacts_per_grain, precision_name(precision), g, r.gpu[k].steps, c, r.cpu.steps, ratio,
-      r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain);
+      scene, r.grains, r.contacts_per_grain, precision_name(precision), g, r.gpu[k].steps, c, r.cpu.steps,
+      ratio, r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain);
   std::fflush(stdout);
   return fmt::format("{},{},{:.3f},{:.4g},{},{:.5g},{},{:.5g},{:.4f},{:.1f},{:.1f},{},\"{}\",{}\n", r.grains,
                      r.particles, r.contacts_per_grain, r.dt, r.gpu[k].steps, g, r.cpu.steps, c, ratio,
-                     r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain, precision_name(precision), renderer, scene);
+                     r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain, precision_name(precision), renderer,
+                     scene);
 }
 
 }  // namespace
@@ -279,8 +281,8 @@ int main(int argc, char** argv) {
     ts::gpu::Context context;
     fmt::print(stderr, "renderer: {}\n", context.summary());
     std::string csv =
-        "grains,particles,contacts_per_grain,dt_s,gpu_steps,gpu_grain_steps_per_s,cpu_steps,cpu_grain_steps_per_s,"
-        "gpu_over_cpu,gpu_bytes_per_grain,cpu_bytes_per_grain,precision,renderer,scene\n";
+        "grains,particles,contacts_per_grain,dt_s,gpu_steps,gpu_grain_steps_per_s,cpu_steps,"
+        "cpu_grain_steps_per_s,gpu_over_cpu,gpu_bytes_per_grain,cpu_bytes_per_grain,precision,renderer,scene\n";
     for (std::uint32_t requested : options.grains) {
       const Row r = measure_size(context, requested, options);
       for (std::size_t k = 0; k < options.precisions.size(); ++k)

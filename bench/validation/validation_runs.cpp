@@ -748,7 +748,8 @@ void agreement(const fs::path& out, const std::string& part) {
 // mixed_silo_PRECISION.csv), so the two can run as separate processes; bench/validation/mixed_precision.py
 // reads them.
 void mixed_precision(const fs::path& out, const std::string& part, const std::string& precision,
-                     const std::vector<std::uint64_t>& silo_seeds, const std::vector<std::uint64_t>& heap_seeds) {
+                     const std::vector<std::uint64_t>& silo_seeds,
+                     const std::vector<std::uint64_t>& heap_seeds) {
   if (precision != "double" && precision != "full-double") {
     throw std::runtime_error("mixed: precision '" + precision + "' is neither double nor full-double");
   }
@@ -791,8 +792,8 @@ std::vector<std::uint64_t> seed_list(const std::string& text) {
     const std::size_t comma = std::min(text.find(',', at), text.size());
     const std::string item = text.substr(at, comma - at);
     if (item.empty() || item.find_first_not_of("0123456789") != std::string::npos) {
-      throw std::runtime_error(fmt::format("mixed: seed '{}' is not a non-negative integer (expected e.g. 5,6,7,8)",
-                                           item));
+      throw std::runtime_error(
+          fmt::format("mixed: seed '{}' is not a non-negative integer (expected e.g. 5,6,7,8)", item));
     }
     seeds.push_back(std::stoull(item));
     at = comma + 1;
@@ -828,11 +829,13 @@ std::vector<double> radii_list(const std::string& text) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr,
-                 "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|forces-gentle [BATCHES]|forces "
-                 "[GRAINS]|column [R0,R0,...]|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres] [SCENE]|"
-                 "mixed[-heap|-silo] [double|full-double] [SILO_SEEDS] [HEAP_SEEDS]]\n",
-                 argv[0]);
+    std::fprintf(
+        stderr,
+        "usage: %s OUT_DIR [restitution|repose|silo "
+        "[SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|forces-gentle [BATCHES]|forces "
+        "[GRAINS]|column [R0,R0,...]|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres] [SCENE]|"
+        "mixed[-heap|-silo] [double|full-double] [SILO_SEEDS] [HEAP_SEEDS]]\n",
+        argv[0]);
     return 2;
   }
   try {
@@ -856,7 +859,8 @@ int main(int argc, char** argv) {
     if (what.rfind("agreement-", 0) == 0) agreement(out, what.substr(10));
     if (what == "mixed" || what.rfind("mixed-", 0) == 0) {
       mixed_precision(out, what == "mixed" ? "all" : what.substr(6), argc > 3 ? argv[3] : "double",
-                      seed_list(argc > 4 ? argv[4] : "5,6,7,8"), seed_list(argc > 5 ? argv[5] : "11,12,13,14"));
+                      seed_list(argc > 4 ? argv[4] : "5,6,7,8"),
+                      seed_list(argc > 5 ? argv[5] : "11,12,13,14"));
     }
     return 0;
   } catch (const std::exception& e) {
