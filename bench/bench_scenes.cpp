@@ -166,4 +166,40 @@ BenchWorld settled_bed(std::uint32_t grains) {
   return out;
 }
 
+BenchWorld ploughed_bed(std::uint32_t grains, double speed) {
+  const BenchWorld bed = settled_bed(grains);
+  const sim::World& source = bed.world;
+  const sim::Bodies& b = source.bodies;
+  const Eigen::Vector3d lo = source.walls.planes.at(0).point;  // the box's low corner (settled_bed's walls)
+  const Eigen::Vector3d hi = source.walls.planes.at(3).point;  // its high corner in x and y
+  double radius = 0, top = lo.z();                             // m: largest particle radius, the bed's top
+  for (std::size_t p = 0; p < source.particles.size(); ++p)
+    radius = std::max(radius, source.particles.radius[p]);
+  for (std::size_t k = 0; k < b.size(); ++k) top = std::max(top, b.position[k].z() + b.bounding_radius[k]);
+  const double blade_x = lo.x() + 0.25 * (hi.x() - lo.x());
+  const double spacing = 1.5 * radius;  // m: gaps of half a radius, far narrower than a grain
+  BenchWorld out;
+  out.settings = bed.settings;
+  out.settings.design_speed = std::max(out.settings.design_speed, speed);
+  out.world.materials = source.materials;
+  out.world.gravity = source.gravity;
+  out.world.walls = source.walls;
+  const Eigen::Vector3d none = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    // The slot: grains within reach of the blade's spheres, with a tenth of a radius to spare.
+    if (std::abs(b.position[k].x() - blade_x) < b.bounding_radius[k] + 1.1 * radius) continue;
+    copy_body(source, k, none, out.world);
+  }
+  sim::BodyDesc sphere;
+  sphere.motion = sim::MotionType::Kinematic;
+  sphere.linear_velocity = Eigen::Vector3d(speed, 0, 0);
+  for (double y = lo.y() + radius; y <= hi.y() - radius; y += spacing) {
+    for (double z = lo.z() + 1.1 * radius; z <= top + 2e-3; z += spacing) {
+      sphere.position = Eigen::Vector3d(blade_x, y, z);
+      sim::add_body(out.world, sphere, {none}, {radius}, 0);
+    }
+  }
+  return out;
+}
+
 }  // namespace ts::bench

@@ -49,4 +49,13 @@ BenchWorld settle(const scene::Scene& scene);
 // per-grain contact load.
 BenchWorld settled_bed(std::uint32_t grains);
 
+// A scene that moves, for the cost of the contact lists' builds (issue 44, item 6): the settled bed of
+// `grains` grains with a plough blade driven through it. The blade is a wall of kinematic spheres (each
+// its own body, of the grains' particle radius so the grid's cell stays the bed's) spanning the bed's
+// width, from just above the floor to 2 mm above the bed's top, moving along +x at `speed` (m/s); it
+// stands in a slot cut across the bed a quarter of its length in (the grains it would overlap are left
+// out), so it pushes grains from its first step. The step settings are the bed's, with the design
+// speed (which picks the lists' skin) at least `speed`. `grains` counts the bed before the cut.
+BenchWorld ploughed_bed(std::uint32_t grains, double speed);
+
 }  // namespace ts::bench

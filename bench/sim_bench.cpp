@@ -2,7 +2,8 @@
 // same scenes, in one run, as ratios, from 1k to 1M grains; memory per grain of both. Usage:
 //   tetrasand_bench_sim [--grains 1000,8000,64000,512000,1000000] [--seconds 2] [--min-steps 2]
 //                       [--cpu-min-steps N] [--precision float|double|full-double (a list)] [--csv FILE]
-//                       [--timings] [--bonded 256,2048] [--bonded-csv FILE]
+//                       [--timings] [--bonded 256,2048] [--bonded-csv FILE] [--scene bed|plough]
+//                       [--plough-speed 0.5] [--skip-cpu]
 // --cpu-min-steps: the CPU reference's own minimum (default --min-steps), so a device run can time 10 GPU
 // steps a size without spending its time cap on 10 CPU steps of 4M grains. --timings prints each engine's
 // timing_report() (per-kernel GPU times, the contact lists' skin, builds and candidates) on stderr.
@@ -12,6 +13,12 @@
 // double is the mixed-precision pipeline of `--precision double`; full-double keeps the contact kernel
 // in double too (sim::Precision::FullDouble), to time what the mixed pipeline saves.
 // The CSV is rewritten (atomically) after every size, so a run stopped at its time cap keeps its rows.
+// --scene plough measures a scene that moves instead (bench_scenes.h ploughed_bed: the same bed with a
+// kinematic blade driven through it at --plough-speed m/s), where the contact lists are rebuilt every
+// few tens of steps, so its rate includes their builds (--timings says how many, and what they cost).
+// Its grain count is the bed's grains left after the blade's slot; the blade's spheres are not counted.
+// --skip-cpu leaves the CPU reference out (its columns and the contacts per grain 0, the ratio nan): at 4M
+// grains its world copy and stepper would double the memory the GPU measurement needs, and take its time.
 // --bonded 256,2048 (sphere counts, default none) adds, after the grain rows, a row per size of
 // bonded spheres (bench_scenes.h bonded_block: breakable-prop spheres resting on a floor, the bond law
 // in both steppers, issue 48): sphere-steps per second of both, and the memory per bond of both (GPU:
@@ -22,6 +29,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -48,6 +56,9 @@ struct Options {
   bool timings = false;  // per-kernel GPU times and host round trips of each size, on stderr
   std::vector<std::uint32_t> bonded;  // sphere counts of the bonded rows
   std::string bonded_csv;
+  std::string scene = "bed";  // bed (settled) or plough (moving)
+  double plough_speed = 0.5;  // m/s
+  bool skip_cpu = false;      // GPU rows only
 };
 
 std::vector<std::uint32_t> parse_counts(const std::string& text) {
@@ -89,6 +100,17 @@ Options parse(int argc, char** argv) {
       o.bonded = parse_counts(next());
     } else if (arg == "--bonded-csv") {
       o.bonded_csv = next();
+    } else if (arg == "--scene") {
+      o.scene = next();
+      if (o.scene != "bed" && o.scene != "plough")
+        throw std::runtime_error("--scene: expected bed or plough, got " + o.scene);
+    } else if (arg == "--plough-speed") {
+      o.plough_speed = std::stod(next());
+      if (!(o.plough_speed > 0 && o.plough_speed <= 10))
+        throw std::runtime_error("--plough-speed: expected a speed in m/s within (0, 10], got " +
+                                 std::string(argv[i]));
+    } else if (arg == "--skip-cpu") {
+      o.skip_cpu = true;
     } else if (arg == "--timings") {
       o.timings = true;
     } else {
@@ -142,13 +164,16 @@ struct Row {
 };
 
 Row measure_size(ts::gpu::Context& context, std::uint32_t requested, const Options& options) {
-  const ts::bench::BenchWorld bed = ts::bench::settled_bed(requested);
+  const ts::bench::BenchWorld bed = options.scene == "plough"
+                                        ? ts::bench::ploughed_bed(requested, options.plough_speed)
+                                        : ts::bench::settled_bed(requested);
   Row row;
-  row.grains = bed.world.bodies.size();
+  row.grains = static_cast<std::size_t>(std::count(
+      bed.world.bodies.motion.begin(), bed.world.bodies.motion.end(), ts::sim::MotionType::Dynamic));
   row.particles = bed.world.particles.size();
   row.dt = bed.settings.dt;
   const int batch = std::clamp(static_cast<int>(200000 / row.grains), 1, 100);
-  {
+  if (!options.skip_cpu) {
     // CPU first, so the resident-memory growth it causes is not memory the GPU stepper freed.
     const double before = resident_bytes();
     ts::sim::World world = bed.world;
@@ -231,19 +256,21 @@ const char* precision_name(ts::sim::Precision p) {
 }
 
 // The printed line and the CSV row of one size and precision k.
-std::string report_row(const Row& r, std::size_t k, ts::sim::Precision precision,
-                       const std::string& renderer) {
+std::string report_row(const Row& r, std::size_t k, ts::sim::Precision precision, const std::string& renderer,
+                       const std::string& scene) {
   const double g = r.gpu[k].steps_per_second * static_cast<double>(r.grains);
   const double c = r.cpu.steps_per_second * static_cast<double>(r.grains);
+  const double ratio = c > 0 ? g / c : std::nan("");  // --skip-cpu: no CPU rate
   fmt::print(
-      "grains {:>8}: {:.1f} contacts/grain; GPU {} {:.3g} grain-steps/s ({} steps), CPU reference {:.3g} "
+      "{} grains {:>8}: {:.1f} contacts/grain; GPU {} {:.3g} grain-steps/s ({} steps), CPU reference {:.3g} "
       "grain-steps/s ({} steps), ratio {:.2f}; memory per grain GPU {:.0f} B, CPU {:.0f} B\n",
-      r.grains, r.contacts_per_grain, precision_name(precision), g, r.gpu[k].steps, c, r.cpu.steps, g / c,
-      r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain);
+      scene, r.grains, r.contacts_per_grain, precision_name(precision), g, r.gpu[k].steps, c, r.cpu.steps,
+      ratio, r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain);
   std::fflush(stdout);
-  return fmt::format("{},{},{:.3f},{:.4g},{},{:.5g},{},{:.5g},{:.4f},{:.1f},{:.1f},{},\"{}\"\n", r.grains,
-                     r.particles, r.contacts_per_grain, r.dt, r.gpu[k].steps, g, r.cpu.steps, c, g / c,
-                     r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain, precision_name(precision), renderer);
+  return fmt::format("{},{},{:.3f},{:.4g},{},{:.5g},{},{:.5g},{:.4f},{:.1f},{:.1f},{},\"{}\",{}\n", r.grains,
+                     r.particles, r.contacts_per_grain, r.dt, r.gpu[k].steps, g, r.cpu.steps, c, ratio,
+                     r.gpu_bytes_per_grain[k], r.cpu_bytes_per_grain, precision_name(precision), renderer,
+                     scene);
 }
 
 }  // namespace
@@ -254,12 +281,12 @@ int main(int argc, char** argv) {
     ts::gpu::Context context;
     fmt::print(stderr, "renderer: {}\n", context.summary());
     std::string csv =
-        "grains,particles,contacts_per_grain,dt_s,gpu_steps,gpu_grain_steps_per_s,cpu_steps,cpu_grain_steps_per_s,"
-        "gpu_over_cpu,gpu_bytes_per_grain,cpu_bytes_per_grain,precision,renderer\n";
+        "grains,particles,contacts_per_grain,dt_s,gpu_steps,gpu_grain_steps_per_s,cpu_steps,"
+        "cpu_grain_steps_per_s,gpu_over_cpu,gpu_bytes_per_grain,cpu_bytes_per_grain,precision,renderer,scene\n";
     for (std::uint32_t requested : options.grains) {
       const Row r = measure_size(context, requested, options);
       for (std::size_t k = 0; k < options.precisions.size(); ++k)
-        csv += report_row(r, k, options.precisions[k], context.summary());
+        csv += report_row(r, k, options.precisions[k], context.summary(), options.scene);
       if (!options.csv.empty()) ts::write_file_atomically(options.csv, csv);
     }
     std::string bonded_csv =

@@ -4,10 +4,12 @@
 //   tetrasand_validation_runs OUT_DIR [restitution|repose|silo
 //   [SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|forces-gentle [BATCHES]|column [R0_M,R0_M,...]|all|
 //   agreement[-heap|-silo|-bed]|
-//                                      oedometer[-tetrahedra|-spheres] [SCENE]]
+//                                      oedometer[-tetrahedra|-spheres] [SCENE]|
+//   mixed[-heap|-silo] [double|full-double] [SILO_SEEDS] [HEAP_SEEDS]]
 // `all` is the physical report: restitution and repose take minutes, the column collapse (8 x 20,000
 // grains) and the Mankoc-sized silo (80,000 grains) tens of minutes each on two cores. `agreement`
-// (GPU pipeline against the CPU reference) is separate: on llvmpipe it is the slow part.
+// (GPU pipeline against the CPU reference) is separate: on llvmpipe it is the slow part. `mixed` runs
+// the agreement's heap and silo on the GPU pipeline in one fp64 precision (mixed or full double).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -736,6 +738,69 @@ void agreement(const fs::path& out, const std::string& part) {
   if (part == "bed" || part == "all") ts::write_file_atomically(out / "agreement_bed.csv", bed_csv);
 }
 
+// The agreement's heap and silo on the GPU pipeline in fp64 (issue 44, item 4): `precision` "double"
+// (Precision::Double, the mixed kernel: float contact arithmetic on double-differenced positions, double
+// state and sums) or "full-double" (Precision::FullDouble, the all-double kernel it replaced), so the
+// two can be compared on the decks' statistics (docs/benchmarks/sim.md "Mixed precision"). `part` is
+// heap, silo or all; `silo_seeds` the silo's fill seeds (the agreement's are 5-8), `heap_seeds` the
+// heap's pour seeds (the scene's own is 11; one pour's angle scatters by degrees, so several are
+// averaged). Each precision writes its own files (mixed_heap_PRECISION_seedN.csv,
+// mixed_silo_PRECISION.csv), so the two can run as separate processes; bench/validation/mixed_precision.py
+// reads them.
+void mixed_precision(const fs::path& out, const std::string& part, const std::string& precision,
+                     const std::vector<std::uint64_t>& silo_seeds,
+                     const std::vector<std::uint64_t>& heap_seeds) {
+  if (precision != "double" && precision != "full-double") {
+    throw std::runtime_error("mixed: precision '" + precision + "' is neither double nor full-double");
+  }
+  if (part != "heap" && part != "silo" && part != "all") {
+    throw std::runtime_error("mixed: part '" + part + "' is none of heap, silo, all");
+  }
+  const Precision p = precision == "double" ? Precision::Double : Precision::FullDouble;
+  ts::gpu::Context context;
+  const MakeStepper make = [&](const StepSettings& s) -> std::unique_ptr<Stepper> {
+    return std::make_unique<GpuStepper>(context, s, p, false);
+  };
+  ts::write_file_atomically(out / "mixed_renderer.txt", context.summary() + "\n");
+  if (part == "heap" || part == "all") {
+    for (const std::uint64_t seed : heap_seeds) {
+      Scene scene = reference("heap.toml");
+      scene.emitters.at(0).seed = seed;
+      const std::string name = fmt::format("mixed_heap_{}_seed{}", precision, seed);
+      const Run heap = run(scene, out / "runs", name, false, make);
+      ts::write_file_atomically(out / (name + ".csv"), ts::bench::grain_centres_csv(heap.last));
+    }
+  }
+  if (part == "silo" || part == "all") {
+    std::string csv = "backend,seed,time_s,discharged\n";
+    for (const std::uint64_t seed : silo_seeds) {
+      Scene scene = silo_scene(0.016);
+      scene.emitters.at(0).seed = seed;
+      const Run r = run(scene, out / "runs", fmt::format("mixed_silo{}_{}", seed, precision), true, make);
+      csv += discharge_rows(fmt::format("gpu-{},{}", precision, seed), r);
+      // After each fill: a run stopped at its time cap keeps the fills it finished.
+      ts::write_file_atomically(out / ("mixed_silo_" + precision + ".csv"), csv);
+    }
+  }
+}
+
+// "5,6" -> {5, 6}: fill seeds.
+std::vector<std::uint64_t> seed_list(const std::string& text) {
+  std::vector<std::uint64_t> seeds;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, comma - at);
+    if (item.empty() || item.find_first_not_of("0123456789") != std::string::npos) {
+      throw std::runtime_error(
+          fmt::format("mixed: seed '{}' is not a non-negative integer (expected e.g. 5,6,7,8)", item));
+    }
+    seeds.push_back(std::stoull(item));
+    at = comma + 1;
+  }
+  return seeds;
+}
+
 // "0.32,0.25" -> {0.32, 0.25}: cylinder radii in metres, each within the floor the column lays out.
 std::vector<double> radii_list(const std::string& text) {
   std::vector<double> radii;
@@ -764,10 +829,13 @@ std::vector<double> radii_list(const std::string& text) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr,
-                 "usage: %s OUT_DIR [restitution|repose|silo [SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|forces-gentle [BATCHES]|forces "
-                 "[GRAINS]|column [R0,R0,...]|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres] [SCENE]]\n",
-                 argv[0]);
+    std::fprintf(
+        stderr,
+        "usage: %s OUT_DIR [restitution|repose|silo "
+        "[SCENE]|silo-spheres|silo[-spheres]-lammps|forces-backed|forces-gentle [BATCHES]|forces "
+        "[GRAINS]|column [R0,R0,...]|all|agreement[-heap|-silo|-bed]|oedometer[-tetrahedra|-spheres] [SCENE]|"
+        "mixed[-heap|-silo] [double|full-double] [SILO_SEEDS] [HEAP_SEEDS]]\n",
+        argv[0]);
     return 2;
   }
   try {
@@ -789,6 +857,11 @@ int main(int argc, char** argv) {
     if (what == "oedometer" || what == "oedometer-tetrahedra") oedometer(out, "tetrahedra", oedometer_scene);
     if (what == "oedometer" || what == "oedometer-spheres") oedometer(out, "spheres", oedometer_scene);
     if (what.rfind("agreement-", 0) == 0) agreement(out, what.substr(10));
+    if (what == "mixed" || what.rfind("mixed-", 0) == 0) {
+      mixed_precision(out, what == "mixed" ? "all" : what.substr(6), argc > 3 ? argv[3] : "double",
+                      seed_list(argc > 4 ? argv[4] : "5,6,7,8"),
+                      seed_list(argc > 5 ? argv[5] : "11,12,13,14"));
+    }
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
