@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One entry point for the comparisons and reports (docs/benchmarks.md and its pages in docs/benchmarks/,
 # docs/validation.md).
-# Usage: scripts/bench.sh [peers|sdf|sparse|sample|sample-large|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all]
+# Usage: scripts/bench.sh [peers|sdf|sparse|sample|sample-large|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|mixed|all]
 #                        [--build-dir DIR] [--no-build] [--quick] [--grains LIST] [--cases 'MESH@R1,R2 ...']
 #                        [--only TRADES]
 #   peers       the three comparisons with peers in one run: sdf, sample and peers-sim below, each writing
@@ -53,6 +53,10 @@
 #               (~2 h on 2 shared cores: 12 pours, CPU reference and LAMMPS serial)
 #   agreement   GPU pipeline against the CPU reference on the heap, the small silo and the bed
 #               -> its section of docs/validation.md                    (~30 min on llvmpipe, 2 cores)
+#   mixed       the agreement's heap (4 pours) and silo (4 fills) on the GPU pipeline in mixed precision
+#               (--precision double) against full double, against the criterion in docs/benchmarks/sim.md
+#               "Mixed precision on the repose and silo decks" -> a table on standard output for that
+#               section                                         (~25 min on llvmpipe, 2 idle cores)
 #   sdf         SDF construction three ways per mesh and grid in one run: GPU scan conversion, CPU exact
 #               (CGAL, all cores), OpenVDB meshToLevelSet (all cores), errors against exact; default
 #               knot1, armadillo (libcgal-demo) and a 1.3M-triangle icosphere:8 at 64^3..1024^3
@@ -88,7 +92,7 @@ while [ $# -gt 0 ]; do
     *) echo "bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
-case "$what" in peers|sdf|sparse|sample|sample-large|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|all) ;;
+case "$what" in peers|sdf|sparse|sample|sample-large|certificate|certificate-cpu|defaults|peers-sim|sim|sim-accuracy|validation|oedometer|repose|agreement|mixed|all) ;;
   *) echo "bench: unknown benchmark '$what'" >&2; exit 2 ;;
 esac
 [ "$quick" -eq 1 ] && sdf_cases="knot1@64,128 armadillo@64,128"
@@ -187,6 +191,10 @@ if runs agreement; then
   "$bin/tetrasand_validation_runs" "$work/agreement" agreement
   "$py" "$root/bench/validation/report.py" "$work/agreement" "$root/docs" >/dev/null
   echo "bench: wrote the agreement section of docs/validation.md"
+fi
+if runs mixed; then
+  for precision in double full-double; do "$bin/tetrasand_validation_runs" "$work/mixed" mixed "$precision"; done
+  "$py" "$root/bench/validation/mixed_precision.py" "$work/mixed" || status=1
 fi
 # cgal_meshes: the folder of libcgal-demo's meshes, where the tests unpacked them, else unpacked here.
 cgal_meshes() {
