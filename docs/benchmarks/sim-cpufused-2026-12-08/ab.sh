@@ -2,10 +2,11 @@
 # A/B on reference/bed.toml, pinned to core 0: A = main at bcbf881 (built in a second worktree, same
 # flags), B = a copy of branch cpufused's build at the commit under test, L = LAMMPS serial (Debian's lmp)
 # on the deck of `tetrasand export lammps`. usage: ab.sh ROUNDS LABEL B_BINARY [same|agree]
-# same: every output of A and B compared with cmp; agree: metrics compared with scripts/sim_outputs_agree.py.
+# same: every output of A and B compared with cmp; agree: run scripts/sim_outputs_agree.py after.
+# A 5th argument replaces A (a copy of an earlier commit's build, to measure one change alone).
 rounds=${1:-3}; label=${2:-ab}; B=${3:-/work/wt-cpufused/build/bin/tetrasand}; check=${4:-same}
 scene=/work/wt-cpufused/assets/scenes/reference/bed.toml
-A=/work/wt-cpufused-base/build/bin/tetrasand
+A=${5:-/work/wt-cpufused-base/build/bin/tetrasand}
 out=/tmp/cf/runs/$label; mkdir -p $out
 [ -f $out/deck/in.tetrasand ] || $A export lammps $scene -o $out/deck >/dev/null
 echo "start $(date -u +%T) load $(cut -d' ' -f1-3 /proc/loadavg)"
