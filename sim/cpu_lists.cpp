@@ -170,27 +170,44 @@ void CpuContactLists::search(const GridEntry& self, Fn&& fn) const {
   }
 }
 
-// Two passes over the grid, counting then filling, so the lists are one compact array (CSR) in cell
-// order; each list sorted by world id.
+// One search per particle: each block of slots collects its particles' lists, each sorted by world
+// id, into its own buffer (kept from build to build) and their lengths into offsets_; after a scan
+// the blocks are copied into place, so the lists are one compact array (CSR) in cell order. (It
+// was a counting pass and a filling pass, each searching the grid: twice the search.)
 void CpuContactLists::fill_lists() {
   const auto n = static_cast<std::uint32_t>(order_.size());
+  constexpr std::uint32_t kBlock = kSerialBelow / 4;  // slots
+  const std::uint32_t blocks = (n + kBlock - 1) / kBlock;
   offsets_.assign(std::size_t{n} + 1, 0);
-  for_each_index(n, [&](std::uint32_t s) {
-    const GridEntry& self = grid_entries_[grid_slot_[order_[s]]];
-    if (!self.receives_force) return;
-    std::uint32_t count = 0;
-    search(self, [&](std::uint32_t) { ++count; });
-    offsets_[s + 1] = count;
-  });
+  if (block_entries_.size() < blocks) block_entries_.resize(blocks);
+  auto search_block = [&](std::uint32_t block) {
+    std::vector<ListEntry>& out = block_entries_[block];
+    out.clear();
+    for (std::uint32_t s = block * kBlock; s < std::min(n, (block + 1) * kBlock); ++s) {
+      const GridEntry& self = grid_entries_[grid_slot_[order_[s]]];
+      if (!self.receives_force) continue;
+      const std::size_t begin = out.size();
+      search(self, [&](std::uint32_t j) { out.push_back({slot_[j], j}); });
+      std::sort(out.begin() + static_cast<std::ptrdiff_t>(begin), out.end(),
+                [](const ListEntry& a, const ListEntry& b) { return a.particle < b.particle; });
+      offsets_[s + 1] = static_cast<std::uint32_t>(out.size() - begin);
+    }
+  };
+  auto for_each_block = [&](auto&& fn) {
+    if (n < kSerialBelow) {
+      for (std::uint32_t block = 0; block < blocks; ++block) fn(block);
+      return;
+    }
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, blocks, 1), [&](const tbb::blocked_range<std::uint32_t>& r) {
+      for (std::uint32_t block = r.begin(); block < r.end(); ++block) fn(block);
+    });
+  };
+  for_each_block(search_block);
   for (std::uint32_t s = 0; s < n; ++s) offsets_[s + 1] += offsets_[s];
   entries_.resize(offsets_[n]);
-  for_each_index(n, [&](std::uint32_t s) {
-    const GridEntry& self = grid_entries_[grid_slot_[order_[s]]];
-    if (!self.receives_force) return;
-    ListEntry* out = entries_.data() + offsets_[s];
-    search(self, [&](std::uint32_t j) { *out++ = {slot_[j], j}; });
-    std::sort(entries_.data() + offsets_[s], out,
-              [](const ListEntry& a, const ListEntry& b) { return a.particle < b.particle; });
+  for_each_block([&](std::uint32_t block) {
+    const std::vector<ListEntry>& from = block_entries_[block];
+    std::copy(from.begin(), from.end(), entries_.begin() + offsets_[block * kBlock]);
   });
 }
 
