@@ -69,7 +69,7 @@ bool CpuContactLists::stale(const std::vector<Eigen::Vector3d>& positions) const
     return m;
   };
   const double largest =
-      positions.size() < kSerialBelow
+      positions.size() < kSerialBelow || one_thread()
           ? largest_in(0, positions.size(), 0.0)
           : tbb::parallel_reduce(
                 tbb::blocked_range<std::size_t>(0, positions.size(), kSerialBelow / 4), 0.0,
@@ -194,7 +194,7 @@ void CpuContactLists::fill_lists() {
     }
   };
   auto for_each_block = [&](auto&& fn) {
-    if (n < kSerialBelow) {
+    if (n < kSerialBelow || one_thread()) {
       for (std::uint32_t block = 0; block < blocks; ++block) fn(block);
       return;
     }
