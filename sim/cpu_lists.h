@@ -119,7 +119,6 @@ class CpuContactLists {
   std::vector<std::uint32_t> order_, slot_;  // cell order -> world id, world id -> cell order
   std::vector<std::uint32_t> offsets_;       // CSR by slot: size + 1 entries
   std::vector<ListEntry> entries_;
-  std::vector<std::vector<ListEntry>> block_entries_;  // fill_lists()'s per-block buffers, reused
   CandidatePairs pairs_;
   std::vector<Eigen::Vector3d> built_position_;  // m, world order, at the build
   BondedPartners bonded_;                        // of the build: pairs the contact law leaves to their bond
