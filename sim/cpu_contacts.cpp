@@ -167,25 +167,54 @@ void CpuContacts::compute_pair_contacts() {
 // as computed, the second its negation about its own arm. The contact law is antisymmetric bit for bit
 // (sim/contact_model.h: the difference vectors, the normal and the relative velocity only change sign
 // when the two particles swap), so either side sums what computing it from its own side gives.
+//
+// Written for the branch predictor and the optimiser: about one candidate in five touches, so a test
+// and jump per candidate mispredicts often; instead a chunk of the list is first compacted without
+// branches (each candidate's place written, the count advanced only by a touching one), then the
+// touching ones are summed. The sums stay in locals (the stores into `out` could alias the lists'
+// storage and made the compiler reload it each time), and the side a contact is read from picks a
+// sign and an arm instead of a branch: -1 * f is -f and adding 0 to a sum changes no bit, so the
+// results are the same bits as the plain loop's.
 void CpuContacts::add_pair_contacts(std::uint32_t slot, ParticleContacts& out) const {
-  for (const ListEntry& entry : lists_.candidates(slot)) {
-    const std::uint32_t contact = contact_of_pair_[entry.pair];
-    if (contact == kNotTouching) continue;
-    const PairContact& c = pair_contacts_[contact];
-    ++out.touching;
-    if (!entry.first) {
-      const Eigen::Vector3d force = -c.force;
-      out.force += force;
-      out.torque += c.arm_second.cross(force);
-      continue;
+  const std::span<const ListEntry> list = lists_.candidates(slot);
+  const std::uint32_t* contact_of_pair = contact_of_pair_.data();
+  const PairContact* contacts = pair_contacts_.data();
+  Eigen::Vector3d force = out.force, torque = out.torque;
+  double max_overlap_ratio = out.max_overlap_ratio, elastic_energy = out.elastic_energy;
+  std::uint32_t touching = 0, pairs = 0, overlap_clamps = 0;
+  constexpr std::size_t kChunk = 32;
+  std::uint32_t touching_contact[kChunk];
+  bool touching_first[kChunk];
+  for (std::size_t begin = 0; begin < list.size(); begin += kChunk) {
+    const std::size_t end = std::min(list.size(), begin + kChunk);
+    std::size_t found = 0;
+    for (std::size_t e = begin; e < end; ++e) {
+      const std::uint32_t contact = contact_of_pair[list[e].pair];
+      touching_contact[found] = contact;
+      touching_first[found] = list[e].first;
+      found += contact != kNotTouching ? 1 : 0;
     }
-    out.force += c.force;
-    out.torque += c.arm_first.cross(c.force);
-    out.max_overlap_ratio = std::max(out.max_overlap_ratio, c.overlap_ratio);
-    out.elastic_energy += c.elastic_energy;
-    out.overlap_clamps += c.overlap_clamped ? 1 : 0;
-    ++out.pairs;
+    for (std::size_t k = 0; k < found; ++k) {
+      const PairContact& c = contacts[touching_contact[k]];
+      const bool first = touching_first[k];
+      const Eigen::Vector3d f = (first ? 1.0 : -1.0) * c.force;
+      force += f;
+      torque += (first ? c.arm_first : c.arm_second).cross(f);
+      // The statistics are the first side's (it counts the contact).
+      max_overlap_ratio = std::max(max_overlap_ratio, first ? c.overlap_ratio : 0.0);
+      elastic_energy += first ? c.elastic_energy : 0.0;
+      overlap_clamps += first && c.overlap_clamped ? 1 : 0;
+      pairs += first ? 1 : 0;
+    }
+    touching += static_cast<std::uint32_t>(found);
   }
+  out.force = force;
+  out.torque = torque;
+  out.max_overlap_ratio = max_overlap_ratio;
+  out.elastic_energy = elastic_energy;
+  out.touching += touching;
+  out.pairs += pairs;
+  out.overlap_clamps += overlap_clamps;
 }
 
 // Smooth walls, in declaration order: planes, then cylinders (partner -1 - wall index).

@@ -69,7 +69,7 @@ bool CpuContactLists::stale(const std::vector<Eigen::Vector3d>& positions) const
     return m;
   };
   const double largest =
-      positions.size() < kSerialBelow
+      positions.size() < kSerialBelow || one_thread()
           ? largest_in(0, positions.size(), 0.0)
           : tbb::parallel_reduce(
                 tbb::blocked_range<std::size_t>(0, positions.size(), kSerialBelow / 4), 0.0,
@@ -170,11 +170,33 @@ void CpuContactLists::search(const GridEntry& self, Fn&& fn) const {
   }
 }
 
-// Two passes over the grid, counting then filling, so the lists are one compact array (CSR) in cell
-// order; each list sorted by world id.
+// The lists as one compact array (CSR) in cell order, each sorted by world id. On one thread each
+// particle's search appends its list straight to the array. Split over threads, a counting pass sizes
+// every list, then a filling pass searches again and writes each in its place: twice the search, but
+// the lists are held once in memory (collecting them per thread and copying them into place cost a
+// second copy of the lists, about 9 % more CPU memory at 64k grains).
 void CpuContactLists::fill_lists() {
   const auto n = static_cast<std::uint32_t>(order_.size());
   offsets_.assign(std::size_t{n} + 1, 0);
+  auto by_world_id = [](const ListEntry& a, const ListEntry& b) { return a.particle < b.particle; };
+  if (n < kSerialBelow || one_thread()) {
+    // Filled as a local (moved in and out, so it keeps its capacity: a build allocates only when the
+    // lists outgrow the last ones), which the compiler need not reload after every store as it does a
+    // member's: 3 % of the bed's run.
+    std::vector<ListEntry> lists = std::move(entries_);
+    lists.clear();
+    for (std::uint32_t s = 0; s < n; ++s) {
+      const GridEntry& self = grid_entries_[grid_slot_[order_[s]]];
+      if (self.receives_force) {
+        const std::size_t begin = lists.size();
+        search(self, [&](std::uint32_t j) { lists.push_back({slot_[j], j}); });
+        std::sort(lists.begin() + static_cast<std::ptrdiff_t>(begin), lists.end(), by_world_id);
+      }
+      offsets_[s + 1] = static_cast<std::uint32_t>(lists.size());
+    }
+    entries_ = std::move(lists);
+    return;
+  }
   for_each_index(n, [&](std::uint32_t s) {
     const GridEntry& self = grid_entries_[grid_slot_[order_[s]]];
     if (!self.receives_force) return;
@@ -189,8 +211,7 @@ void CpuContactLists::fill_lists() {
     if (!self.receives_force) return;
     ListEntry* out = entries_.data() + offsets_[s];
     search(self, [&](std::uint32_t j) { *out++ = {slot_[j], j}; });
-    std::sort(entries_.data() + offsets_[s], out,
-              [](const ListEntry& a, const ListEntry& b) { return a.particle < b.particle; });
+    std::sort(entries_.data() + offsets_[s], out, by_world_id);
   });
 }
 

@@ -5,6 +5,7 @@
 // body writes only its own index's results, so where it runs changes no bit of them.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <cstdint>
 
@@ -15,10 +16,15 @@ namespace ts::sim {
 // contact lists"). Also the grain TBB splits larger ranges into.
 inline constexpr std::uint32_t kSerialBelow = 1024;
 
+// Whether loops run on the calling thread whatever their length: when the arena has one thread (a
+// process pinned to one core, or limited by a task_arena), TBB would run every chunk on it anyway,
+// after splitting the range and making a task per chunk.
+inline bool one_thread() { return tbb::this_task_arena::max_concurrency() == 1; }
+
 // Calls fn(i) for every i in [0, n), in any order and on any thread.
 template <typename Fn>
 void for_each_index(std::uint32_t n, Fn&& fn) {
-  if (n < kSerialBelow) {
+  if (n < kSerialBelow || one_thread()) {
     for (std::uint32_t i = 0; i < n; ++i) fn(i);
     return;
   }

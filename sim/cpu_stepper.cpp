@@ -40,7 +40,8 @@ void CpuStepper::reset_energy_reference(const World& world) {
 StepStats CpuStepper::advance(World& world, std::int64_t steps) {
   StepStats last, sums;
   for (std::int64_t i = 0; i < steps; ++i) {
-    last = step(world);
+    // Only the last step's energy is returned; the others' would be computed for nothing.
+    last = step_once(world, i + 1 == steps);
     sums.velocity_clamps += last.velocity_clamps;
     sums.angular_velocity_clamps += last.angular_velocity_clamps;
     sums.overlap_clamps += last.overlap_clamps;
@@ -196,7 +197,9 @@ void CpuStepper::add_bonds(World& world, StepStats& stats) {
   if (bonds.broke > 0) contacts_.invalidate_lists();
 }
 
-StepStats CpuStepper::step(World& world) {
+StepStats CpuStepper::step(World& world) { return step_once(world, true); }
+
+StepStats CpuStepper::step_once(World& world, bool energy_after) {
   if (world.materials.size() != material_count_) reset_energy_reference(world);
   StepStats stats;
   apply_tracks(world, world.time);  // keyframed bodies start the step on their track
@@ -217,7 +220,8 @@ StepStats CpuStepper::step(World& world) {
   integrate(world, stats);
   apply_tracks(world, world.time + settings_.dt);  // and end it there, with the velocities of that time
   world.time += settings_.dt;
-  stats.energy = energy(world);
+  // The energy after the step is the next step's start energy, which that step takes (and checks) itself.
+  if (energy_after) stats.energy = energy(world);
   check_stability(world, mechanical, stats);
   return stats;
 }

@@ -48,6 +48,8 @@ class CpuStepper : public Stepper {
   const CpuContactLists& lists() const { return contacts_.lists(); }
 
  private:
+  // As step(world); the energy after the step (stats.energy) only if `energy_after`, else zero.
+  StepStats step_once(World& world, bool energy_after);
   void add_bonds(World& world, StepStats& stats);
   void integrate(World& world, StepStats& stats);
   void check_stability(const World& world, double mechanical_energy, const StepStats& stats) const;
