@@ -97,6 +97,15 @@ Eigen::Matrix3d world_inverse_inertia(const Eigen::Quaterniond& q, const Eigen::
   return r * body_inverse_inertia * r.transpose();
 }
 
+// c when the body-frame inverse inertia is c times the identity (the grains: make_tetrahedral_grain's
+// inertia is isotropic), else 0.
+double isotropic_inverse_inertia(const Eigen::Matrix3d& m) {
+  const double c = m(0, 0);
+  const bool isotropic = m(1, 1) == c && m(2, 2) == c && m(0, 1) == 0 && m(0, 2) == 0 && m(1, 0) == 0 &&
+                         m(1, 2) == 0 && m(2, 0) == 0 && m(2, 1) == 0;
+  return isotropic && c > 0 ? c : 0.0;
+}
+
 }  // namespace
 
 void CpuStepper::integrate(World& world, StepStats& stats) {
@@ -125,12 +134,20 @@ void CpuStepper::integrate(World& world, StepStats& stats) {
     const Eigen::Vector3d acceleration = world.gravity + b.inverse_mass[k] * force;
     // Rotation first (eqs. 3.47-3.50) through the angular momentum, which is what the torque
     // changes; for the isotropic grains this is plain w += I^-1 tau dt.
-    const Eigen::Matrix3d inverse_inertia_now = world_inverse_inertia(b.orientation[k], b.inverse_inertia[k]);
-    const Eigen::Vector3d momentum = inverse_inertia_now.inverse() * b.angular_velocity[k] + torque * dt;
-    Eigen::Vector3d w_move = b.angular_velocity[k];
-    if (settings_.integrator == Integrator::SemiImplicitEuler) w_move = inverse_inertia_now * momentum;
-    b.orientation[k] = advance_orientation(b.orientation[k], w_move, dt);
-    Eigen::Vector3d w = world_inverse_inertia(b.orientation[k], b.inverse_inertia[k]) * momentum;
+    Eigen::Vector3d w_move = b.angular_velocity[k], w;
+    if (const double c = isotropic_inverse_inertia(b.inverse_inertia[k]); c > 0) {
+      // I^-1 = c Id in every frame (R c Id R^T = c Id): the angular momentum's update w / c + tau dt
+      // is w + c tau dt, with no rotation of the tensor and no inverse.
+      w = b.angular_velocity[k] + (c * dt) * torque;
+      if (settings_.integrator == Integrator::SemiImplicitEuler) w_move = w;
+      b.orientation[k] = advance_orientation(b.orientation[k], w_move, dt);
+    } else {
+      const Eigen::Matrix3d inverse_inertia_now = world_inverse_inertia(b.orientation[k], b.inverse_inertia[k]);
+      const Eigen::Vector3d momentum = inverse_inertia_now.inverse() * b.angular_velocity[k] + torque * dt;
+      if (settings_.integrator == Integrator::SemiImplicitEuler) w_move = inverse_inertia_now * momentum;
+      b.orientation[k] = advance_orientation(b.orientation[k], w_move, dt);
+      w = world_inverse_inertia(b.orientation[k], b.inverse_inertia[k]) * momentum;
+    }
 
     Eigen::Vector3d v = b.linear_velocity[k] + acceleration * dt;
     const Eigen::Vector3d v_move = settings_.integrator == Integrator::SemiImplicitEuler ? v : b.linear_velocity[k];
