@@ -255,12 +255,15 @@ void CpuContacts::prepare_particles(const World& world) {
   const auto n = static_cast<std::uint32_t>(p.size());
   position_.resize(n);
   velocity_.resize(n);
-  // Particle world positions and velocities from the body poses (eqs. 3.42, 3.43).
-  for_each_index(n, [&](std::uint32_t i) {
-    const std::uint32_t k = p.body[i];
-    const Eigen::Vector3d arm = b.orientation[k] * p.offset[i];
-    position_[i] = b.position[k] + arm;
-    velocity_[i] = b.linear_velocity[k] + b.angular_velocity[k].cross(arm);
+  // Particle world positions and velocities from the body poses (eqs. 3.42, 3.43), body by body: one
+  // rotation matrix a body (a grain has 4 particles) costs less than a quaternion rotation a particle.
+  for_each_index(static_cast<std::uint32_t>(b.size()), [&](std::uint32_t k) {
+    const Eigen::Matrix3d rotation = b.orientation[k].toRotationMatrix();
+    for (std::uint32_t i = b.first_particle[k]; i < b.first_particle[k] + b.particle_count[k]; ++i) {
+      const Eigen::Vector3d arm = rotation * p.offset[i];
+      position_[i] = b.position[k] + arm;
+      velocity_[i] = b.linear_velocity[k] + b.angular_velocity[k].cross(arm);
+    }
   });
   if (lists_.stale(position_)) {
     const auto start = std::chrono::steady_clock::now();
