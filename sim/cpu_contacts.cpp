@@ -220,6 +220,7 @@ void CpuContacts::add_pair_contacts(std::uint32_t slot, ParticleContacts& out) c
 // Smooth walls, in declaration order: planes, then cylinders (partner -1 - wall index).
 template <typename Fn>
 void CpuContacts::visit_walls(const World& world, std::uint32_t slot, Fn& fn, SpringLookup& lookup) const {
+  if (!near_wall_[slot]) return;
   const ParticleState& me = state_[slot];
   const double ri = me.radius;
   const Eigen::Vector3d& x = me.position;
@@ -265,7 +266,8 @@ void CpuContacts::prepare_particles(const World& world) {
       velocity_[i] = b.linear_velocity[k] + b.angular_velocity[k].cross(arm);
     }
   });
-  if (lists_.stale(position_)) {
+  const bool build = lists_.stale(position_);
+  if (build) {
     const auto start = std::chrono::steady_clock::now();
     lists_.build(world, position_, settings_);
     build_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -280,6 +282,31 @@ void CpuContacts::prepare_particles(const World& world) {
     state_[s] = {position_[i], velocity_[i], b.angular_velocity[k], p.radius[i], b.inverse_mass[k], p.material[i]};
     sphere_[s] = {position_[i], p.radius[i]};
   });
+  if (build || near_wall_.size() != n || world.walls.planes != walls_marked_.planes ||
+      world.walls.cylinders != walls_marked_.cylinders) {
+    mark_near_walls(world);
+  }
+}
+
+// From the particles' positions now, which are within half the skin of the build's, so a particle
+// moves at most a skin from here before the lists go stale: a wall it could touch by then has a gap
+// under its radius + the skin. The tests are written so that a NaN marks the particle near (visited,
+// as before the marks).
+void CpuContacts::mark_near_walls(const World& world) {
+  const auto n = static_cast<std::uint32_t>(state_.size());
+  near_wall_.resize(n);
+  const double skin = lists_.skin();  // m
+  for_each_index(n, [&](std::uint32_t s) {
+    const Eigen::Vector3d& x = sphere_[s].centre;
+    const double reach = sphere_[s].radius + skin;  // m
+    bool near = false;
+    for (const PlaneWall& wall : world.walls.planes) near |= !(wall.normal.dot(x - wall.point) >= reach);
+    for (const CylinderWall& wall : world.walls.cylinders) {
+      near |= !(wall.radius - (x.head<2>() - wall.axis).norm() >= reach);
+    }
+    near_wall_[s] = near ? 1 : 0;
+  });
+  walls_marked_ = world.walls;
 }
 
 CpuContacts::SpringSlots CpuContacts::read_only_slots(const World& world, std::uint32_t i) const {

@@ -146,6 +146,12 @@ class CpuContacts {
   };
   std::vector<Sphere> sphere_;
   std::vector<std::size_t> overflows_;                // world order
+  // Cell order: 0 where the particle cannot reach any smooth wall before the lists go stale (every
+  // wall's gap at least its radius + the skin, when it has moved at most half the skin since the
+  // build), so the walls' tests are skipped. Marked at each build, and again when the walls change.
+  std::vector<std::uint8_t> near_wall_;
+  Walls walls_marked_;  // the walls near_wall_ was marked for
+  void mark_near_walls(const World& world);
   // For report(): steps gathered, touching particle partners summed over them (both sides of a
   // pair), and seconds spent building lists and gathering in all.
   std::size_t gathers_ = 0, touching_ = 0;
