@@ -266,6 +266,23 @@ TEST(CpuReference, SettlingBedNeverGainsEnergy) {
   EXPECT_LT(energy(w).total(), initial - scale);  // it fell and dissipated
 }
 
+// The walls' tests are skipped for particles marked far from every wall at a list build; a wall
+// moved between steps (no particle moves, so no build) must still be felt.
+TEST(CpuReference, WallMovedUnderAParticleIsFeltBeforeTheNextListBuild) {
+  World w = empty_world(0.5);
+  add_sphere(w, Eigen::Vector3d(0, 0, 1), Eigen::Vector3d::Zero());
+  w.walls.planes.push_back({Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0});
+  StepSettings s;
+  s.dt = 1e-6;
+  CpuStepper stepper(w, s);
+  EXPECT_EQ(stepper.step(w).wall_contacts, 0u);
+  w.walls.planes[0].point = Eigen::Vector3d(0, 0, 1 - kRadius + 1e-5);  // 10 um into the sphere
+  stepper.reset_energy_reference(w);  // moving the wall did work on the sphere
+  EXPECT_EQ(stepper.step(w).wall_contacts, 1u);
+  EXPECT_EQ(stepper.lists().builds(), 1u);
+  EXPECT_GT(w.bodies.linear_velocity[0].z(), 0.0);
+}
+
 TEST(CpuReference, QuaternionStaysNormalised) {
   World w = empty_world(0.65);
   add_grain(w, make_tetrahedral_grain(kRadius, 2 * kRadius, 2600), 0, Eigen::Vector3d::Zero(),
