@@ -89,7 +89,6 @@ template <typename Fn>
 void CpuContacts::visit_neighbours(std::uint32_t slot, Fn& fn, SpringLookup& lookup) const {
   const double cap = overlap_ratio_cap();
   const ParticleState& me = state_[slot];
-  const std::uint32_t me_id = lists_.order()[slot];
   for (const ListEntry& entry : lists_.candidates(slot)) {
     const ParticleState& other = state_[entry.slot];
     const double reach = me.radius + other.radius;  // m
@@ -100,7 +99,7 @@ void CpuContacts::visit_neighbours(std::uint32_t slot, Fn& fn, SpringLookup& loo
     const ContactForce<double> f = sphere_sphere_contact(
         me.position, me.velocity, me.angular_velocity, me.radius, me.inverse_mass, other.position, other.velocity,
         other.angular_velocity, other.radius, other.inverse_mass, cap * smaller, coefficients, settings_.dt,
-        lookup.find(partner), lists_.rest_overlap(me_id, entry.particle));
+        lookup.find(partner), lists_.pairs().rest_overlap_of(entry.pair));
     if (!f.touching) continue;
     lookup.keep(partner);
     fn(f, partner, smaller);
@@ -155,7 +154,7 @@ void CpuContacts::compute_pair_contacts() {
     const std::uint32_t p = touching_pairs_[k];
     // A pair whose bond broke touches only past its rest overlap (BondSet::rest_overlap), as on the
     // spring path; 0 for every other pair.
-    const double rest = lists_.rest_overlap(lists_.order()[pairs.first[p]], lists_.order()[pairs.second[p]]);
+    const double rest = pairs.rest_overlap_of(p);
     if (!pair_contact(state_[pairs.first[p]], state_[pairs.second[p]], cap, rest, pair_contacts_[k])) {
       contact_of_pair_[p] = kNotTouching;
     }

@@ -239,6 +239,13 @@ void CpuContactLists::fill_pairs() {
       e.pair = p++;
     }
   });
+  pairs_.rest_overlap.clear();
+  if (!rest_.empty()) {
+    pairs_.rest_overlap.resize(pairs_.size());
+    for_each_index(static_cast<std::uint32_t>(pairs_.size()), [&](std::uint32_t p) {
+      pairs_.rest_overlap[p] = rest_.of(order_[pairs_.first[p]], order_[pairs_.second[p]]);
+    });
+  }
   // The second side's entry of each pair between two particles that take a force. The search is
   // symmetric (the same reach both ways), so the entry is there; a miss would be a bug here.
   const auto pair_count = static_cast<std::uint32_t>(pairs_.size());

@@ -53,6 +53,10 @@ struct ListEntry {
 // does. Pairs are grouped by their first particle, in cell order. Slots of the cell order.
 struct CandidatePairs {
   std::vector<std::uint32_t> first, second;
+  // m, per pair: the rest overlap of a broken bond between the two (RestOverlaps), found once at the
+  // build instead of by a search a step; empty (every pair 0) when no broken bond has one.
+  std::vector<double> rest_overlap;
+  double rest_overlap_of(std::uint32_t pair) const { return rest_overlap.empty() ? 0.0 : rest_overlap[pair]; }
   std::size_t size() const { return first.size(); }
 };
 
@@ -81,8 +85,6 @@ class CpuContactLists {
   // The same candidates, each pair once; every list entry names its pair.
   const CandidatePairs& pairs() const { return pairs_; }
 
-  // m: the rest overlap of the bond that joined world particles i and j (RestOverlaps), 0 if none.
-  double rest_overlap(std::uint32_t i, std::uint32_t j) const { return rest_.of(i, j); }
   double skin() const { return skin_; }                          // m
   double largest_diameter() const { return largest_diameter_; }  // m, of the last build
   std::size_t builds() const { return builds_; }                 // since construction
