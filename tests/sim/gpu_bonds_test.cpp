@@ -107,6 +107,25 @@ TEST_F(GpuBonds, ReportedBondEnergyIsTheCpuReferencesEnergyOfTheSameState) {
   }
 }
 
+// A block of more bonds than one work group of the energy reduction sums (256), shaken from the
+// inside: the GPU's total over the groups' partials is still the CPU reference's energy of the state.
+TEST_F(GpuBonds, BondEnergyOfManyWorkGroupsIsTheCpuReferencesEnergyOfTheSameState) {
+  World w = bonded_block(4, cement());
+  ASSERT_GT(w.bonds.size(), 4u * 256u) << "the test needs several work groups of bonds";
+  for (std::size_t k = 0; k < w.bodies.size(); ++k) {
+    const double x = static_cast<double>(k);
+    w.bodies.linear_velocity[k] = 0.05 * V(std::sin(x), std::cos(1.7 * x), std::sin(0.3 * x + 1.0));
+  }
+  for (Precision precision : {Precision::FullDouble, Precision::Float}) {
+    World run = w;
+    GpuStepper gpu(context, run, symplectic(bond_step(w)), precision);
+    const double reported = gpu.advance(run, 50).elastic_energy;
+    const double reference = bond_energy(run);
+    EXPECT_GT(reference, 0.0);
+    EXPECT_LT(std::abs(reported - reference), 1e-12 * reference) << gpu.engine();
+  }
+}
+
 // Two runs of one throw in the float pipeline end in the same bits, the reported bond energy
 // included: the bonds' loads are summed per particle, and their energies over the bonds, in a fixed
 // order, with no float atomics.
