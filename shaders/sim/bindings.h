@@ -88,6 +88,9 @@
 // BUILD_POSITION share slots with the statistics' partials, which only their own passes bind; the
 // decision's buffers reuse low slots that the grid passes after it bind for themselves.
 #define TS_SIM_LIST 24               // uint[(K + 1) N], column-major: [i] count, [(k + 1) N + i] candidate k (list_build.comp)
+// Set in a listed candidate whose bond with the particle broke (the rest of the word is its GPU index):
+// only for such pairs does the contact kernel look up the bond's rest overlap (list_build.comp).
+#define TS_SIM_LIST_BROKEN_BOND 0x80000000u
 #define TS_SIM_BUILD_POSITION 25     // vec4 per particle: TS_SIM_PARTICLE_POSITION at the last list build
 #define TS_SIM_LIST_STATE 1          // uint[2]: TS_SIM_LIST_MAX_DISPLACEMENT, TS_SIM_LIST_FORCED
 #define TS_SIM_LIST_PLAN 2           // uvec4 per rebuild dispatch: its work groups x, y, z (gpu::Queue::end_indirect)
