@@ -118,12 +118,13 @@ void GpuStepper::rename_bonded_spheres() {
 }
 
 // Each intact bond's load^2 / (2 stiffness) summed on the GPU in a fixed order: per work group, then
-// the groups' partials by one work group, and the total read back (8 bytes, one round trip, as the
-// host sum it replaces took to read the loads). An output of advance() has already brought the loads
-// back in download_bonds, so summing those on the host would cost no read at all; but statistics()
-// also runs without a download (the tests, bench/sim_accuracy.cpp), where the host sum would read
-// 32 or 64 bytes a bond, and a pipeline that some day skips the state download at outputs (frames
-// from GPU memory) keeps the energy check at one double an output.
+// the groups' partials by one work group, and the total read back (8 bytes in one round trip; the
+// host sum it replaced read every bond's loads, 32 or 64 bytes a bond, in one). At an output of
+// advance(), download_bonds has just read those same loads (bond_state_) back for the world, so the
+// cheapest there would be to sum the downloaded loads on the host: no read and no dispatch, about 20
+// flops a bond. The GPU sum is kept because statistics() also runs without a download (tests,
+// bench/sim_accuracy.cpp), where it reads 8 bytes instead of the whole buffer, and an output that
+// one day keeps the state on the GPU (frames drawn from GPU memory) needs no bond loads for it.
 double GpuStepper::bond_energy() {
   if (bond_count_ == 0) return 0.0;
   bond_pair_.bind(TS_SIM_BOND_PAIR);
