@@ -3,7 +3,8 @@
 // bond and breaks those past their strength (counted, and the lists rebuilt at the next step, all on
 // the GPU), then bond_sums.comp adds each particle's bond loads to its wrench in ascending bond index,
 // as the CPU reference does, so a run is the same bits every time. The bonds keep their world order;
-// a re-sort only renames their spheres (resort_bonds.comp).
+// a re-sort only renames their spheres (resort_bonds.comp). At an output the energy they hold is
+// reduced on the GPU in a fixed order (bond_energy.comp), so statistics() reads back one double.
 #include <algorithm>
 #include <bit>
 #include <utility>
@@ -40,21 +41,27 @@ std::vector<std::uint32_t> bond_csr(const BondSet& bonds, std::size_t particles)
   return out;
 }
 
+// Work groups of bond_energy.comp's first pass (256 bonds each); its total goes after their partials.
+std::size_t energy_groups(std::uint32_t bonds) { return (std::size_t{bonds} + 255) / 256; }
+
 }  // namespace
 
 void GpuStepper::upload_bonds(const World& world) {
   const BondSet& bonds = world.bonds;
   bond_count_ = static_cast<std::uint32_t>(bonds.size());
-  bond_geometry_.clear();
   std::vector<std::uint32_t> pairs;
-  std::vector<double> constants, state;
+  std::vector<double> constants, state, energy_factors;
   for (std::size_t k = 0; k < bonds.size(); ++k) {
     // GPU indices are the world's at upload; the re-sort that ends upload() renames them.
     pairs.insert(pairs.end(), {bonds.a[k], bonds.b[k], bonds.intact[k] ? 1u : 0u, 0u});
     const BondGeometry<double> g = bond_geometry(world.particles.radius[bonds.a[k]],
                                                  world.particles.radius[bonds.b[k]],
                                                  world.bond_materials[bonds.material[k]]);
-    bond_geometry_.push_back(g);
+    // sim::bond_energy's denominators, inverted once here in double (TS_SIM_BOND_ENERGY_FACTORS).
+    energy_factors.insert(energy_factors.end(),
+                          {1.0 / (2.0 * g.normal_stiffness * g.area), 1.0 / (2.0 * g.shear_stiffness * g.area),
+                           1.0 / (2.0 * g.shear_stiffness * g.polar_inertia),
+                           1.0 / (2.0 * g.normal_stiffness * g.bending_inertia)});
     constants.insert(constants.end(), {g.area, g.bending_inertia, g.polar_inertia, g.radius, g.normal_stiffness,
                                        g.shear_stiffness, bonds.tensile_strength[k], bonds.shear_strength[k]});
     const BondState<double>& s = bonds.state[k];
@@ -65,6 +72,7 @@ void GpuStepper::upload_bonds(const World& world) {
   if (pairs.empty()) pairs.assign(4, 0u);
   if (constants.empty()) constants.assign(8, 0.0);
   if (state.empty()) state.assign(8, 0.0);
+  if (energy_factors.empty()) energy_factors.assign(4, 0.0);
   bond_pair_ = gpu::Buffer::from<std::uint32_t>(pairs);
   bond_csr_ = gpu::Buffer::from<std::uint32_t>(bond_csr(bonds, particle_count_));
   // Reals as the pipeline keeps them (GpuStepper::real_buffer lives in gpu_stepper.cpp).
@@ -76,11 +84,14 @@ void GpuStepper::upload_bonds(const World& world) {
   bond_state_ = reals(state);
   const std::size_t real_size = fp64() ? 8 : 4;
   bond_load_ = gpu::Buffer(std::max<std::size_t>(bond_count_, 1) * 16 * real_size);
+  // Doubles in every pipeline, as the other energies' partials (reduce_metrics.comp).
+  bond_energy_factors_ = gpu::Buffer::from<double>(energy_factors);
+  bond_energy_partials_ = gpu::Buffer((energy_groups(bond_count_) + 1) * sizeof(double));
   bond_params_.values.sizes = {bond_count_, particle_count_, 0u, 0u};
   bond_params_.values.step.x = static_cast<float>(settings_.dt);
   bond_params64_.values.sizes = {bond_count_, particle_count_, 0u, 0u};
   bond_params64_.values.step.x = settings_.dt;
-  resort_bonds_params_.values.count.x = bond_count_;
+  bond_count_params_.values.count.x = bond_count_;
 }
 
 void GpuStepper::bond_passes() {
@@ -102,24 +113,30 @@ void GpuStepper::bond_passes() {
 void GpuStepper::rename_bonded_spheres() {
   bond_pair_.bind(TS_SIM_BOND_PAIR);
   new_of_old_.bind(TS_SIM_RESORT_DESTINATION);
-  resort_bonds_params_.bind(TS_SIM_PARAMS);
+  bond_count_params_.bind(TS_SIM_PARAMS);
   queue_.dispatch_items(resort_bonds_, bond_count_);
 }
 
-double GpuStepper::bond_energy() const {
+// Each intact bond's load^2 / (2 stiffness) summed on the GPU in a fixed order: per work group, then
+// the groups' partials by one work group, and the total read back (8 bytes in one round trip; the
+// host sum it replaced read every bond's loads, 32 or 64 bytes a bond, in one). At an output of
+// advance(), download_bonds has just read those same loads (bond_state_) back for the world, so the
+// cheapest there would be to sum the downloaded loads on the host: no read and no dispatch, about 20
+// flops a bond. The GPU sum is kept because statistics() also runs without a download (tests,
+// bench/sim_accuracy.cpp), where it reads 8 bytes instead of the whole buffer, and an output that
+// one day keeps the state on the GPU (frames drawn from GPU memory) needs no bond loads for it.
+double GpuStepper::bond_energy() {
   if (bond_count_ == 0) return 0.0;
-  const std::vector<double> values = read_real(bond_state_, 8 * std::size_t{bond_count_});
-  double energy = 0.0;
-  for (std::size_t k = 0; k < bond_count_; ++k) {  // broken bonds hold zero loads
-    const double* v = &values[8 * k];
-    BondState<double> s;
-    s.shear_force = {v[0], v[1], v[2]};
-    s.normal_force = v[3];
-    s.bending_moment = {v[4], v[5], v[6]};
-    s.twisting_moment = v[7];
-    energy += sim::bond_energy(s, bond_geometry_[k]);
-  }
-  return energy;
+  bond_pair_.bind(TS_SIM_BOND_PAIR);
+  bond_state_.bind(TS_SIM_BOND_STATE);
+  bond_energy_factors_.bind(TS_SIM_BOND_ENERGY_FACTORS);
+  bond_energy_partials_.bind(TS_SIM_BOND_ENERGY_PARTIALS);
+  bond_count_params_.bind(TS_SIM_PARAMS);
+  const std::size_t groups = energy_groups(bond_count_);
+  queue_.dispatch_items(bond_energy_groups_, 256 * groups);
+  queue_.dispatch_items(bond_energy_total_, 256);  // one work group
+  bind_state();  // the pass took slots of the state
+  return bond_energy_partials_.read<double>(1, groups)[0];
 }
 
 void GpuStepper::download_bonds(World& world) const {

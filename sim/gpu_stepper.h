@@ -107,11 +107,11 @@ class GpuStepper : public Stepper {
   // Bonds of breakable props (sim/gpu_bonds.cpp): their buffers from `world` (placeholders without
   // bonds, so list_build always has its bindings); each step's two passes (the loads and breaks, then
   // the per-particle sums into the wrench); their spheres renamed after a re-sort; the energy they
-  // hold (J, read back); their state back into `world`.
+  // hold (J, reduced on the GPU, one double read back); their state back into `world`.
   void upload_bonds(const World& world);
   void bond_passes();
   void rename_bonded_spheres();
-  double bond_energy() const;
+  double bond_energy();
   void download_bonds(World& world) const;
   std::size_t counter_count() const;  // uints of counters_
   Penetration penetration(const std::vector<std::uint32_t>& counters) const;
@@ -179,13 +179,14 @@ class GpuStepper : public Stepper {
   double skin_ = 0.0, list_cell_ = 0.0;                       // m
   std::uint32_t list_capacity_ = 0;
   std::uint64_t list_builds_ = 0, list_overflows_ = 0;
-  // Bonds (TS_SIM_BOND_*), their kernels and parameters, and each bond's geometry for the energy.
-  gpu::Program bond_forces_, bond_sums_, resort_bonds_;
+  // Bonds (TS_SIM_BOND_*), their kernels and parameters, and the energy reduction's two passes
+  // (sim/bond_energy.comp: per work group, then the total) and buffers.
+  gpu::Program bond_forces_, bond_sums_, resort_bonds_, bond_energy_groups_, bond_energy_total_;
   gpu::ParamBlock<gpu::params::SimBondParams> bond_params_;
   gpu::ParamBlock<gpu::params::SimBondParams64> bond_params64_;
-  gpu::ParamBlock<gpu::params::ItemCount> resort_bonds_params_;
+  gpu::ParamBlock<gpu::params::ItemCount> bond_count_params_;  // x: bonds (resort_bonds_, bond_energy_*)
   gpu::Buffer bond_pair_, bond_csr_, bond_state_, bond_constants_, bond_load_;
-  std::vector<BondGeometry<double>> bond_geometry_;
+  gpu::Buffer bond_energy_factors_, bond_energy_partials_;
   std::uint32_t bond_count_ = 0;
   std::int64_t steps_since_resort_ = 0;
   std::uint32_t particle_count_ = 0, body_count_ = 0, plane_count_ = 0, cylinder_count_ = 0, material_count_ = 0;

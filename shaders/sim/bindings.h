@@ -32,6 +32,7 @@
 //                                 BOND_PAIR, _STATE, _PARAMS, _LOAD, COUNTERS, LIST_STATE
 //   sim/bond_sums.comp            PARTICLE_POSITION, _INFO, _WRENCH, _POSITION_EXACT (fp64), BODY_POSITION,
 //                                 BOND_PAIR, _CSR, _LOAD
+//   sim/bond_energy.comp          BOND_PAIR, _STATE, _ENERGY_FACTORS, _ENERGY_PARTIALS (statistics only)
 // list_build.comp also binds BOND_PAIR and BOND_CSR (intact bonded pairs are no contact candidates),
 // contact_forces.comp (TS_CONTACT_BONDS) BOND_CSR (a broken bond's pair meets past its rest overlap).
 #ifndef TETRASAND_SIM_BINDINGS_H
@@ -87,6 +88,9 @@
 // BUILD_POSITION share slots with the statistics' partials, which only their own passes bind; the
 // decision's buffers reuse low slots that the grid passes after it bind for themselves.
 #define TS_SIM_LIST 24               // uint[(K + 1) N], column-major: [i] count, [(k + 1) N + i] candidate k (list_build.comp)
+// Set in a listed candidate whose bond with the particle broke (the rest of the word is its GPU index):
+// only for such pairs does the contact kernel look up the bond's rest overlap (list_build.comp).
+#define TS_SIM_LIST_BROKEN_BOND 0x80000000u
 #define TS_SIM_BUILD_POSITION 25     // vec4 per particle: TS_SIM_PARTICLE_POSITION at the last list build
 #define TS_SIM_LIST_STATE 1          // uint[2]: TS_SIM_LIST_MAX_DISPLACEMENT, TS_SIM_LIST_FORCED
 #define TS_SIM_LIST_PLAN 2           // uvec4 per rebuild dispatch: its work groups x, y, z (gpu::Queue::end_indirect)
@@ -115,6 +119,13 @@
 // 4 real4 per bond, this step's load (sim::BondLoad): [4k] force on a [N], [4k + 1] moment on a [N m],
 // [4k + 2] arm from a's centre to the bond's centre [m], [4k + 3] the same from b's. Zero when broken.
 #define TS_SIM_BOND_LOAD 8
+// The bonds' energy reduction (sim/bond_energy.comp, run by statistics()), on the slots of BOND_PARAMS
+// and BOND_LOAD, which that pass does not bind. dvec4 per bond, the factors 1 / (2 stiffness) of
+// sim::bond_energy's four springs: x 1 / (2 k_n A), y 1 / (2 k_s A), z 1 / (2 k_s J), w 1 / (2 k_n I)
+// [J/N^2, J/N^2, J/(N m)^2, J/(N m)^2].
+#define TS_SIM_BOND_ENERGY_FACTORS 5
+// double per 256 bonds, each work group's energy [J], then the total [J] after them (read back).
+#define TS_SIM_BOND_ENERGY_PARTIALS 8
 
 // ---- Re-sort by Morton key (GpuStepper::resort): the keys go through gpu::BucketSort (TS_SORT_*).
 #define TS_SIM_RESORT_ORDER TS_SORT_SORTED  // uint per new body: its old index (the sort's output)

@@ -9,7 +9,8 @@
 // contact kernel walks the grid for it (still valid for it: the cell is largest diameter + skin).
 // The positions are kept as the build's (TS_SIM_BUILD_POSITION) for the displacement test.
 // Pairs joined by an intact bond are left to the bond (sim/bond_forces.comp), as the CPU lists do: no
-// candidates. An overflowing particle lists its intact bonded partners instead, in row 4 (how many)
+// candidates; a pair whose bond broke is listed with TS_SIM_LIST_BROKEN_BOND set, so the contact
+// kernel looks up its rest overlap for such pairs only. An overflowing particle lists its intact bonded partners instead, in row 4 (how many)
 // and rows 5 on, for the contact kernel's grid walk to skip; when they do not fit either, it is
 // counted (TS_SIM_COUNTER_BOND_EXCLUSIONS_LOST) and the run stops at the next statistics.
 #include "common/dispatch.glsl"
@@ -31,13 +32,17 @@ layout(std430, binding = TS_SIM_BOND_CSR) readonly buffer Csr { uint bond_csr[];
 #include "common/params.h"
 layout(std140, binding = TS_SIM_PARAMS) uniform ListBlock { SimListParams params; };
 
-// Particle i's intact bonds (its CSR entries [first, last)): whether one joins it to j.
-bool bonded(uint i, uint j, uint first, uint last, uint particles) {
+// Particle i's bonds (its CSR entries [first, last)): BOND_NONE when none joins it to j, else whether
+// the one that does is intact or broken.
+#define BOND_NONE 0u
+#define BOND_INTACT 1u
+#define BOND_BROKEN 2u
+uint bond_with(uint i, uint j, uint first, uint last, uint particles) {
   for (uint e = first; e < last; ++e) {
     uvec4 pair = bond_pair[bond_csr[particles + 1u + TS_SIM_BOND_CSR_STRIDE * e]];
-    if (pair.z != 0u && (pair.x == j || pair.y == j) && j != i) return true;
+    if ((pair.x == j || pair.y == j) && j != i) return pair.z != 0u ? BOND_INTACT : BOND_BROKEN;
   }
-  return false;
+  return BOND_NONE;
 }
 
 void main() {
@@ -58,12 +63,13 @@ void main() {
     if (body_j == body_i || (fixed_i && body_position[body_j].w == 0.0)) continue;
     vec4 xj = particle_position[j];
     if (distance(xi.xyz, xj.xyz) >= xi.w + xj.w + params.lengths.z) continue;
-    if (bonds_first != bonds_last && bonded(i, j, bonds_first, bonds_last, particles)) continue;
+    uint bond = bonds_first != bonds_last ? bond_with(i, j, bonds_first, bonds_last, particles) : BOND_NONE;
+    if (bond == BOND_INTACT) continue;
     if (n == capacity) {
       n = capacity + 1u;
       break;
     }
-    list[(n + 1u) * particles + i] = j;
+    list[(n + 1u) * particles + i] = bond == BOND_BROKEN ? j | TS_SIM_LIST_BROKEN_BOND : j;
     ++n;
   }
   list[i] = n;

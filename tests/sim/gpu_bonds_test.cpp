@@ -4,8 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 
+#include "sim/cpu_bonds.h"
 #include "sim/cpu_stepper.h"
 #include "sim/gpu_stepper.h"
 #include "sim/state_bytes.h"
@@ -73,20 +77,74 @@ TEST_F(GpuBonds, ThrownBlockBreaksTheSameBondsAsTheCpuReference) {
   }
 }
 
-// Two runs of one throw in the float pipeline end in the same bits: the bonds' loads are summed per
-// particle in a fixed order, with no float atomics.
+// The bonds' elastic energy an output reports (reduced on the GPU) is the CPU reference's bond energy
+// of the state the same output downloads, to the rounding of another summation order, in every
+// pipeline; in the double pipelines it follows the CPU reference's own run within 1e-4 of the
+// largest energy the bonds hold on the way (the float bond law of the mixed pipeline included).
+TEST_F(GpuBonds, ReportedBondEnergyIsTheCpuReferencesEnergyOfTheSameState) {
+  for (Precision precision : {Precision::FullDouble, Precision::Double, Precision::Float}) {
+    World cpu_world = thrown_block(kWeak, kSpeed);
+    World gpu_world = cpu_world;
+    const StepSettings s = throw_settings(cpu_world, kSpeed);
+    CpuStepper cpu(cpu_world, s);
+    GpuStepper gpu(context, gpu_world, s, precision);
+    double same_state = 0.0, against_cpu = 0.0, peak = 0.0;
+    for (int c = 0; c < kChunks; ++c) {
+      cpu.advance(cpu_world, kChunk);
+      const double reported = gpu.advance(gpu_world, kChunk).elastic_energy;
+      const double reference = bond_energy(gpu_world);
+      same_state = std::max(same_state, std::abs(reported - reference) / std::max(reference, 1e-300));
+      against_cpu = std::max(against_cpu, std::abs(reported - bond_energy(cpu_world)));
+      peak = std::max(peak, reference);
+    }
+    std::printf("%s: bond energy up to %.3g J, reported vs the same state %.3g (relative), vs the CPU run %.3g J\n",
+                gpu.engine().c_str(), peak, same_state, against_cpu);
+    EXPECT_GT(peak, 0.0) << "the throw should load the bonds";
+    EXPECT_LT(same_state, 1e-12) << gpu.engine();
+    if (precision != Precision::Float) {
+      EXPECT_LT(against_cpu, 1e-4 * peak) << gpu.engine();
+    }
+  }
+}
+
+// A block of more bonds than one work group of the energy reduction sums (256), shaken from the
+// inside: the GPU's total over the groups' partials is still the CPU reference's energy of the state.
+TEST_F(GpuBonds, BondEnergyOfManyWorkGroupsIsTheCpuReferencesEnergyOfTheSameState) {
+  World w = bonded_block(4, cement());
+  ASSERT_GT(w.bonds.size(), 4u * 256u) << "the test needs several work groups of bonds";
+  for (std::size_t k = 0; k < w.bodies.size(); ++k) {
+    const double x = static_cast<double>(k);
+    w.bodies.linear_velocity[k] = 0.05 * V(std::sin(x), std::cos(1.7 * x), std::sin(0.3 * x + 1.0));
+  }
+  for (Precision precision : {Precision::FullDouble, Precision::Float}) {
+    World run = w;
+    GpuStepper gpu(context, run, symplectic(bond_step(w)), precision);
+    const double reported = gpu.advance(run, 50).elastic_energy;
+    const double reference = bond_energy(run);
+    EXPECT_GT(reference, 0.0);
+    EXPECT_LT(std::abs(reported - reference), 1e-12 * reference) << gpu.engine();
+  }
+}
+
+// Two runs of one throw in the float pipeline end in the same bits, the reported bond energy
+// included: the bonds' loads are summed per particle, and their energies over the bonds, in a fixed
+// order, with no float atomics.
 TEST_F(GpuBonds, SameThrowGivesBitwiseTheSameState) {
   std::string first;
+  std::uint64_t first_energy = 0;
   for (int run = 0; run < 2; ++run) {
     World w = thrown_block(kWeak, kSpeed);
     GpuStepper gpu(context, w, throw_settings(w, kSpeed), Precision::Float);
     const StepStats stats = gpu.advance(w, kChunks * kChunk);
     EXPECT_EQ(stats.bonds_broken, w.bonds.size() - w.bonds.intact_count());
     EXPECT_GT(stats.bonds_broken, 0u);
+    EXPECT_GT(stats.elastic_energy, 0.0);
     if (run == 0) {
       first = world_bytes(w);
+      first_energy = std::bit_cast<std::uint64_t>(stats.elastic_energy);
     } else {
       EXPECT_TRUE(world_bytes(w) == first) << "the second run differs";
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(stats.elastic_energy), first_energy) << "its bond energy differs";
     }
   }
 }
