@@ -97,15 +97,6 @@ Eigen::Matrix3d world_inverse_inertia(const Eigen::Quaterniond& q, const Eigen::
   return r * body_inverse_inertia * r.transpose();
 }
 
-// c when the body-frame inverse inertia is c times the identity (the grains: make_tetrahedral_grain's
-// inertia is isotropic), else 0.
-double isotropic_inverse_inertia(const Eigen::Matrix3d& m) {
-  const double c = m(0, 0);
-  const bool isotropic = m(1, 1) == c && m(2, 2) == c && m(0, 1) == 0 && m(0, 2) == 0 && m(1, 0) == 0 &&
-                         m(1, 2) == 0 && m(2, 0) == 0 && m(2, 1) == 0;
-  return isotropic && c > 0 ? c : 0.0;
-}
-
 }  // namespace
 
 void CpuStepper::integrate(World& world, StepStats& stats) {

@@ -75,18 +75,15 @@ Eigen::Matrix3d world_inertia(const Bodies& b, std::size_t i) {
   return r * b.inverse_inertia[i].inverse() * r.transpose();
 }
 
-// 1 / c when the body-frame inverse inertia is c times the identity (every grain:
-// make_tetrahedral_grain's inertia is isotropic), else 0. R (1/c) Id R^T = (1/c) Id, so such a body's
-// world inertia needs no rotation and no inverse (as CpuStepper::integrate's isotropic path).
-double isotropic_inertia(const Eigen::Matrix3d& inverse_inertia) {
+}  // namespace
+
+double isotropic_inverse_inertia(const Eigen::Matrix3d& inverse_inertia) {
   const Eigen::Matrix3d& m = inverse_inertia;
   const double c = m(0, 0);
   const bool isotropic = m(1, 1) == c && m(2, 2) == c && m(0, 1) == 0 && m(0, 2) == 0 && m(1, 0) == 0 &&
                          m(1, 2) == 0 && m(2, 0) == 0 && m(2, 1) == 0;
-  return isotropic && c > 0 ? 1.0 / c : 0.0;
+  return isotropic && c > 0 ? c : 0.0;
 }
-
-}  // namespace
 
 Energy energy(const World& world) {
   const Bodies& b = world.bodies;
@@ -95,8 +92,8 @@ Energy energy(const World& world) {
     if (b.motion[i] != MotionType::Dynamic) continue;
     const double mass = 1.0 / b.inverse_mass[i];
     e.translational += 0.5 * mass * b.linear_velocity[i].squaredNorm();
-    if (const double inertia = isotropic_inertia(b.inverse_inertia[i]); inertia > 0) {
-      e.rotational += 0.5 * inertia * b.angular_velocity[i].squaredNorm();
+    if (const double c = isotropic_inverse_inertia(b.inverse_inertia[i]); c > 0) {
+      e.rotational += 0.5 * (1.0 / c) * b.angular_velocity[i].squaredNorm();
     } else {
       e.rotational += 0.5 * b.angular_velocity[i].dot(world_inertia(b, i) * b.angular_velocity[i]);
     }

@@ -157,6 +157,11 @@ struct Energy {
 };
 Energy energy(const World& world);
 
+// c when a body-frame inverse inertia is c times the identity (every grain: make_tetrahedral_grain's
+// inertia is isotropic), else 0. Such a body's world-frame tensor is c Id in every orientation
+// (R c Id R^T = c Id), so the integration and the energy need neither its rotation nor an inverse.
+double isotropic_inverse_inertia(const Eigen::Matrix3d& inverse_inertia);
+
 // Total linear momentum (kg m/s) and angular momentum about the origin (kg m^2/s) of dynamic bodies.
 Eigen::Vector3d linear_momentum(const World& world);
 Eigen::Vector3d angular_momentum(const World& world);
