@@ -4,7 +4,8 @@
 // the GPU), then bond_sums.comp adds each particle's bond loads to its wrench in ascending bond index,
 // as the CPU reference does, so a run is the same bits every time. The bonds keep their world order;
 // a re-sort only renames their spheres (resort_bonds.comp). At an output the energy they hold is
-// reduced on the GPU in a fixed order (bond_energy.comp), so statistics() reads back one double.
+// summed per work group on the GPU (bond_energy.comp) and the partials in order on the host, as the
+// bodies' energies are (reduce_metrics.comp).
 #include <algorithm>
 #include <bit>
 #include <utility>
@@ -41,7 +42,7 @@ std::vector<std::uint32_t> bond_csr(const BondSet& bonds, std::size_t particles)
   return out;
 }
 
-// Work groups of bond_energy.comp's first pass (256 bonds each); its total goes after their partials.
+// Work groups of bond_energy.comp (256 bonds each), one partial each.
 std::size_t energy_groups(std::uint32_t bonds) { return (std::size_t{bonds} + 255) / 256; }
 
 }  // namespace
@@ -86,7 +87,7 @@ void GpuStepper::upload_bonds(const World& world) {
   bond_load_ = gpu::Buffer(std::max<std::size_t>(bond_count_, 1) * 16 * real_size);
   // Doubles in every pipeline, as the other energies' partials (reduce_metrics.comp).
   bond_energy_factors_ = gpu::Buffer::from<double>(energy_factors);
-  bond_energy_partials_ = gpu::Buffer((energy_groups(bond_count_) + 1) * sizeof(double));
+  bond_energy_partials_ = gpu::Buffer(std::max<std::size_t>(energy_groups(bond_count_), 1) * sizeof(double));
   bond_params_.values.sizes = {bond_count_, particle_count_, 0u, 0u};
   bond_params_.values.step.x = static_cast<float>(settings_.dt);
   bond_params64_.values.sizes = {bond_count_, particle_count_, 0u, 0u};
@@ -117,14 +118,11 @@ void GpuStepper::rename_bonded_spheres() {
   queue_.dispatch_items(resort_bonds_, bond_count_);
 }
 
-// Each intact bond's load^2 / (2 stiffness) summed on the GPU in a fixed order: per work group, then
-// the groups' partials by one work group, and the total read back (8 bytes in one round trip; the
-// host sum it replaced read every bond's loads, 32 or 64 bytes a bond, in one). At an output of
-// advance(), download_bonds has just read those same loads (bond_state_) back for the world, so the
-// cheapest there would be to sum the downloaded loads on the host: no read and no dispatch, about 20
-// flops a bond. The GPU sum is kept because statistics() also runs without a download (tests,
-// bench/sim_accuracy.cpp), where it reads 8 bytes instead of the whole buffer, and an output that
-// one day keeps the state on the GPU (frames drawn from GPU memory) needs no bond loads for it.
+// Each intact bond's load^2 / (2 stiffness), summed per work group on the GPU and the partials in
+// order here (bonds / 256 doubles read back instead of every bond's loads). At an output of advance(),
+// download_bonds has just read those loads back for the world, so summing them on the host would
+// cost no read there; the GPU sum serves statistics() without a download too (tests,
+// bench/sim_accuracy.cpp).
 double GpuStepper::bond_energy() {
   if (bond_count_ == 0) return 0.0;
   bond_pair_.bind(TS_SIM_BOND_PAIR);
@@ -132,11 +130,11 @@ double GpuStepper::bond_energy() {
   bond_energy_factors_.bind(TS_SIM_BOND_ENERGY_FACTORS);
   bond_energy_partials_.bind(TS_SIM_BOND_ENERGY_PARTIALS);
   bond_count_params_.bind(TS_SIM_PARAMS);
-  const std::size_t groups = energy_groups(bond_count_);
-  queue_.dispatch_items(bond_energy_groups_, 256 * groups);
-  queue_.dispatch_items(bond_energy_total_, 256);  // one work group
+  queue_.dispatch_items(bond_energy_, bond_count_);
   bind_state();  // the pass took slots of the state
-  return bond_energy_partials_.read<double>(1, groups)[0];
+  double energy = 0.0;
+  for (double partial : bond_energy_partials_.read<double>(energy_groups(bond_count_))) energy += partial;
+  return energy;
 }
 
 void GpuStepper::download_bonds(World& world) const {

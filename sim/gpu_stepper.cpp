@@ -36,13 +36,6 @@ std::vector<std::string> bond_defines(Precision precision) {
   return defines;
 }
 
-// The bond energy reduction's two passes: per work group of bonds, then their total.
-std::vector<std::string> bond_energy_defines(Precision precision, bool total) {
-  std::vector<std::string> defines = precision_defines(precision);
-  defines.push_back(fmt::format("TS_BOND_ENERGY_TOTAL {}", total ? 1 : 0));
-  return defines;
-}
-
 // The contact kernel's specialisation for these settings and a world with or without walls
 // (shaders/sim/contact_forces.comp, TS_CONTACT_*): switches the whole scene shares are compiled in, so
 // what is off (the spring history above all) costs the kernel no registers.
@@ -117,10 +110,7 @@ GpuStepper::GpuStepper(gpu::Context& context, const StepSettings& settings, Prec
       bond_forces_(gpu::Program::compute(library_, "sim/bond_forces.comp", bond_defines(precision))),
       bond_sums_(gpu::Program::compute(library_, "sim/bond_sums.comp", bond_defines(precision))),
       resort_bonds_(gpu::Program::compute(library_, "sim/resort_bonds.comp")),
-      bond_energy_groups_(gpu::Program::compute(library_, "sim/bond_energy.comp",
-                                                bond_energy_defines(precision, false))),
-      bond_energy_total_(gpu::Program::compute(library_, "sim/bond_energy.comp",
-                                               bond_energy_defines(precision, true))),
+      bond_energy_(gpu::Program::compute(library_, "sim/bond_energy.comp", precision_defines(precision))),
       syncs_at_start_(gpu::host_sync_counts()) {}
 
 template <typename T>

@@ -107,7 +107,7 @@ class GpuStepper : public Stepper {
   // Bonds of breakable props (sim/gpu_bonds.cpp): their buffers from `world` (placeholders without
   // bonds, so list_build always has its bindings); each step's two passes (the loads and breaks, then
   // the per-particle sums into the wrench); their spheres renamed after a re-sort; the energy they
-  // hold (J, reduced on the GPU, one double read back); their state back into `world`.
+  // hold (J, per work group on the GPU, the partials added in order); their state back into `world`.
   void upload_bonds(const World& world);
   void bond_passes();
   void rename_bonded_spheres();
@@ -179,9 +179,9 @@ class GpuStepper : public Stepper {
   double skin_ = 0.0, list_cell_ = 0.0;                       // m
   std::uint32_t list_capacity_ = 0;
   std::uint64_t list_builds_ = 0, list_overflows_ = 0;
-  // Bonds (TS_SIM_BOND_*), their kernels and parameters, and the energy reduction's two passes
-  // (sim/bond_energy.comp: per work group, then the total) and buffers.
-  gpu::Program bond_forces_, bond_sums_, resort_bonds_, bond_energy_groups_, bond_energy_total_;
+  // Bonds (TS_SIM_BOND_*), their kernels (the energy's per work group: sim/bond_energy.comp) and
+  // parameters, and buffers.
+  gpu::Program bond_forces_, bond_sums_, resort_bonds_, bond_energy_;
   gpu::ParamBlock<gpu::params::SimBondParams> bond_params_;
   gpu::ParamBlock<gpu::params::SimBondParams64> bond_params64_;
   gpu::ParamBlock<gpu::params::ItemCount> bond_count_params_;  // x: bonds (resort_bonds_, bond_energy_*)
